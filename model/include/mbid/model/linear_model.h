@@ -1,0 +1,42 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <complex>
+#include <string>
+#include <vector>
+
+namespace mbid::model {
+
+// The linearized equations of motion about a static equilibrium (method.md, eq. 1 with r = 0):
+//   M q'' + D q' + C q = 0,   y = H q,
+// with q the deviation of the generalized coordinates from the equilibrium (rad) and y the
+// deviation of the outputs (rad). C includes the geometric (gravity) stiffness.
+struct LinearModel {
+  std::vector<std::string> coordinates;  // n names
+  std::vector<std::string> outputs;      // m names
+  Eigen::MatrixXd M;  // n x n, kg*m^2
+  Eigen::MatrixXd D;  // n x n, N*m*s/rad
+  Eigen::MatrixXd C;  // n x n, N*m/rad
+  Eigen::MatrixXd H;  // m x n, rad/rad
+};
+
+// One complex pole of the first-order system and its shape. For an underdamped pair only the
+// member with Im(lambda) > 0 is kept.
+struct Mode {
+  std::complex<double> lambda;  // 1/s; decaying modes have Re(lambda) < 0
+  Eigen::VectorXcd shape;         // per coordinate, unit largest magnitude
+  Eigen::VectorXcd output_shape;  // H * shape
+
+  double frequency_hz() const;           // Im(lambda) / (2 pi), damped
+  double decay_rate_per_s() const;       // -Re(lambda)
+  double damping_ratio() const;          // -Re(lambda) / |lambda|
+  double undamped_frequency_hz() const;  // |lambda| / (2 pi)
+  double log_decrement() const;          // 2 pi decay / omega_d
+  double half_life_s() const;            // ln 2 / decay
+};
+
+// The exact modes: eigenvalues of [0 I; -M^-1 C  -M^-1 D], oscillatory ones (Im > 0) sorted by
+// ascending damped frequency, followed by real (overdamped) poles sorted by decay.
+std::vector<Mode> CalcModes(const LinearModel& linear);
+
+}  // namespace mbid::model

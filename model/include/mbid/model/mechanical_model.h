@@ -1,0 +1,79 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbid/model/linear_model.h"
+
+namespace SimTK {
+class MultibodySystem;
+class State;
+}  // namespace SimTK
+
+namespace mbid::model {
+
+// A tunable parameter of a model, with its unit and admissible range.
+struct Parameter {
+  std::string name;   // "c_alpha", "d_theta", ...
+  std::string units;  // "N*m/rad", "N*m*s/rad"
+  double value = 0.0;
+  double lower = 0.0;
+  double upper = 0.0;
+};
+
+// A static force at a named point of the machine, expressed in the ground frame (N). The crane
+// names its boom tip "boom_tip"; a payload of mass m is {"boom_tip", {0, 0, -m g}}.
+struct PointLoad {
+  std::string point;
+  Eigen::Vector3d force_G = Eigen::Vector3d::Zero();
+};
+
+// What identification and updating see of a machine: named coordinates, outputs and
+// parameters; a Simbody system whose state is q = generalized coordinates (q' = u, no
+// quaternions, no constraints); its static equilibrium and linearization. Each instance owns
+// its system and states, so a worker thread owns its model.
+class MechanicalModel {
+ public:
+  virtual ~MechanicalModel() = default;
+
+  virtual std::string type() const = 0;
+  virtual const std::vector<std::string>& coordinate_names() const = 0;
+  virtual const std::vector<std::string>& output_names() const = 0;
+  // Output units, one per output.
+  virtual const std::vector<std::string>& output_units() const = 0;
+  int coordinate_count() const { return static_cast<int>(coordinate_names().size()); }
+  int output_count() const { return static_cast<int>(output_names().size()); }
+  // Names of points that accept external loads.
+  virtual std::vector<std::string> load_points() const = 0;
+
+  // The tunable parameters with their current values.
+  virtual std::vector<Parameter> parameters() const = 0;
+  // Throws InputError for an unknown name or a value outside (lower, upper).
+  virtual void SetParameter(const std::string& name, double value) = 0;
+  double GetParameter(const std::string& name) const;
+
+  // The Simbody system; realized to Topology.
+  virtual const SimTK::MultibodySystem& system() const = 0;
+  // A state at time 0 with coordinates q and speeds u (rad, rad/s), carrying the current
+  // parameters and no external load.
+  virtual SimTK::State MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const = 0;
+  // Sets the external load of `state` (replaces what was there; invalidates Dynamics only).
+  virtual void SetExternalLoad(SimTK::State& state, const std::vector<PointLoad>& loads,
+                               const Eigen::VectorXd& generalized_forces) const = 0;
+  // The outputs y (rad) of a state realized at least to Position.
+  virtual Eigen::VectorXd CalcOutputs(const SimTK::State& state) const = 0;
+  // Total mechanical energy (J): kinetic + gravity + spring potential.
+  virtual double CalcEnergy(const SimTK::State& state) const = 0;
+
+  // The static equilibrium q under the given static loads, at rest. Solved by Newton to
+  // machine precision; a failure to converge is a NumericalError.
+  virtual Eigen::VectorXd SolveStaticEquilibrium(const std::vector<PointLoad>& loads) const = 0;
+  // Linearization about the unloaded equilibrium (q = 0 by construction of the preload).
+  virtual LinearModel Linearize() const = 0;
+
+  virtual std::unique_ptr<MechanicalModel> Clone() const = 0;
+};
+
+}  // namespace mbid::model
