@@ -7,6 +7,10 @@ namespace mbid {
 // An output file that appears under its final name only when complete. Write to temp_path();
 // Commit() renames it into place; destruction without Commit() removes the temporary, so a
 // failed command leaves nothing behind (docs/interfaces: exit codes).
+//
+// The temporary is "<path>.tmp-<pid>-<n>" beside the target. The constructor throws InputError
+// when the target's directory does not exist or the target is a directory (a bad output flag);
+// Commit() throws std::runtime_error when nothing was written or the rename fails.
 class AtomicFile {
  public:
   explicit AtomicFile(std::string path);

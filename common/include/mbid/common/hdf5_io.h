@@ -16,7 +16,11 @@ namespace mbid {
 //   /scenario     attr yaml (resolved scenario text)
 //   other groups  (/truth, /identification, ...): one dataset per quantity, attr units.
 // The file is written under a temporary name and renamed by Commit(); an H5Writer destroyed
-// without Commit() leaves no file.
+// without Commit() leaves no file. Writing an object that exists replaces it. HDF5 failures
+// throw std::runtime_error naming the file and object; WriteMeasurement() Validate()s first.
+// Strings are variable-length UTF-8 (h5py reads them as str); matrices are stored row-major
+// [rows, cols] as numpy expects. Calls into HDF5 are serialized by a process-wide lock because
+// the serial HDF5 library is not thread-safe.
 class H5Writer {
  public:
   explicit H5Writer(const std::string& path);
@@ -48,8 +52,48 @@ class H5Writer {
   std::unique_ptr<Impl> impl_;
 };
 
+// Read access to an HDF5 file written by H5Writer (or by h5py, MATLAB, ... in the same layout).
+// Every failure is an InputError naming the file and the dataset or attribute. Object paths
+// are absolute ("/truth/modes"); the root is "/". Float datasets of any precision are read as
+// double; strings may be variable- or fixed-length.
+class H5Reader {
+ public:
+  // Throws InputError if the file cannot be opened or is not an HDF5 file.
+  explicit H5Reader(const std::string& path);
+  ~H5Reader();
+  H5Reader(const H5Reader&) = delete;
+  H5Reader& operator=(const H5Reader&) = delete;
+
+  const std::string& path() const;
+  // Whether the group or dataset `object` exists ("/measurement/psi").
+  bool Exists(const std::string& object) const;
+  bool HasAttribute(const std::string& object, const std::string& name) const;
+
+  Eigen::VectorXd ReadVector(const std::string& group, const std::string& name) const;
+  Eigen::MatrixXd ReadMatrix(const std::string& group, const std::string& name) const;
+  double ReadScalar(const std::string& group, const std::string& name) const;
+  std::vector<std::string> ReadStrings(const std::string& group, const std::string& name) const;
+  // The "units" attribute of dataset group/name.
+  std::string ReadUnits(const std::string& group, const std::string& name) const;
+  std::string ReadStringAttribute(const std::string& object, const std::string& name) const;
+  std::vector<std::string> ReadStringArrayAttribute(const std::string& object,
+                                                    const std::string& name) const;
+  double ReadDoubleAttribute(const std::string& object, const std::string& name) const;
+  long long ReadIntAttribute(const std::string& object, const std::string& name) const;
+
+  // See ReadMeasurementH5 and ReadScenarioYaml.
+  Measurement ReadMeasurement() const;
+  std::string ReadScenarioYaml() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // Reads /measurement; errors (not HDF5, wrong format attribute, missing channel, missing units,
 // non-uniform or decreasing time, NaN/Inf, empty) name the file and the dataset or attribute.
+// The sample interval is the sample_interval_s attribute, which must agree with the time
+// dataset to the uniformity tolerance; the start time is the first time sample.
 Measurement ReadMeasurementH5(const std::string& path);
 
 // Reads the /scenario yaml attribute, or an empty string if the file has none.

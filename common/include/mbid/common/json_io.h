@@ -5,7 +5,10 @@
 
 namespace mbid {
 
-// Writes `value` pretty-printed to `path` atomically; "-" writes to standard output.
+// Writes `value` pretty-printed (2-space indent) to `path` atomically; "-" writes to standard
+// output. JSON has no NaN or infinity: a non-finite number throws std::invalid_argument naming
+// its JSON pointer ("/modes/0/frequency_hz") and nothing is written. I/O failures throw
+// std::runtime_error.
 void WriteJson(const nlohmann::json& value, const std::string& path);
 
 // Reads a JSON file; a parse error is an InputError naming the file and line.

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -12,9 +13,9 @@ struct Measurement {
   std::vector<std::string> channels;  // in file order
   std::vector<std::string> units;     // one per channel, e.g. "rad"
   double start_time_s = 0.0;
-  double sample_interval_s = 0.0;     // tau
-  Eigen::MatrixXd values;             // samples x channels
-  std::string source = "import";      // "simulation" | "import" | ...
+  double sample_interval_s = 0.0;  // tau
+  Eigen::MatrixXd values;          // samples x channels
+  std::string source = "import";   // "simulation" | "import" | ...
 
   int samples() const { return static_cast<int>(values.rows()); }
   int channel_count() const { return static_cast<int>(values.cols()); }
@@ -25,7 +26,19 @@ struct Measurement {
   // Throws InputError naming `origin` (usually the file) unless: at least two samples, at least
   // one channel, names and units match the columns, names unique and non-empty, a positive
   // finite sample interval, and every value finite (the error names the channel and sample).
+  // Names must also be writable to both file formats: not "time", no ',', '/' or line breaks.
   void Validate(const std::string& origin) const;
 };
+
+// Largest deviation of a sample time from the uniform grid t0 + j * tau, relative to tau, that
+// a measurement file may have (docs/interfaces).
+inline constexpr double kTimeUniformityTolerance = 1e-6;
+
+// Checks a time column (seconds): at least two samples, all finite, strictly increasing, and
+// uniform: |t_j - (t_0 + j * tau)| < kTimeUniformityTolerance * tau for tau = (t_{N-1} - t_0) /
+// (N - 1). Returns tau. Errors are InputErrors with source `origin` and the field
+// `field_of_sample(j)` of the offending sample j (e.g. "line 12" or "/measurement/time").
+double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin,
+                        const std::function<std::string(Eigen::Index)>& field_of_sample);
 
 }  // namespace mbid

@@ -1,0 +1,90 @@
+#pragma once
+
+// Helpers shared by the common sources; not part of the public API.
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mbid/common/error.h"
+
+namespace mbid::internal {
+
+enum class ParseStatus { kOk, kNotANumber, kOutOfRange };
+
+// Parses all of `text` as a decimal double, independent of the C locale. "nan"/"inf" parse
+// (callers reject non-finite values with their own message); a leading '+' is accepted.
+inline ParseStatus ParseDouble(std::string_view text, double* value) {
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  if (text.empty() || text.front() == '+' || text.front() == ' ') return ParseStatus::kNotANumber;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, *value);
+  if (ptr != end) return ParseStatus::kNotANumber;
+  if (ec == std::errc::result_out_of_range) {
+    // from_chars also reports underflow to a subnormal; strtod gives the nearest value then.
+    const std::string copy(text);
+    const double v = std::strtod(copy.c_str(), nullptr);
+    if (!std::isfinite(v)) return ParseStatus::kOutOfRange;
+    *value = v;
+    return ParseStatus::kOk;
+  }
+  if (ec != std::errc()) return ParseStatus::kNotANumber;
+  return ParseStatus::kOk;
+}
+
+inline std::string Trim(std::string_view text) {
+  const auto first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string_view::npos) return {};
+  const auto last = text.find_last_not_of(" \t\r\n");
+  return std::string(text.substr(first, last - first + 1));
+}
+
+inline std::string Join(const std::vector<std::string>& items, const std::string& separator) {
+  std::string out;
+  for (size_t i = 0; i < items.size(); ++i) {
+    if (i > 0) out += separator;
+    out += items[i];
+  }
+  return out;
+}
+
+// Whole file as text; a file that cannot be opened or read is an InputError naming it.
+inline std::string ReadTextFile(const std::string& path, const std::string& expected) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    throw InputError(path, "", std::string("cannot open: ") + std::strerror(errno), expected);
+  }
+  std::string text;
+  char buffer[65536];
+  size_t n = 0;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), file)) > 0) text.append(buffer, n);
+  const bool failed = std::ferror(file) != 0;
+  const int error = errno;
+  std::fclose(file);
+  if (failed)
+    throw InputError(path, "", std::string("cannot read: ") + std::strerror(error), expected);
+  return text;
+}
+
+// Throws the same "cannot open" InputError as ReadTextFile when `path` is not readable.
+inline void CheckReadable(const std::string& path, const std::string& expected) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    throw InputError(path, "", std::string("cannot open: ") + std::strerror(errno), expected);
+  }
+  char byte = 0;
+  const size_t n = std::fread(&byte, 1, 1, file);
+  const bool failed = n == 0 && std::ferror(file) != 0;
+  const int error = errno;
+  std::fclose(file);
+  if (failed)
+    throw InputError(path, "", std::string("cannot read: ") + std::strerror(error), expected);
+}
+
+}  // namespace mbid::internal

@@ -1,0 +1,149 @@
+#include "mbid/common/measurement.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <set>
+
+#include "mbid/common/error.h"
+
+namespace mbid {
+namespace {
+
+std::string DescribeNonFinite(double value) {
+  if (std::isnan(value)) return "NaN";
+  return value > 0 ? "+Inf" : "-Inf";
+}
+
+}  // namespace
+
+Eigen::VectorXd Measurement::CalcTime() const {
+  Eigen::VectorXd time(values.rows());
+  // t0 + j * tau per sample (not a running sum) so that files round-trip bit for bit.
+  for (Eigen::Index j = 0; j < time.size(); ++j) {
+    time[j] = start_time_s + static_cast<double>(j) * sample_interval_s;
+  }
+  return time;
+}
+
+int Measurement::FindChannel(const std::string& channel) const {
+  for (size_t i = 0; i < channels.size(); ++i) {
+    if (channels[i] == channel) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+void Measurement::Validate(const std::string& origin) const {
+  if (values.cols() < 1) {
+    throw InputError(origin, "", "the measurement has no channels", "at least one channel");
+  }
+  if (values.rows() < 2) {
+    throw InputError(origin, "", fmt::format("the measurement has {} samples", values.rows()),
+                     "at least 2 samples");
+  }
+  if (channels.size() != static_cast<size_t>(values.cols())) {
+    throw InputError(
+        origin, "",
+        fmt::format("{} channel names for {} value columns", channels.size(), values.cols()),
+        "one name per column");
+  }
+  if (units.size() != channels.size()) {
+    throw InputError(origin, "",
+                     fmt::format("{} units for {} channels", units.size(), channels.size()),
+                     "one unit per channel");
+  }
+  std::set<std::string> seen;
+  for (size_t i = 0; i < channels.size(); ++i) {
+    const std::string& name = channels[i];
+    if (name.empty()) {
+      throw InputError(origin, fmt::format("channel {}", i), "empty channel name",
+                       "a non-empty name");
+    }
+    if (name == "time" || name.find_first_of(",/\r\n") != std::string::npos) {
+      throw InputError(origin, name, fmt::format("invalid channel name '{}'", name),
+                       "a name other than 'time' without ',', '/' or line breaks");
+    }
+    if (!seen.insert(name).second) {
+      throw InputError(origin, name, fmt::format("channel '{}' appears twice", name),
+                       "unique channel names");
+    }
+    if (units[i].empty()) {
+      throw InputError(origin, name, "empty unit", "a unit such as 'rad'");
+    }
+  }
+  if (!std::isfinite(sample_interval_s) || sample_interval_s <= 0) {
+    throw InputError(origin, "sample_interval_s",
+                     fmt::format("sample interval {} s", sample_interval_s),
+                     "a positive finite sample interval");
+  }
+  if (!std::isfinite(start_time_s)) {
+    throw InputError(origin, "time", fmt::format("start time {} s", start_time_s),
+                     "a finite start time");
+  }
+  for (Eigen::Index c = 0; c < values.cols(); ++c) {
+    for (Eigen::Index j = 0; j < values.rows(); ++j) {
+      const double v = values(j, c);
+      if (!std::isfinite(v)) {
+        throw InputError(origin, channels[c],
+                         fmt::format("sample {} (t = {} s) is {}", j,
+                                     start_time_s + static_cast<double>(j) * sample_interval_s,
+                                     DescribeNonFinite(v)),
+                         "finite values");
+      }
+    }
+  }
+}
+
+double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin,
+                        const std::function<std::string(Eigen::Index)>& field_of_sample) {
+  const Eigen::Index n = time_s.size();
+  if (n < 2) {
+    throw InputError(origin, field_of_sample(0), fmt::format("{} time samples", n),
+                     "at least 2 samples");
+  }
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (!std::isfinite(time_s[j])) {
+      throw InputError(origin, field_of_sample(j),
+                       fmt::format("time of sample {} is {}", j, DescribeNonFinite(time_s[j])),
+                       "finite times in seconds");
+    }
+  }
+  for (Eigen::Index j = 1; j < n; ++j) {
+    if (time_s[j] > time_s[j - 1]) continue;
+    const std::string problem =
+        time_s[j] == time_s[j - 1]
+            ? fmt::format("time {} s of sample {} repeats sample {}", time_s[j], j, j - 1)
+            : fmt::format("time decreases from {} s (sample {}) to {} s (sample {})", time_s[j - 1],
+                          j - 1, time_s[j], j);
+    throw InputError(origin, field_of_sample(j), problem, "strictly increasing time");
+  }
+  const double t0 = time_s[0];
+  const double tau = (time_s[n - 1] - t0) / static_cast<double>(n - 1);
+  double max_deviation = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    max_deviation =
+        std::max(max_deviation, std::abs(time_s[j] - (t0 + static_cast<double>(j) * tau)));
+  }
+  if (max_deviation >= kTimeUniformityTolerance * tau) {
+    // The grid test decides; the step furthest from tau locates the gap or jump for the user.
+    Eigen::Index worst = 1;
+    double worst_step_deviation = -1;
+    for (Eigen::Index j = 1; j < n; ++j) {
+      const double d = std::abs((time_s[j] - time_s[j - 1]) - tau);
+      if (d > worst_step_deviation) {
+        worst_step_deviation = d;
+        worst = j;
+      }
+    }
+    throw InputError(
+        origin, field_of_sample(worst),
+        fmt::format("non-uniform time: step {:.9g} s from sample {} to {} differs from the mean "
+                    "step {:.9g} s (relative deviation {:.3g})",
+                    time_s[worst] - time_s[worst - 1], worst - 1, worst, tau,
+                    worst_step_deviation / tau),
+        fmt::format("uniform sampling (relative deviation under {:g})", kTimeUniformityTolerance));
+  }
+  return tau;
+}
+
+}  // namespace mbid
