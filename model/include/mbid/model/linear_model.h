@@ -14,16 +14,16 @@ namespace mbid::model {
 struct LinearModel {
   std::vector<std::string> coordinates;  // n names
   std::vector<std::string> outputs;      // m names
-  Eigen::MatrixXd M;  // n x n, kg*m^2
-  Eigen::MatrixXd D;  // n x n, N*m*s/rad
-  Eigen::MatrixXd C;  // n x n, N*m/rad
-  Eigen::MatrixXd H;  // m x n, rad/rad
+  Eigen::MatrixXd M;                     // n x n, kg*m^2
+  Eigen::MatrixXd D;                     // n x n, N*m*s/rad
+  Eigen::MatrixXd C;                     // n x n, N*m/rad
+  Eigen::MatrixXd H;                     // m x n, rad/rad
 };
 
 // One complex pole of the first-order system and its shape. For an underdamped pair only the
 // member with Im(lambda) > 0 is kept.
 struct Mode {
-  std::complex<double> lambda;  // 1/s; decaying modes have Re(lambda) < 0
+  std::complex<double> lambda;    // 1/s; decaying modes have Re(lambda) < 0
   Eigen::VectorXcd shape;         // per coordinate, unit largest magnitude
   Eigen::VectorXcd output_shape;  // H * shape
 

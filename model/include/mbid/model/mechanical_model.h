@@ -47,6 +47,9 @@ class MechanicalModel {
   int output_count() const { return static_cast<int>(output_names().size()); }
   // Names of points that accept external loads.
   virtual std::vector<std::string> load_points() const = 0;
+  // The static loads of a payload of `mass_kg` hanging where the machine carries loads (the
+  // crane's boom tip): its weight, at rest.
+  virtual std::vector<PointLoad> CalcPayloadLoads(double mass_kg) const = 0;
 
   // The tunable parameters with their current values.
   virtual std::vector<Parameter> parameters() const = 0;

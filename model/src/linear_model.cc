@@ -1,0 +1,55 @@
+#include "mbid/model/linear_model.h"
+
+#include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace mbid::model {
+
+double Mode::frequency_hz() const { return lambda.imag() / (2 * M_PI); }
+double Mode::decay_rate_per_s() const { return -lambda.real(); }
+double Mode::damping_ratio() const { return -lambda.real() / std::abs(lambda); }
+double Mode::undamped_frequency_hz() const { return std::abs(lambda) / (2 * M_PI); }
+double Mode::log_decrement() const { return 2 * M_PI * decay_rate_per_s() / lambda.imag(); }
+double Mode::half_life_s() const { return std::log(2.0) / decay_rate_per_s(); }
+
+std::vector<Mode> CalcModes(const LinearModel& linear) {
+  const Eigen::Index n = linear.M.rows();
+  if (linear.M.cols() != n || linear.C.rows() != n || linear.C.cols() != n ||
+      linear.D.rows() != n || linear.D.cols() != n || linear.H.cols() != n) {
+    throw std::invalid_argument("CalcModes: M, D, C must be n x n and H m x n");
+  }
+  // First-order form x' = A x, x = [q; q'] (the exact poles of eq. 1 with r = 0).
+  const Eigen::PartialPivLU<Eigen::MatrixXd> M_lu(linear.M);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomLeftCorner(n, n) = -M_lu.solve(linear.C);
+  A.bottomRightCorner(n, n) = -M_lu.solve(linear.D);
+  const Eigen::EigenSolver<Eigen::MatrixXd> eigen(A);
+  if (eigen.info() != Eigen::Success) throw std::runtime_error("CalcModes: eigensolver failed");
+
+  std::vector<Mode> oscillatory, real;
+  for (Eigen::Index k = 0; k < 2 * n; ++k) {
+    const std::complex<double> lambda = eigen.eigenvalues()[k];
+    // Keep one member of each conjugate pair; a real pole is its own partner.
+    if (lambda.imag() < 0) continue;
+    Mode mode;
+    mode.lambda = lambda;
+    mode.shape = eigen.eigenvectors().col(k).head(n);
+    Eigen::Index largest = 0;
+    mode.shape.cwiseAbs().maxCoeff(&largest);
+    mode.shape /= mode.shape[largest];
+    mode.output_shape = linear.H * mode.shape;
+    (lambda.imag() > 0 ? oscillatory : real).push_back(mode);
+  }
+  std::sort(oscillatory.begin(), oscillatory.end(),
+            [](const Mode& a, const Mode& b) { return a.lambda.imag() < b.lambda.imag(); });
+  std::sort(real.begin(), real.end(),
+            [](const Mode& a, const Mode& b) { return a.lambda.real() > b.lambda.real(); });
+  oscillatory.insert(oscillatory.end(), real.begin(), real.end());
+  return oscillatory;
+}
+
+}  // namespace mbid::model

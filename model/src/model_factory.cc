@@ -1,0 +1,98 @@
+#include "mbid/model/model_factory.h"
+
+#include <cmath>
+
+#include "mbid/common/error.h"
+
+namespace mbid::model {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+Eigen::Vector3d ReadVector3(const YamlReader& node, const std::string& key) {
+  const std::array<double, 3> v = node.Vector3(key);
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+Eigen::Vector3d ReadPrincipalInertia(const YamlReader& node) {
+  const Eigen::Vector3d I = ReadVector3(node, "inertia_kgm2");
+  for (int i = 0; i < 3; ++i) {
+    if (!(I[i] > 0)) {
+      node.FailAt("inertia_kgm2", "non-positive principal moment", "positive moments in kg*m^2");
+    }
+    if (I[i] > I[(i + 1) % 3] + I[(i + 2) % 3]) {
+      node.FailAt("inertia_kgm2", "principal moments violate the triangle inequality",
+                  "each moment at most the sum of the other two");
+    }
+  }
+  return I;
+}
+
+}  // namespace
+
+TruckCraneParameters ReadTruckCraneParameters(const YamlReader& model) {
+  model.ExpectMap({"type", "gravity_mps2", "configuration", "base", "slewing", "boom", "joints",
+                   "payload_mass_kg"});
+  TruckCraneParameters p;
+  p.gravity_mps2 = model.PositiveDouble("gravity_mps2", 9.81);
+  p.attached_payload_kg = model.Double("payload_mass_kg", 0.0);
+  if (p.attached_payload_kg < 0) {
+    model.FailAt("payload_mass_kg", "negative mass", "a non-negative mass in kg");
+  }
+
+  const YamlReader configuration = model.Child("configuration");
+  configuration.ExpectMap({"boom_elevation_deg", "slew_deg"});
+  const double elevation_deg = configuration.Double("boom_elevation_deg");
+  if (!(std::abs(elevation_deg) < 90)) {
+    configuration.FailAt("boom_elevation_deg", "elevation " + std::to_string(elevation_deg),
+                         "an angle in (-90, 90) degrees");
+  }
+  p.boom_elevation_rad = elevation_deg * kDegToRad;
+  p.slew_rad = configuration.Double("slew_deg") * kDegToRad;
+
+  const YamlReader base = model.Child("base");
+  base.ExpectMap({"pitch_pivot_m", "mass_kg", "com_m", "inertia_kgm2"});
+  p.p_GOa_m = ReadVector3(base, "pitch_pivot_m");
+  p.base_mass_kg = base.PositiveDouble("mass_kg");
+  p.p_GBcm_m = ReadVector3(base, "com_m");
+  p.base_inertia_kgm2 = ReadPrincipalInertia(base);
+
+  const YamlReader slewing = model.Child("slewing");
+  slewing.ExpectMap({"bearing_m", "mass_kg", "com_m", "inertia_kgm2"});
+  p.p_GOs_m = ReadVector3(slewing, "bearing_m");
+  p.slewing_mass_kg = slewing.PositiveDouble("mass_kg");
+  p.p_OsScm_S_m = ReadVector3(slewing, "com_m");
+  p.slewing_inertia_kgm2 = ReadPrincipalInertia(slewing);
+
+  const YamlReader boom = model.Child("boom");
+  boom.ExpectMap({"foot_m", "mass_kg", "length_m", "axial_inertia_kgm2"});
+  p.p_OsF_S_m = ReadVector3(boom, "foot_m");
+  p.boom_mass_kg = boom.PositiveDouble("mass_kg");
+  p.boom_length_m = boom.PositiveDouble("length_m");
+  p.boom_axial_inertia_kgm2 = boom.PositiveDouble("axial_inertia_kgm2");
+
+  const YamlReader joints = model.Child("joints");
+  joints.ExpectMap({"alpha", "gamma", "eta", "theta"});
+  const char* names[] = {"alpha", "gamma", "eta", "theta"};
+  for (int i = 0; i < 4; ++i) {
+    const YamlReader joint = joints.Child(names[i]);
+    joint.ExpectMap({"stiffness_Nm_per_rad", "damping_Nms_per_rad"});
+    p.joints[i].stiffness_Nm_per_rad = joint.PositiveDouble("stiffness_Nm_per_rad");
+    p.joints[i].damping_Nms_per_rad = joint.PositiveDouble("damping_Nms_per_rad");
+  }
+  try {
+    p.Validate();
+  } catch (const InputError& error) {
+    // Re-anchor a model-level check to the scenario file and field.
+    throw InputError(model.source(), model.field() + "." + error.field(), error.problem(),
+                     error.expected());
+  }
+  return p;
+}
+
+std::unique_ptr<MechanicalModel> MakeModel(const YamlReader& model) {
+  const std::string type = model.Choice("type", {"truck_crane"}, "truck_crane");
+  return std::make_unique<TruckCrane>(ReadTruckCraneParameters(model));
+}
+
+}  // namespace mbid::model

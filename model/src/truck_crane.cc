@@ -1,0 +1,386 @@
+#include "mbid/model/truck_crane.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "mbid/common/error.h"
+#include "mbid/model/simbody.h"
+#include "mbid/model/simbody_conversions.h"
+
+namespace mbid::model {
+namespace {
+
+using SimTK::Inertia;
+using SimTK::MassProperties;
+using SimTK::MobilizedBody;
+using SimTK::Rotation;
+using SimTK::Transform;
+using SimTK::Vec3;
+
+const std::vector<std::string> kCoordinates{"alpha", "gamma", "eta", "theta"};
+const std::vector<std::string> kOutputs{"psi", "phi"};
+const std::vector<std::string> kOutputUnits{"rad", "rad"};
+constexpr int kDofs = 4;
+
+// Maps the Universal mobilizer's (x, then new y) axes onto the boom joint axes: F's x along S's
+// z (eta) and F's y along -y (theta > 0 lifts the tip). Columns: P e_x = e_z, P e_y = -e_y.
+Rotation CalcUniversalAxes() {
+  SimTK::Mat33 p(0, 0, 1,   //
+                 0, -1, 0,  //
+                 1, 0, 0);
+  return Rotation(p, true);
+}
+
+double WrapToPi(double angle_rad) { return std::remainder(angle_rad, 2.0 * M_PI); }
+
+}  // namespace
+
+struct TruckCrane::Impl {
+  explicit Impl(const TruckCraneParameters& p) : parameters(p), matter(system), forces(system) {
+    parameters.Validate();
+    const Vec3 gravity_G(0, 0, -parameters.gravity_mps2);
+    SimTK::Force::UniformGravity(forces, matter, gravity_G);
+
+    // B: body frame coincides with G at alpha = 0, so data given "in G at alpha = 0" are body
+    // coordinates. The pin turns about its frames' z axis, rotated onto G's y.
+    const Rotation R_GF_pitch(-M_PI / 2, SimTK::XAxis);
+    const Vec3 p_GOa = ToVec3(parameters.p_GOa_m);
+    const MassProperties base_mass(
+        parameters.base_mass_kg, ToVec3(parameters.p_GBcm_m),
+        Inertia(ToVec3(parameters.base_inertia_kgm2))
+            .shiftFromMassCenter(ToVec3(parameters.p_GBcm_m), parameters.base_mass_kg));
+    base = MobilizedBody::Pin(matter.Ground(), Transform(R_GF_pitch, p_GOa),
+                              SimTK::Body::Rigid(base_mass), Transform(R_GF_pitch, p_GOa));
+
+    // S: origin at O_s, x axis along the boom's horizontal direction (slew psi0 + gamma).
+    const Vec3 p_OsScm = ToVec3(parameters.p_OsScm_S_m);
+    const MassProperties slewing_mass(
+        parameters.slewing_mass_kg, p_OsScm,
+        Inertia(ToVec3(parameters.slewing_inertia_kgm2))
+            .shiftFromMassCenter(p_OsScm, parameters.slewing_mass_kg));
+    slewing = MobilizedBody::Pin(
+        base, Transform(Rotation(parameters.slew_rad, SimTK::ZAxis), ToVec3(parameters.p_GOs_m)),
+        SimTK::Body::Rigid(slewing_mass), Transform());
+
+    // K: origin at the foot F, x along the boom. R_K = R_S Rz(eta) Ry(-(phi0 + theta)).
+    const double L = parameters.boom_length_m;
+    const double m = parameters.boom_mass_kg;
+    const Vec3 p_FKcm(L / 2, 0, 0);
+    Inertia boom_inertia =
+        Inertia(Vec3(parameters.boom_axial_inertia_kgm2, m * L * L / 12, m * L * L / 12))
+            .shiftFromMassCenter(p_FKcm, m);
+    MassProperties boom_mass(m, p_FKcm, boom_inertia);
+    if (parameters.attached_payload_kg > 0) {
+      const double mp = parameters.attached_payload_kg;
+      const Vec3 p_FTip(L, 0, 0);
+      boom_mass = MassProperties(m + mp, (m * p_FKcm + mp * p_FTip) / (m + mp),
+                                 boom_inertia + Inertia::pointMassAt(p_FTip, mp));
+    }
+    const Rotation P = CalcUniversalAxes();
+    boom = MobilizedBody::Universal(
+        slewing, Transform(P, ToVec3(parameters.p_OsF_S_m)), SimTK::Body::Rigid(boom_mass),
+        Transform(Rotation(parameters.boom_elevation_rad, SimTK::YAxis) * P, Vec3(0)));
+
+    const std::array<std::pair<MobilizedBody*, int>, kDofs> joint_mobilities{
+        {{&base, 0}, {&slewing, 0}, {&boom, 0}, {&boom, 1}}};
+    for (int i = 0; i < kDofs; ++i) {
+      auto [mobod, which] = joint_mobilities[i];
+      springs[i] =
+          SimTK::Force::MobilityLinearSpring(forces, *mobod, SimTK::MobilizerUIndex(which),
+                                             parameters.joints[i].stiffness_Nm_per_rad, 0.0);
+      dampers[i] = SimTK::Force::MobilityLinearDamper(forces, *mobod, SimTK::MobilizerUIndex(which),
+                                                      parameters.joints[i].damping_Nms_per_rad);
+    }
+    external = SimTK::Force::DiscreteForces(forces, matter);
+
+    system.realizeTopology();
+    default_state = system.getDefaultState();
+    system.realizeModel(default_state);
+    if (default_state.getNQ() != kDofs || default_state.getNU() != kDofs) {
+      throw std::logic_error("TruckCrane: expected 4 coordinates and speeds");
+    }
+    unloaded_gravity_force = CalcUnloadedGravityForce();
+  }
+
+  // Gravity's generalized force at q = 0 on the crane without the attached payload: the dead
+  // weight the springs carry (the preload rule).
+  Eigen::Vector4d CalcUnloadedGravityForce() const {
+    SimTK::State s = default_state;
+    for (int i = 0; i < kDofs; ++i) {
+      springs[i].setStiffness(s, 0.0);
+      dampers[i].setDamping(s, 0.0);
+    }
+    s.updQ() = 0;
+    s.updU() = 0;
+    const Eigen::VectorXd payload_force = CalcPointLoadForce(
+        s, {"boom_tip",
+            Eigen::Vector3d(0, 0, -parameters.attached_payload_kg * parameters.gravity_mps2)});
+    return CalcRestForce(s) - payload_force;
+  }
+
+  // Generalized force M(q) u' at rest: all applied forces projected on the coordinates (velocity
+  // terms vanish at u = 0). Works on a copy so callers keep const states.
+  Eigen::VectorXd CalcRestForce(SimTK::State s) const {
+    system.realize(s, SimTK::Stage::Acceleration);
+    SimTK::Vector m_udot;
+    matter.multiplyByM(s, s.getUDot(), m_udot);
+    return ToEigen(m_udot);
+  }
+
+  Eigen::VectorXd CalcPointLoadForce(const SimTK::State& s, const PointLoad& load) const {
+    if (load.force_G.isZero(0.0)) return Eigen::VectorXd::Zero(kDofs);
+    system.realize(s, SimTK::Stage::Position);
+    SimTK::Vector f;
+    matter.multiplyByStationJacobianTranspose(s, FindLoadBody(load.point),
+                                              FindLoadStation(load.point), ToVec3(load.force_G), f);
+    return ToEigen(f);
+  }
+
+  const MobilizedBody& FindLoadBody(const std::string& point) const {
+    if (point == "boom_tip") return boom;
+    throw InputError("model", "load point", "unknown point '" + point + "'", "boom_tip");
+  }
+  Vec3 FindLoadStation(const std::string& point) const {
+    FindLoadBody(point);
+    return Vec3(parameters.boom_length_m, 0, 0);
+  }
+
+  void ApplyJointParameters(SimTK::State& s) const {
+    for (int i = 0; i < kDofs; ++i) {
+      const double c = parameters.joints[i].stiffness_Nm_per_rad;
+      springs[i].setStiffness(s, c);
+      // c (q0 - 0) + g(0) = 0 at the unloaded rest position q = 0.
+      springs[i].setQZero(s, -unloaded_gravity_force[i] / c);
+      dampers[i].setDamping(s, parameters.joints[i].damping_Nms_per_rad);
+    }
+  }
+
+  TruckCraneParameters parameters;
+  SimTK::MultibodySystem system;
+  SimTK::SimbodyMatterSubsystem matter;
+  SimTK::GeneralForceSubsystem forces;
+  MobilizedBody::Pin base;
+  MobilizedBody::Pin slewing;
+  MobilizedBody::Universal boom;
+  std::array<SimTK::Force::MobilityLinearSpring, kDofs> springs;
+  std::array<SimTK::Force::MobilityLinearDamper, kDofs> dampers;
+  SimTK::Force::DiscreteForces external;
+  SimTK::State default_state;
+  Eigen::Vector4d unloaded_gravity_force;
+};
+
+TruckCrane::TruckCrane(const TruckCraneParameters& parameters)
+    : impl_(std::make_unique<Impl>(parameters)) {}
+
+TruckCrane::~TruckCrane() = default;
+
+const TruckCraneParameters& TruckCrane::crane_parameters() const { return impl_->parameters; }
+const std::vector<std::string>& TruckCrane::coordinate_names() const { return kCoordinates; }
+const std::vector<std::string>& TruckCrane::output_names() const { return kOutputs; }
+const std::vector<std::string>& TruckCrane::output_units() const { return kOutputUnits; }
+std::vector<std::string> TruckCrane::load_points() const { return {"boom_tip"}; }
+
+std::vector<PointLoad> TruckCrane::CalcPayloadLoads(double mass_kg) const {
+  return {{"boom_tip", Eigen::Vector3d(0, 0, -mass_kg * impl_->parameters.gravity_mps2)}};
+}
+
+std::vector<Parameter> TruckCrane::parameters() const {
+  std::vector<Parameter> result;
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < kDofs; ++i) {
+    result.push_back({"c_" + kCoordinates[i], "N*m/rad",
+                      impl_->parameters.joints[i].stiffness_Nm_per_rad, 0.0, inf});
+  }
+  for (int i = 0; i < kDofs; ++i) {
+    result.push_back({"d_" + kCoordinates[i], "N*m*s/rad",
+                      impl_->parameters.joints[i].damping_Nms_per_rad, 0.0, inf});
+  }
+  return result;
+}
+
+void TruckCrane::SetParameter(const std::string& name, double value) {
+  for (int i = 0; i < kDofs; ++i) {
+    JointSpringDamper& joint = impl_->parameters.joints[i];
+    if (name == "c_" + kCoordinates[i]) {
+      if (!(std::isfinite(value) && value > 0)) {
+        throw InputError("model", name, "stiffness " + std::to_string(value),
+                         "a positive finite value in N*m/rad");
+      }
+      joint.stiffness_Nm_per_rad = value;
+      return;
+    }
+    if (name == "d_" + kCoordinates[i]) {
+      if (!(std::isfinite(value) && value >= 0)) {
+        throw InputError("model", name, "damping " + std::to_string(value),
+                         "a non-negative finite value in N*m*s/rad");
+      }
+      joint.damping_Nms_per_rad = value;
+      return;
+    }
+  }
+  throw InputError("model", name, "unknown parameter",
+                   "c_<joint> or d_<joint> with joint in alpha, gamma, eta, theta");
+}
+
+const SimTK::MultibodySystem& TruckCrane::system() const { return impl_->system; }
+
+SimTK::State TruckCrane::MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const {
+  if (q.size() != kDofs || u.size() != kDofs) {
+    throw std::invalid_argument("TruckCrane::MakeState: q and u need 4 entries");
+  }
+  SimTK::State s = impl_->default_state;
+  impl_->ApplyJointParameters(s);
+  s.setTime(0.0);
+  s.updQ() = ToVector(q);
+  s.updU() = ToVector(u);
+  return s;
+}
+
+void TruckCrane::SetExternalLoad(SimTK::State& state, const std::vector<PointLoad>& loads,
+                                 const Eigen::VectorXd& generalized_forces) const {
+  const SimTK::Force::DiscreteForces& external = impl_->external;
+  external.clearAllForces(state);
+  for (const PointLoad& load : loads) {
+    external.addForceToBodyPoint(state, impl_->FindLoadBody(load.point),
+                                 impl_->FindLoadStation(load.point), ToVec3(load.force_G));
+  }
+  if (generalized_forces.size() > 0) {
+    if (generalized_forces.size() != kDofs) {
+      throw std::invalid_argument("TruckCrane::SetExternalLoad: 4 generalized forces expected");
+    }
+    external.setAllMobilityForces(state, ToVector(generalized_forces));
+  }
+}
+
+Eigen::VectorXd TruckCrane::CalcOutputs(const SimTK::State& state) const {
+  impl_->system.realize(state, SimTK::Stage::Position);
+  const Vec3 u_G = impl_->boom.getBodyRotation(state).x();  // boom axis in G
+  const TruckCraneParameters& p = impl_->parameters;
+  Eigen::VectorXd y(2);
+  y[0] = WrapToPi(std::atan2(u_G[1], u_G[0]) - p.slew_rad);
+  y[1] = std::atan2(u_G[2], std::hypot(u_G[0], u_G[1])) - p.boom_elevation_rad;
+  return y;
+}
+
+double TruckCrane::CalcEnergy(const SimTK::State& state) const {
+  impl_->system.realize(state, SimTK::Stage::Dynamics);
+  return impl_->system.calcEnergy(state);
+}
+
+Eigen::VectorXd TruckCrane::CalcStaticGeneralizedForce(const Eigen::VectorXd& q,
+                                                       const std::vector<PointLoad>& loads) const {
+  SimTK::State s = MakeState(q, Eigen::VectorXd::Zero(kDofs));
+  Eigen::VectorXd force = impl_->CalcRestForce(s);
+  for (const PointLoad& load : loads) force += impl_->CalcPointLoadForce(s, load);
+  return force;
+}
+
+Eigen::VectorXd TruckCrane::SolveStaticEquilibrium(const std::vector<PointLoad>& loads) const {
+  // Newton on f(q) = 0 with the tangent stiffness -df/dq by central differences; the root's
+  // accuracy depends only on f, so Newton reaches machine precision. Start at the unloaded rest.
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(kDofs);
+  const double scale = impl_->parameters.joints[0].stiffness_Nm_per_rad;
+  Eigen::VectorXd f = CalcStaticGeneralizedForce(q, loads);
+  double last_step = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    Eigen::Matrix4d jacobian;
+    const double h = 1e-7;  // rad; smooth forces, curvature scale ~1 rad
+    for (int j = 0; j < kDofs; ++j) {
+      Eigen::VectorXd dq = Eigen::VectorXd::Zero(kDofs);
+      dq[j] = h;
+      jacobian.col(j) =
+          (CalcStaticGeneralizedForce(q + dq, loads) - CalcStaticGeneralizedForce(q - dq, loads)) /
+          (2 * h);
+    }
+    const Eigen::VectorXd step = jacobian.partialPivLu().solve(-f);
+    q += step;
+    f = CalcStaticGeneralizedForce(q, loads);
+    const double step_norm = step.lpNorm<Eigen::Infinity>();
+    // Converged when the step is at roundoff of q, or stops shrinking after being tiny.
+    if (step_norm <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, q.norm()) ||
+        (step_norm < 1e-12 && step_norm >= last_step)) {
+      return q;
+    }
+    last_step = step_norm;
+  }
+  throw NumericalError("static equilibrium", "Newton did not converge in 50 iterations; residual " +
+                                                 std::to_string(f.norm()) +
+                                                 " N*m (stiffness scale " + std::to_string(scale) +
+                                                 ")");
+}
+
+LinearModel TruckCrane::Linearize() const {
+  LinearModel linear;
+  linear.coordinates = kCoordinates;
+  linear.outputs = kOutputs;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(kDofs);
+  SimTK::State s = MakeState(zero, zero);
+  impl_->system.realize(s, SimTK::Stage::Position);
+  SimTK::Matrix M;
+  impl_->matter.calcM(s, M);
+  linear.M = ToEigen(M);
+
+  // Geometric stiffness K_g = -d(gravity force)/dq with springs and dampers off, by central
+  // differences with one Richardson step: error O(h^4) ~ 1e-16 of the gravity torque.
+  SimTK::State gravity_only = s;
+  for (int i = 0; i < kDofs; ++i) {
+    impl_->springs[i].setStiffness(gravity_only, 0.0);
+    impl_->dampers[i].setDamping(gravity_only, 0.0);
+  }
+  auto gravity_force = [&](const Eigen::VectorXd& q) {
+    SimTK::State t = gravity_only;
+    t.updQ() = ToVector(q);
+    return impl_->CalcRestForce(t);
+  };
+  auto central = [&](int j, double h) {
+    Eigen::VectorXd dq = Eigen::VectorXd::Zero(kDofs);
+    dq[j] = h;
+    return Eigen::VectorXd((gravity_force(dq) - gravity_force(-dq)) / (2 * h));
+  };
+  Eigen::MatrixXd K_g(kDofs, kDofs);
+  const double h = 1e-3;  // rad; Richardson removes the h^2 term, h^4 ~ 1e-12 relative
+  for (int j = 0; j < kDofs; ++j) {
+    K_g.col(j) = -(4 * central(j, h / 2) - central(j, h)) / 3;
+  }
+  K_g = (0.5 * (K_g + K_g.transpose())).eval();  // a Hessian: symmetric up to roundoff
+  linear.C = K_g;
+  linear.D = Eigen::MatrixXd::Zero(kDofs, kDofs);
+  for (int i = 0; i < kDofs; ++i) {
+    linear.C(i, i) += impl_->parameters.joints[i].stiffness_Nm_per_rad;
+    // Dampers are the only velocity-dependent forces; gyroscopic terms are quadratic in u.
+    linear.D(i, i) = impl_->parameters.joints[i].damping_Nms_per_rad;
+  }
+
+  // H exactly: a unit speed of coordinate j turns the boom axis u at w_GK, du = w x u, and
+  // psi = atan2(u_y, u_x), phi = atan2(u_z, |u_xy|) differentiate in closed form.
+  linear.H.resize(2, kDofs);
+  const Vec3 u = impl_->boom.getBodyRotation(s).x();
+  const double rho2 = u[0] * u[0] + u[1] * u[1];
+  const double rho = std::sqrt(rho2);
+  for (int j = 0; j < kDofs; ++j) {
+    SimTK::State v = s;
+    v.updU() = 0;
+    v.updU()[j] = 1;
+    impl_->system.realize(v, SimTK::Stage::Velocity);
+    const Vec3 du = impl_->boom.getBodyAngularVelocity(v) % u;
+    linear.H(0, j) = (u[0] * du[1] - u[1] * du[0]) / rho2;
+    linear.H(1, j) = (rho2 * du[2] - u[2] * (u[0] * du[0] + u[1] * du[1])) / rho;
+  }
+  return linear;
+}
+
+std::unique_ptr<MechanicalModel> TruckCrane::Clone() const {
+  return std::make_unique<TruckCrane>(impl_->parameters);
+}
+
+Eigen::Vector4d TruckCrane::neutral_angles() const {
+  Eigen::Vector4d q0;
+  for (int i = 0; i < kDofs; ++i) {
+    q0[i] = -impl_->unloaded_gravity_force[i] / impl_->parameters.joints[i].stiffness_Nm_per_rad;
+  }
+  return q0;
+}
+
+}  // namespace mbid::model
