@@ -1,0 +1,80 @@
+#pragma once
+
+#include <functional>
+#include <memory>
+
+#include "mbid/simulation/integrator_options.h"
+
+namespace SimTK {
+class State;
+class System;
+}  // namespace SimTK
+
+namespace mbid::simulation {
+
+// Integrates the equations of motion of a Simbody system with SUNDIALS CVODES.
+//
+// CVODES sees the ODE  Y' = f(t, Y)  with  Y = [q | u | z]  (Simbody's continuous state:
+// generalized coordinates, speeds and auxiliary variables). f is Simbody's own: set t and Y,
+// realize(Stage::Acceleration), read getYDot(). The kinematic equation q' = N(q) u is
+// therefore Simbody's, not assumed to be q' = u.
+//
+// Supported systems: no constraints and no quaternions (Pin, Universal, Slider, Gimbal ...).
+// Nothing here projects onto a constraint manifold or normalizes quaternions, so a system
+// with either is rejected by Initialize(). Simbody event handlers are not run.
+//
+// One integrator owns one working State and one CVODES memory: do not share it between
+// threads. The system must outlive the integrator.
+class CvodesIntegrator {
+ public:
+  // Called on the working state at every right-hand-side evaluation, after time and Y are set
+  // and before realize(): the place to set time-dependent inputs (e.g. DiscreteForces).
+  using TimeDependentInputs = std::function<void(SimTK::State&)>;
+
+  // `system` must be realized to Topology. Throws std::invalid_argument for invalid options
+  // or an unrealized system.
+  CvodesIntegrator(const SimTK::System& system, const IntegratorOptions& options);
+  ~CvodesIntegrator();
+  CvodesIntegrator(CvodesIntegrator&&) noexcept;
+  CvodesIntegrator& operator=(CvodesIntegrator&&) noexcept;
+  CvodesIntegrator(const CvodesIntegrator&) = delete;
+  CvodesIntegrator& operator=(const CvodesIntegrator&) = delete;
+
+  // Replaces the input hook (an empty function removes it). Takes effect at the next
+  // evaluation; after a discontinuous change call Initialize(state()) to restart the
+  // multistep history at the discontinuity.
+  void set_time_dependent_inputs(TimeDependentInputs hook);
+
+  // Starts (or restarts) the integration from a copy of `initial` at initial.getTime(); the
+  // copy is realized to Stage::Velocity (the input hook is not called yet: AdvanceTo(time())
+  // realizes it to Acceleration with the inputs). Throws std::invalid_argument if the state
+  // belongs to a system with constraints or quaternions, and NumericalError if CVODES cannot
+  // be set up.
+  void Initialize(const SimTK::State& initial);
+
+  // Integrates to exactly time `t` (s), t >= time(), and returns the working state at t
+  // realized to Stage::Acceleration (valid until the next call). Unless
+  // options().interpolate_outputs, CVODES stops at t (a stop time, no interpolation), so
+  // inputs changed between calls never act before their time.
+  //
+  // An exception thrown by Simbody or the input hook is a recoverable failure for CVODES
+  // (it retries with a smaller step); after 100 failures within one call it is final. Throws
+  // NumericalError (stage "CVODES") naming the SUNDIALS flag (CV_TOO_MUCH_WORK, ...), its
+  // message, the time reached and the last exception; Initialize() must then be called again
+  // and state() holds the last point CVODES reached. Throws std::logic_error before
+  // Initialize() and std::invalid_argument for t < time().
+  const SimTK::State& AdvanceTo(double t);
+
+  // The working state at time(): realized to Velocity after Initialize(), to Acceleration after
+  // AdvanceTo(). Throws std::logic_error before the first Initialize().
+  const SimTK::State& state() const;
+  double time() const;
+  IntegratorStatistics statistics() const;
+  const IntegratorOptions& options() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mbid::simulation

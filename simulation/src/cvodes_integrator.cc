@@ -1,0 +1,352 @@
+#include "mbid/simulation/cvodes_integrator.h"
+
+#include <Simbody.h>
+#include <cvodes/cvodes.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+#include "mbid/common/error.h"
+
+namespace mbid::simulation {
+namespace {
+
+// Failed right-hand-side evaluations tolerated within one AdvanceTo() call. CVODES answers a
+// recoverable failure with a smaller step; a failure that persists past some time (e.g. inputs
+// that end there) would otherwise make it crawl towards that time until max_steps. Beyond the
+// limit every evaluation fails: SUNDIALS 6.4.1's fixed-point solver (Adams) turns an
+// unrecoverable RHS failure into a convergence failure, so only a sticky failure ends it.
+constexpr int kMaxRhsFailuresPerCall = 100;
+
+// Owners of SUNDIALS objects; each deleter is the matching SUNDIALS destructor.
+struct ContextDeleter {
+  void operator()(SUNContext context) const { SUNContext_Free(&context); }
+};
+struct VectorDeleter {
+  void operator()(N_Vector vector) const { N_VDestroy(vector); }
+};
+struct MatrixDeleter {
+  void operator()(SUNMatrix matrix) const { SUNMatDestroy(matrix); }
+};
+struct LinearSolverDeleter {
+  void operator()(SUNLinearSolver solver) const { SUNLinSolFree(solver); }
+};
+struct NonlinearSolverDeleter {
+  void operator()(SUNNonlinearSolver solver) const { SUNNonlinSolFree(solver); }
+};
+struct CvodeDeleter {
+  void operator()(void* memory) const { CVodeFree(&memory); }
+};
+
+template <typename Handle, typename Deleter>
+using Owned = std::unique_ptr<std::remove_pointer_t<Handle>, Deleter>;
+
+// CVodeGet*ReturnFlagName returns a malloc'ed string that the caller frees.
+std::string TakeName(char* name) {
+  if (name == nullptr) return "unknown flag";
+  std::string result(name);
+  std::free(name);
+  return result;
+}
+
+std::string FlagName(int flag) { return TakeName(CVodeGetReturnFlagName(flag)); }
+std::string LinearSolverFlagName(int flag) { return TakeName(CVodeGetLinReturnFlagName(flag)); }
+
+}  // namespace
+
+class CvodesIntegrator::Impl {
+ public:
+  Impl(const SimTK::System& system, const IntegratorOptions& options)
+      : system_(&system), options_(options) {
+    std::string why;
+    if (!options.IsValid(&why)) {
+      throw std::invalid_argument("CvodesIntegrator: invalid IntegratorOptions: " + why);
+    }
+    if (!system.systemTopologyHasBeenRealized()) {
+      throw std::invalid_argument(
+          "CvodesIntegrator: the system is not realized to Topology; expected "
+          "realizeTopology() before building the integrator");
+    }
+    SUNContext context = nullptr;
+    if (SUNContext_Create(nullptr, &context) != 0 || context == nullptr) {
+      throw NumericalError("CVODES", "SUNContext_Create failed");
+    }
+    context_.reset(context);
+  }
+
+  void set_time_dependent_inputs(TimeDependentInputs hook) { hook_ = std::move(hook); }
+
+  void Initialize(const SimTK::State& initial) {
+    // Copy first: `initial` may be our own working state.
+    SimTK::State state = initial;
+    try {
+      system_->realize(state, SimTK::Stage::Instance);
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(
+          std::string("CvodesIntegrator::Initialize: the state does not fit the system: ") +
+          e.what());
+    }
+    if (state.getNQ() != state.getNU()) {
+      std::ostringstream why;
+      why << "CvodesIntegrator::Initialize: the system has quaternions (nq = " << state.getNQ()
+          << ", nu = " << state.getNU()
+          << "), which would need normalization; expected nq == nu (Pin, Universal, "
+             "Slider ... mobilizers)";
+      throw std::invalid_argument(why.str());
+    }
+    if (state.getNYErr() != 0 || state.getNMultipliers() != 0) {
+      std::ostringstream why;
+      why << "CvodesIntegrator::Initialize: the system has constraints (" << state.getNYErr()
+          << " position/velocity errors, " << state.getNMultipliers()
+          << " multipliers), which would need projection; expected none";
+      throw std::invalid_argument(why.str());
+    }
+    const int n = state.getNY();
+    if (n == 0) {
+      throw std::invalid_argument(
+          "CvodesIntegrator::Initialize: the state has no continuous variables; expected "
+          "q, u or z");
+    }
+    // Positions and velocities do not depend on the inputs: realizing them needs no hook.
+    system_->realize(state, SimTK::Stage::Velocity);
+    initialized_ = false;
+    state_ = std::move(state);
+    has_state_ = true;
+    rhs_error_.clear();
+    cvodes_message_.clear();
+    CreateSolver(n);
+    initialized_ = true;
+  }
+
+  const SimTK::State& AdvanceTo(double t) {
+    if (!initialized_) {
+      throw std::logic_error(
+          "CvodesIntegrator::AdvanceTo: not initialized; call Initialize() first (and again "
+          "after a failure)");
+    }
+    const double t_now = state_.getTime();
+    if (!(t >= t_now) || !std::isfinite(t)) {
+      std::ostringstream why;
+      why.precision(17);
+      why << "CvodesIntegrator::AdvanceTo: t = " << t << " s; expected a finite time >= " << t_now
+          << " s";
+      throw std::invalid_argument(why.str());
+    }
+    if (t > t_now) {
+      // By default CVODES stops exactly at t rather than stepping past it and interpolating:
+      // inputs that change between calls then never act before their time, and the returned
+      // state is a step end point whose error the tolerances control.
+      if (!options_.interpolate_outputs) {
+        Check(CVodeSetStopTime(cvode_.get(), t), "CVodeSetStopTime");
+      }
+      rhs_failures_ = 0;
+      realtype t_reached = t_now;
+      const int flag = CVode(cvode_.get(), t, y_.get(), &t_reached, CV_NORMAL);
+      if (flag < 0) {
+        initialized_ = false;
+        // Leave the last point CVODES reached in the state, for diagnosis.
+        state_.setTime(t_reached);
+        CopyToState(N_VGetArrayPointer(y_.get()));
+        throw NumericalError("CVODES", DescribeFailure(flag, t_reached, t));
+      }
+    }
+    SetTimeAndY(t, N_VGetArrayPointer(y_.get()));
+    system_->realize(state_, SimTK::Stage::Acceleration);
+    return state_;
+  }
+
+  const SimTK::State& state() const {
+    if (!has_state_) {
+      throw std::logic_error("CvodesIntegrator::state: call Initialize() first");
+    }
+    return state_;
+  }
+
+  IntegratorStatistics statistics() const {
+    IntegratorStatistics s;
+    if (!cvode_) return s;
+    void* cv = cvode_.get();
+    int current_order = 0;
+    realtype first_step = 0, last_step = 0, current_step = 0, current_time = 0;
+    CVodeGetIntegratorStats(cv, &s.steps, &s.rhs_evaluations, &s.linear_solver_setups,
+                            &s.error_test_failures, &s.last_order, &current_order, &first_step,
+                            &last_step, &current_step, &current_time);
+    s.last_step_s = last_step;
+    CVodeGetNonlinSolvStats(cv, &s.nonlinear_iterations, &s.nonlinear_convergence_failures);
+    if (linear_solver_) {
+      CVodeGetNumJacEvals(cv, &s.jacobian_evaluations);
+      CVodeGetNumLinRhsEvals(cv, &s.rhs_evaluations_for_jacobian);
+    }
+    return s;
+  }
+
+  const IntegratorOptions& options() const { return options_; }
+
+ private:
+  void CreateSolver(int n) {
+    // Members referring to others go first.
+    cvode_.reset();
+    nonlinear_solver_.reset();
+    linear_solver_.reset();
+    matrix_.reset();
+    y_.reset();
+    SUNContext context = context_.get();
+
+    y_.reset(N_VNew_Serial(n, context));
+    if (!y_) throw NumericalError("CVODES", "N_VNew_Serial returned NULL");
+    const SimTK::Vector& y0 = state_.getY();
+    realtype* y = N_VGetArrayPointer(y_.get());
+    for (int i = 0; i < n; ++i) y[i] = y0[i];
+
+    const bool bdf = options_.method == IntegratorOptions::Method::kBdf;
+    cvode_.reset(CVodeCreate(bdf ? CV_BDF : CV_ADAMS, context));
+    if (!cvode_) throw NumericalError("CVODES", "CVodeCreate returned NULL");
+    void* cv = cvode_.get();
+    Check(CVodeSetErrHandlerFn(cv, &Impl::ErrorHandler, this), "CVodeSetErrHandlerFn");
+    Check(CVodeInit(cv, &Impl::Rhs, state_.getTime(), y_.get()), "CVodeInit");
+    Check(CVodeSetUserData(cv, this), "CVodeSetUserData");
+    Check(CVodeSStolerances(cv, options_.relative_tolerance, options_.absolute_tolerance),
+          "CVodeSStolerances");
+    Check(CVodeSetMaxNumSteps(cv, options_.max_steps), "CVodeSetMaxNumSteps");
+    if (options_.max_step_s > 0) Check(CVodeSetMaxStep(cv, options_.max_step_s), "CVodeSetMaxStep");
+
+    if (bdf) {
+      matrix_.reset(SUNDenseMatrix(n, n, context));
+      if (!matrix_) throw NumericalError("CVODES", "SUNDenseMatrix returned NULL");
+      linear_solver_.reset(SUNLinSol_Dense(y_.get(), matrix_.get(), context));
+      if (!linear_solver_) throw NumericalError("CVODES", "SUNLinSol_Dense returned NULL");
+      const int flag = CVodeSetLinearSolver(cv, linear_solver_.get(), matrix_.get());
+      if (flag != CVLS_SUCCESS) {
+        throw NumericalError("CVODES",
+                             "CVodeSetLinearSolver failed: " + LinearSolverFlagName(flag));
+      }
+    } else {
+      // Adams is for non-stiff models, where fixed-point iteration converges without the n
+      // extra RHS calls per difference-quotient Jacobian that Newton would need.
+      nonlinear_solver_.reset(SUNNonlinSol_FixedPoint(y_.get(), 0, context));
+      if (!nonlinear_solver_) {
+        throw NumericalError("CVODES", "SUNNonlinSol_FixedPoint returned NULL");
+      }
+      Check(CVodeSetNonlinearSolver(cv, nonlinear_solver_.get()), "CVodeSetNonlinearSolver");
+    }
+  }
+
+  void Check(int flag, const char* call) const {
+    if (flag < 0) {
+      std::string reason = std::string(call) + " failed: " + FlagName(flag);
+      if (!cvodes_message_.empty()) reason += " (" + cvodes_message_ + ")";
+      throw NumericalError("CVODES", reason);
+    }
+  }
+
+  std::string DescribeFailure(int flag, double t_reached, double t_target) const {
+    std::ostringstream reason;
+    reason.precision(10);
+    reason << FlagName(flag) << " at t = " << t_reached << " s while advancing to " << t_target
+           << " s";
+    if (!cvodes_message_.empty()) reason << ": " << cvodes_message_;
+    if (!rhs_error_.empty()) {
+      reason << "; the right-hand side failed " << rhs_failures_
+             << " time(s) in this call, last at t = " << rhs_error_time_ << " s: " << rhs_error_;
+    }
+    return reason.str();
+  }
+
+  void CopyToState(const realtype* y) {
+    SimTK::Vector& y_state = state_.updY();
+    const int n = y_state.size();
+    for (int i = 0; i < n; ++i) y_state[i] = y[i];
+  }
+
+  void SetTimeAndY(double t, const realtype* y) {
+    state_.setTime(t);
+    CopyToState(y);
+    if (hook_) hook_(state_);
+  }
+
+  // Y' = f(t, Y) for CVODES: Simbody's own derivative of [q | u | z].
+  static int Rhs(realtype t, N_Vector y, N_Vector y_dot, void* user_data) {
+    auto* self = static_cast<Impl*>(user_data);
+    if (self->rhs_failures_ > kMaxRhsFailuresPerCall) return -1;
+    try {
+      self->SetTimeAndY(t, N_VGetArrayPointer(y));
+      self->system_->realize(self->state_, SimTK::Stage::Acceleration);
+      const SimTK::Vector& y_dot_state = self->state_.getYDot();
+      realtype* out = N_VGetArrayPointer(y_dot);
+      const int n = y_dot_state.size();
+      for (int i = 0; i < n; ++i) out[i] = y_dot_state[i];
+      return 0;
+    } catch (const std::exception& e) {
+      self->RecordRhsError(t, e.what());
+    } catch (...) {
+      self->RecordRhsError(t, "unknown exception");
+    }
+    // Recoverable (CVODES retries with a smaller step) until the failure persists.
+    return self->rhs_failures_ > kMaxRhsFailuresPerCall ? -1 : 1;
+  }
+
+  void RecordRhsError(double t, const char* what) {
+    ++rhs_failures_;
+    rhs_error_time_ = t;
+    rhs_error_ = what;
+  }
+
+  // Keeps CVODES' message for the exception instead of printing it to stderr. Warnings
+  // (e.g. t + h == t) are dropped: if they matter, an error flag follows.
+  static void ErrorHandler(int error_code, const char* /*module*/, const char* function,
+                           char* message, void* user_data) {
+    if (error_code == CV_WARNING) return;
+    auto* self = static_cast<Impl*>(user_data);
+    self->cvodes_message_ =
+        std::string(function ? function : "CVODES") + ": " + (message ? message : "");
+  }
+
+  const SimTK::System* system_;
+  IntegratorOptions options_;
+  TimeDependentInputs hook_;
+  SimTK::State state_;
+  bool has_state_ = false;
+  bool initialized_ = false;  // CVODES is ready to advance state_.
+  std::string cvodes_message_;
+  std::string rhs_error_;
+  double rhs_error_time_ = std::numeric_limits<double>::quiet_NaN();
+  int rhs_failures_ = 0;
+
+  // Declared in creation order so that they are destroyed in reverse: CVODES memory first,
+  // the context last.
+  Owned<SUNContext, ContextDeleter> context_;
+  Owned<N_Vector, VectorDeleter> y_;
+  Owned<SUNMatrix, MatrixDeleter> matrix_;
+  Owned<SUNLinearSolver, LinearSolverDeleter> linear_solver_;
+  Owned<SUNNonlinearSolver, NonlinearSolverDeleter> nonlinear_solver_;
+  Owned<void*, CvodeDeleter> cvode_;
+};
+
+CvodesIntegrator::CvodesIntegrator(const SimTK::System& system, const IntegratorOptions& options)
+    : impl_(std::make_unique<Impl>(system, options)) {}
+CvodesIntegrator::~CvodesIntegrator() = default;
+CvodesIntegrator::CvodesIntegrator(CvodesIntegrator&&) noexcept = default;
+CvodesIntegrator& CvodesIntegrator::operator=(CvodesIntegrator&&) noexcept = default;
+
+void CvodesIntegrator::set_time_dependent_inputs(TimeDependentInputs hook) {
+  impl_->set_time_dependent_inputs(std::move(hook));
+}
+void CvodesIntegrator::Initialize(const SimTK::State& initial) { impl_->Initialize(initial); }
+const SimTK::State& CvodesIntegrator::AdvanceTo(double t) { return impl_->AdvanceTo(t); }
+const SimTK::State& CvodesIntegrator::state() const { return impl_->state(); }
+double CvodesIntegrator::time() const { return impl_->state().getTime(); }
+IntegratorStatistics CvodesIntegrator::statistics() const { return impl_->statistics(); }
+const IntegratorOptions& CvodesIntegrator::options() const { return impl_->options(); }
+
+}  // namespace mbid::simulation

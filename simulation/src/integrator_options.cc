@@ -1,0 +1,43 @@
+#include "mbid/simulation/integrator_options.h"
+
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+namespace mbid::simulation {
+namespace {
+
+std::string Describe(const char* field, double value, const char* expected) {
+  std::ostringstream out;
+  out << field << ": " << value << "; expected " << expected;
+  return out.str();
+}
+
+}  // namespace
+
+bool IntegratorOptions::IsValid(std::string* why) const {
+  auto fail = [why](std::string reason) {
+    if (why != nullptr) *why = std::move(reason);
+    return false;
+  };
+  if (method != Method::kBdf && method != Method::kAdams) {
+    return fail("method: unknown value; expected kBdf or kAdams");
+  }
+  // Below about 100 unit roundoffs CVODES cannot meet the tolerance (CV_TOO_MUCH_ACC); at 1
+  // and above there is no accuracy left to control.
+  if (!(relative_tolerance >= 1e-14 && relative_tolerance < 1.0)) {
+    return fail(Describe("relative_tolerance", relative_tolerance, "a value in [1e-14, 1)"));
+  }
+  if (!(absolute_tolerance >= 0.0 && std::isfinite(absolute_tolerance))) {
+    return fail(Describe("absolute_tolerance", absolute_tolerance, "a finite value >= 0"));
+  }
+  if (max_steps <= 0) {
+    return fail(Describe("max_steps", max_steps, "a value > 0"));
+  }
+  if (!(max_step_s >= 0.0 && std::isfinite(max_step_s))) {
+    return fail(Describe("max_step_s", max_step_s, "a finite value >= 0 (0 = unlimited)"));
+  }
+  return true;
+}
+
+}  // namespace mbid::simulation
