@@ -37,6 +37,21 @@ double WrapToPi(double angle_rad) { return std::remainder(angle_rad, 2.0 * M_PI)
 
 }  // namespace
 
+// Applies the model's external load function, evaluated at the state's time. Reading the time
+// from the state keeps Simbody's caching right: a new time invalidates the Dynamics stage.
+class ExternalLoadForce : public SimTK::Force::Custom::Implementation {
+ public:
+  explicit ExternalLoadForce(const TruckCrane::Impl& crane) : crane_(crane) {}
+  void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& body_forces,
+                 SimTK::Vector_<SimTK::Vec3>& particle_forces,
+                 SimTK::Vector& mobility_forces) const override;
+  SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
+  bool dependsOnlyOnPositions() const override { return false; }
+
+ private:
+  const TruckCrane::Impl& crane_;
+};
+
 struct TruckCrane::Impl {
   explicit Impl(const TruckCraneParameters& p) : parameters(p), matter(system), forces(system) {
     parameters.Validate();
@@ -93,7 +108,7 @@ struct TruckCrane::Impl {
       dampers[i] = SimTK::Force::MobilityLinearDamper(forces, *mobod, SimTK::MobilizerUIndex(which),
                                                       parameters.joints[i].damping_Nms_per_rad);
     }
-    external = SimTK::Force::DiscreteForces(forces, matter);
+    SimTK::Force::Custom(forces, new ExternalLoadForce(*this));
 
     system.realizeTopology();
     default_state = system.getDefaultState();
@@ -166,10 +181,30 @@ struct TruckCrane::Impl {
   MobilizedBody::Universal boom;
   std::array<SimTK::Force::MobilityLinearSpring, kDofs> springs;
   std::array<SimTK::Force::MobilityLinearDamper, kDofs> dampers;
-  SimTK::Force::DiscreteForces external;
+  MechanicalModel::ExternalLoadFunction external_load;
   SimTK::State default_state;
   Eigen::Vector4d unloaded_gravity_force;
 };
+
+void ExternalLoadForce::calcForce(const SimTK::State& state,
+                                  SimTK::Vector_<SimTK::SpatialVec>& body_forces,
+                                  SimTK::Vector_<SimTK::Vec3>& /*particle_forces*/,
+                                  SimTK::Vector& mobility_forces) const {
+  if (!crane_.external_load) return;
+  std::vector<PointLoad> loads;
+  Eigen::VectorXd generalized_forces;
+  crane_.external_load(state.getTime(), loads, generalized_forces);
+  for (const PointLoad& load : loads) {
+    crane_.matter.addInStationForce(state, crane_.FindLoadBody(load.point).getMobilizedBodyIndex(),
+                                    crane_.FindLoadStation(load.point), ToVec3(load.force_G),
+                                    body_forces);
+  }
+  if (generalized_forces.size() == 0) return;
+  if (generalized_forces.size() != kDofs) {
+    throw std::invalid_argument("TruckCrane external load: 4 generalized forces expected");
+  }
+  for (int i = 0; i < kDofs; ++i) mobility_forces[i] += generalized_forces[i];
+}
 
 TruckCrane::TruckCrane(const TruckCraneParameters& parameters)
     : impl_(std::make_unique<Impl>(parameters)) {}
@@ -238,20 +273,8 @@ SimTK::State TruckCrane::MakeState(const Eigen::VectorXd& q, const Eigen::Vector
   return s;
 }
 
-void TruckCrane::SetExternalLoad(SimTK::State& state, const std::vector<PointLoad>& loads,
-                                 const Eigen::VectorXd& generalized_forces) const {
-  const SimTK::Force::DiscreteForces& external = impl_->external;
-  external.clearAllForces(state);
-  for (const PointLoad& load : loads) {
-    external.addForceToBodyPoint(state, impl_->FindLoadBody(load.point),
-                                 impl_->FindLoadStation(load.point), ToVec3(load.force_G));
-  }
-  if (generalized_forces.size() > 0) {
-    if (generalized_forces.size() != kDofs) {
-      throw std::invalid_argument("TruckCrane::SetExternalLoad: 4 generalized forces expected");
-    }
-    external.setAllMobilityForces(state, ToVector(generalized_forces));
-  }
+void TruckCrane::SetExternalLoad(ExternalLoadFunction load) {
+  impl_->external_load = std::move(load);
 }
 
 Eigen::VectorXd TruckCrane::CalcOutputs(const SimTK::State& state) const {

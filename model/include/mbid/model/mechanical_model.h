@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -62,9 +63,13 @@ class MechanicalModel {
   // A state at time 0 with coordinates q and speeds u (rad, rad/s), carrying the current
   // parameters and no external load.
   virtual SimTK::State MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const = 0;
-  // Sets the external load of `state` (replaces what was there; invalidates Dynamics only).
-  virtual void SetExternalLoad(SimTK::State& state, const std::vector<PointLoad>& loads,
-                               const Eigen::VectorXd& generalized_forces) const = 0;
+  // Time-dependent external loads (excitations): called at every force evaluation with the
+  // time (s); fills point loads (N, ground frame) and generalized forces (N*m, one per
+  // coordinate, or left empty). An empty function removes the loads. This changes the model:
+  // give each simulation that needs it its own instance (Clone()).
+  using ExternalLoadFunction = std::function<void(double t_s, std::vector<PointLoad>& loads,
+                                                  Eigen::VectorXd& generalized_forces)>;
+  virtual void SetExternalLoad(ExternalLoadFunction load) = 0;
   // The outputs y (rad) of a state realized at least to Position.
   virtual Eigen::VectorXd CalcOutputs(const SimTK::State& state) const = 0;
   // Total mechanical energy (J): kinetic + gravity + spring potential.

@@ -76,8 +76,7 @@ class TruckCrane final : public MechanicalModel {
 
   const SimTK::MultibodySystem& system() const override;
   SimTK::State MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const override;
-  void SetExternalLoad(SimTK::State& state, const std::vector<PointLoad>& loads,
-                       const Eigen::VectorXd& generalized_forces) const override;
+  void SetExternalLoad(ExternalLoadFunction load) override;
   Eigen::VectorXd CalcOutputs(const SimTK::State& state) const override;
   double CalcEnergy(const SimTK::State& state) const override;
   Eigen::VectorXd SolveStaticEquilibrium(const std::vector<PointLoad>& loads) const override;
@@ -92,6 +91,7 @@ class TruckCrane final : public MechanicalModel {
                                              const std::vector<PointLoad>& loads) const;
 
  private:
+  friend class ExternalLoadForce;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

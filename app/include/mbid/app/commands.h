@@ -1,0 +1,20 @@
+#pragma once
+
+#include <string>
+
+namespace mbid::app {
+
+// Options every command shares.
+struct CommonOptions {
+  bool quiet = false;     // no progress on standard error
+  std::string json_path;  // "" = none, "-" = standard output
+};
+
+// `mbid modes SCENARIO [--json FILE]`: the linearized model and its exact modes.
+int RunModesCommand(const std::string& scenario_path, const CommonOptions& common);
+
+// `mbid simulate SCENARIO -o FILE.h5 [--json FILE]`: a synthetic measurement from the model.
+int RunSimulateCommand(const std::string& scenario_path, const std::string& output_path,
+                       const CommonOptions& common);
+
+}  // namespace mbid::app

@@ -1,0 +1,37 @@
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "mbid/common/yaml_reader.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/excitation.h"
+#include "mbid/simulation/sensor.h"
+#include "mbid/simulation/simulate.h"
+
+namespace mbid::app {
+
+// A scenario file (docs/scenarios.md), read strictly: unknown keys anywhere are errors.
+struct Scenario {
+  std::string path;
+  std::string name;
+  std::string yaml_text;  // the file as given, stored with every result
+  YamlReader root;
+  bool has_excitation = false;
+  simulation::Excitation excitation;
+  simulation::SimulationOptions simulation;  // defaults where the section is absent
+  simulation::SensorOptions sensors;         // defaults where the section is absent
+
+  // A fresh model instance (one per worker).
+  std::unique_ptr<model::MechanicalModel> MakeModel() const;
+  // The excitation; an InputError if the scenario has none.
+  const simulation::Excitation& RequireExcitation() const;
+};
+
+Scenario LoadScenario(const std::string& path);
+
+// The built-in reference scenario: scenarios/reference-crane.yaml of the source tree, or of the
+// installed share directory.
+std::string DefaultScenarioPath();
+
+}  // namespace mbid::app

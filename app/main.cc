@@ -1,0 +1,65 @@
+// The mbid command: parses flags, calls the libraries, maps failures to the exit codes of
+// docs/interfaces.md (2 invalid input, 3 numerical failure, 1 anything else).
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "mbid/app/commands.h"
+#include "mbid/app/version.h"
+#include "mbid/common/error.h"
+
+namespace {
+
+int Main(int argc, char** argv) {
+  CLI::App app{
+      "mbid: simulate machine structures, identify their vibration modes from "
+      "free-decay records, and tune joint stiffness and damping to match.",
+      "mbid"};
+  app.set_version_flag("--version", std::string("mbid ") + mbid::app::kVersion);
+  app.require_subcommand(1);
+  app.fallthrough();
+  mbid::app::CommonOptions common;
+  app.add_flag("-q,--quiet", common.quiet, "No progress on standard error");
+
+  std::string scenario_path;
+  CLI::App* modes = app.add_subcommand(
+      "modes", "Linearized model (M, D, C, H) at the unloaded rest and its exact modes");
+  modes->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
+  modes->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
+
+  std::string output_path;
+  CLI::App* simulate = app.add_subcommand(
+      "simulate", "Simulate the scenario's test and write a measurement file (HDF5)");
+  simulate->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
+  simulate->add_option("-o,--output", output_path, "Measurement file to write (.h5)")->required();
+  simulate->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version
+    std::cerr << "mbid: error: command line: " << error.what() << "; expected see mbid --help\n";
+    return static_cast<int>(mbid::ExitCode::kInvalidInput);
+  }
+  if (modes->parsed()) return mbid::app::RunModesCommand(scenario_path, common);
+  if (simulate->parsed()) {
+    return mbid::app::RunSimulateCommand(scenario_path, output_path, common);
+  }
+  return static_cast<int>(mbid::ExitCode::kOther);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Main(argc, argv);
+  } catch (const mbid::InputError& error) {
+    std::cerr << "mbid: error: " << error.what() << "\n";
+    return static_cast<int>(mbid::ExitCode::kInvalidInput);
+  } catch (const mbid::NumericalError& error) {
+    std::cerr << "mbid: numerical failure: " << error.what() << "\n";
+    return static_cast<int>(mbid::ExitCode::kNumericalFailure);
+  } catch (const std::exception& error) {
+    std::cerr << "mbid: failure: " << error.what() << "\n";
+    return static_cast<int>(mbid::ExitCode::kOther);
+  }
+}

@@ -1,0 +1,58 @@
+#include "mbid/app/scenario.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "mbid/common/error.h"
+#include "mbid/model/model_factory.h"
+#include "mbid/simulation/scenario_sections.h"
+
+namespace mbid::app {
+
+std::unique_ptr<model::MechanicalModel> Scenario::MakeModel() const {
+  return model::MakeModel(root.Child("model"));
+}
+
+const simulation::Excitation& Scenario::RequireExcitation() const {
+  if (!has_excitation) root.Fail("no excitation section", "excitation: {type: ...}");
+  return excitation;
+}
+
+Scenario LoadScenario(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "", "cannot open the scenario file", "a readable YAML file");
+  std::stringstream text;
+  text << in.rdbuf();
+  Scenario scenario{path,  "", text.str(), YamlReader::FromString(text.str(), path),
+                    false, {}, {},         {}};
+  if (!scenario.root.IsMap()) scenario.root.Fail("not a mapping", "a YAML mapping of sections");
+  scenario.root.ExpectMap(
+      {"name", "model", "excitation", "simulation", "sensors", "identification", "updating"});
+  scenario.name = scenario.root.String("name");
+  if (scenario.name.empty() || scenario.name.find('/') != std::string::npos) {
+    scenario.root.FailAt("name", "'" + scenario.name + "'",
+                         "a non-empty name without '/' (it names the results folder)");
+  }
+  // Build the model once so that every error surfaces at load time.
+  const auto model = scenario.MakeModel();
+  if (scenario.root.Has("excitation")) {
+    scenario.has_excitation = true;
+    scenario.excitation = simulation::ReadExcitation(scenario.root.Child("excitation"), *model);
+  }
+  if (scenario.root.Has("simulation")) {
+    scenario.simulation = simulation::ReadSimulationOptions(scenario.root.Child("simulation"));
+  }
+  if (scenario.root.Has("sensors")) {
+    scenario.sensors = simulation::ReadSensorOptions(scenario.root.Child("sensors"), *model);
+  }
+  return scenario;
+}
+
+std::string DefaultScenarioPath() {
+  const std::filesystem::path in_tree =
+      std::filesystem::path(MBID_SOURCE_DIR) / "scenarios" / "reference-crane.yaml";
+  return in_tree.string();
+}
+
+}  // namespace mbid::app

@@ -1,0 +1,17 @@
+#pragma once
+
+#include "mbid/common/yaml_reader.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/excitation.h"
+#include "mbid/simulation/sensor.h"
+#include "mbid/simulation/simulate.h"
+
+namespace mbid::simulation {
+
+// The scenario sections the simulation layer owns (docs/scenarios.md), read strictly; names of
+// coordinates, load points and channels are checked against `model`.
+Excitation ReadExcitation(const YamlReader& excitation, const model::MechanicalModel& model);
+SimulationOptions ReadSimulationOptions(const YamlReader& simulation);
+SensorOptions ReadSensorOptions(const YamlReader& sensors, const model::MechanicalModel& model);
+
+}  // namespace mbid::simulation

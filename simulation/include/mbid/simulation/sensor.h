@@ -1,0 +1,31 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mbid/common/measurement.h"
+
+namespace mbid::simulation {
+
+// The sensors of a virtual test (docs/scenarios.md, `sensors:`): sampling, and per channel a
+// constant bias, Gaussian noise and quantization, all in the channel's unit (rad for angles).
+// Every random draw comes from `seed`: the same options give the same bits.
+struct SensorOptions {
+  double sample_rate_hz = 100.0;
+  std::vector<std::string> channels{"psi", "phi"};
+  std::map<std::string, double> noise_std;          // per channel; absent = 0
+  std::map<std::string, double> bias;               // per channel; absent = 0
+  std::map<std::string, double> quantization_step;  // per channel; absent or 0 = none
+  std::uint64_t seed = 1;
+
+  double sample_interval_s() const { return 1.0 / sample_rate_hz; }
+};
+
+// measured = Q(clean + bias + noise), with Q rounding to the nearest multiple of the step.
+// Noise is drawn channel by channel, sample by sample, from a 64-bit Mersenne twister seeded
+// with `seed`.
+Measurement ApplySensor(const Measurement& clean, const SensorOptions& options);
+
+}  // namespace mbid::simulation

@@ -1,0 +1,35 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "mbid/common/measurement.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/excitation.h"
+#include "mbid/simulation/integrator_options.h"
+#include "mbid/simulation/sensor.h"
+
+namespace mbid::simulation {
+
+// `simulation:` of a scenario.
+struct SimulationOptions {
+  double duration_s = 10.0;
+  IntegratorOptions integrator;
+};
+
+struct SimulationResult {
+  Measurement exact;          // the model's outputs at the sample times, no sensor effects
+  Measurement measured;       // after the sensor model
+  Eigen::VectorXd initial_q;  // rad, at t = 0
+  IntegratorStatistics statistics;
+  double forcing_end_s = 0.0;  // the record is a free decay after this time
+};
+
+// Simulates a test: the initial state of `excitation`, CVODES integration of the model's
+// Simbody system, outputs (and coordinates, if asked as channels) sampled exactly at
+// t_j = j / sample_rate, j = 0..floor(duration * rate). The integrator stops at each sample time
+// and at the end of the forcing, so no output is interpolated. CVODES failures propagate as
+// NumericalError("CVODES", reason).
+SimulationResult Simulate(const model::MechanicalModel& model, const Excitation& excitation,
+                          const SimulationOptions& options, const SensorOptions& sensors);
+
+}  // namespace mbid::simulation

@@ -1,0 +1,153 @@
+#include "mbid/simulation/scenario_sections.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "mbid/common/error.h"
+
+namespace mbid::simulation {
+namespace {
+
+bool Contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+// A scalar for every channel, or a map channel -> value; values must be >= 0.
+std::map<std::string, double> ReadPerChannel(const YamlReader& sensors, const std::string& key,
+                                             const std::vector<std::string>& channels,
+                                             bool non_negative) {
+  std::map<std::string, double> values;
+  if (!sensors.Has(key)) return values;
+  const YamlReader node = sensors.Child(key);
+  if (node.IsMap()) {
+    node.ExpectMap(channels);
+    for (const std::string& channel : node.Keys()) values[channel] = node.Double(channel);
+  } else {
+    const double value = sensors.Double(key);
+    for (const std::string& channel : channels) values[channel] = value;
+  }
+  for (const auto& [channel, value] : values) {
+    if (non_negative && value < 0) {
+      sensors.FailAt(key, "negative value for " + channel, "a value >= 0 in the channel's unit");
+    }
+  }
+  return values;
+}
+
+// The target of an impulse or burst: `point` + `force_N` or `coordinate` + `torque_Nm`.
+void ReadForceTarget(const YamlReader& node, const model::MechanicalModel& model,
+                     Excitation& excitation) {
+  const bool has_point = node.Has("point") || node.Has("force_N");
+  const bool has_torque = node.Has("coordinate") || node.Has("torque_Nm");
+  if (has_point == has_torque) {
+    node.Fail("needs exactly one target",
+              "either point + force_N (a force in N, ground frame) or coordinate + torque_Nm");
+  }
+  if (has_point) {
+    excitation.point = node.Choice("point", model.load_points(), model.load_points().front());
+    const std::array<double, 3> f = node.Vector3("force_N");
+    excitation.force_N = Eigen::Vector3d(f[0], f[1], f[2]);
+    if (excitation.force_N.isZero(0.0)) node.FailAt("force_N", "zero force", "a non-zero force");
+  } else {
+    excitation.coordinate = node.Choice("coordinate", model.coordinate_names(), "");
+    excitation.torque_Nm = node.Double("torque_Nm");
+    if (excitation.torque_Nm == 0) node.FailAt("torque_Nm", "zero torque", "a non-zero torque");
+  }
+}
+
+}  // namespace
+
+Excitation ReadExcitation(const YamlReader& node, const model::MechanicalModel& model) {
+  Excitation excitation;
+  const std::string type =
+      node.Choice("type", {"load_drop", "initial_deflection", "impulse", "burst"}, "");
+  if (type == "load_drop") {
+    node.ExpectMap({"type", "payload_mass_kg"});
+    excitation.type = Excitation::Type::kLoadDrop;
+    excitation.payload_mass_kg = node.PositiveDouble("payload_mass_kg");
+  } else if (type == "initial_deflection") {
+    node.ExpectMap({"type", "deflection_rad"});
+    excitation.type = Excitation::Type::kInitialDeflection;
+    const YamlReader deflection = node.Child("deflection_rad");
+    deflection.ExpectMap(model.coordinate_names());
+    for (const std::string& coordinate : deflection.Keys()) {
+      excitation.deflection_rad[coordinate] = deflection.Double(coordinate);
+    }
+    if (excitation.deflection_rad.empty()) {
+      node.FailAt("deflection_rad", "no coordinate given", "at least one coordinate's angle");
+    }
+  } else if (type == "impulse") {
+    node.ExpectMap({"type", "point", "force_N", "coordinate", "torque_Nm", "duration_s", "shape"});
+    excitation.type = Excitation::Type::kImpulse;
+    ReadForceTarget(node, model, excitation);
+    excitation.duration_s = node.PositiveDouble("duration_s");
+    excitation.pulse_shape =
+        node.Choice("shape", {"half_sine", "rectangular"}, "half_sine") == "rectangular"
+            ? Excitation::PulseShape::kRectangular
+            : Excitation::PulseShape::kHalfSine;
+  } else {
+    node.ExpectMap(
+        {"type", "point", "force_N", "coordinate", "torque_Nm", "frequency_hz", "cycles"});
+    excitation.type = Excitation::Type::kBurst;
+    ReadForceTarget(node, model, excitation);
+    excitation.frequency_hz = node.PositiveDouble("frequency_hz");
+    excitation.cycles = node.Int("cycles");
+    if (excitation.cycles < 1) node.FailAt("cycles", "fewer than one cycle", "an integer >= 1");
+  }
+  return excitation;
+}
+
+SimulationOptions ReadSimulationOptions(const YamlReader& node) {
+  SimulationOptions options;
+  node.ExpectMap({"duration_s", "integrator"});
+  options.duration_s = node.PositiveDouble("duration_s", options.duration_s);
+  if (node.Has("integrator")) {
+    const YamlReader integrator = node.Child("integrator");
+    integrator.ExpectMap(
+        {"method", "relative_tolerance", "absolute_tolerance", "max_steps", "max_step_s"});
+    IntegratorOptions& o = options.integrator;
+    o.method = integrator.Choice("method", {"bdf", "adams"}, "bdf") == "adams"
+                   ? IntegratorOptions::Method::kAdams
+                   : IntegratorOptions::Method::kBdf;
+    o.relative_tolerance = integrator.PositiveDouble("relative_tolerance", o.relative_tolerance);
+    o.absolute_tolerance = integrator.PositiveDouble("absolute_tolerance", o.absolute_tolerance);
+    o.max_steps = integrator.Int("max_steps", o.max_steps);
+    o.max_step_s = integrator.Double("max_step_s", o.max_step_s);
+    std::string why;
+    if (!o.IsValid(&why)) integrator.Fail(why, "valid integrator options (docs/scenarios.md)");
+  }
+  return options;
+}
+
+SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalModel& model) {
+  SensorOptions options;
+  node.ExpectMap(
+      {"sample_rate_hz", "channels", "noise_std_rad", "bias_rad", "quantization_step_rad", "seed"});
+  options.sample_rate_hz = node.PositiveDouble("sample_rate_hz", options.sample_rate_hz);
+  if (node.Has("channels")) options.channels = node.StringList("channels");
+  if (options.channels.empty()) node.FailAt("channels", "no channel", "at least one channel");
+  std::vector<std::string> known = model.output_names();
+  known.insert(known.end(), model.coordinate_names().begin(), model.coordinate_names().end());
+  for (size_t i = 0; i < options.channels.size(); ++i) {
+    const std::string& channel = options.channels[i];
+    if (!Contains(known, channel)) {
+      node.FailAt("channels", "unknown channel '" + channel + "'",
+                  "outputs or coordinates of the model; did you mean '" +
+                      ClosestMatch(channel, known) + "'?");
+    }
+    if (std::count(options.channels.begin(), options.channels.end(), channel) > 1) {
+      node.FailAt("channels", "channel '" + channel + "' listed twice", "unique channel names");
+    }
+  }
+  // Every channel of the crane is an angle, so the sensor keys carry rad.
+  options.noise_std = ReadPerChannel(node, "noise_std_rad", options.channels, true);
+  options.bias = ReadPerChannel(node, "bias_rad", options.channels, false);
+  options.quantization_step = ReadPerChannel(node, "quantization_step_rad", options.channels, true);
+  const int seed = node.Int("seed", 1);
+  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
+  options.seed = static_cast<std::uint64_t>(seed);
+  return options;
+}
+
+}  // namespace mbid::simulation
