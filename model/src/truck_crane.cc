@@ -162,16 +162,6 @@ struct TruckCrane::Impl {
     return Vec3(parameters.boom_length_m, 0, 0);
   }
 
-  void ApplyJointParameters(SimTK::State& s) const {
-    for (int i = 0; i < kDofs; ++i) {
-      const double c = parameters.joints[i].stiffness_Nm_per_rad;
-      springs[i].setStiffness(s, c);
-      // c (q0 - 0) + g(0) = 0 at the unloaded rest position q = 0.
-      springs[i].setQZero(s, -unloaded_gravity_force[i] / c);
-      dampers[i].setDamping(s, parameters.joints[i].damping_Nms_per_rad);
-    }
-  }
-
   TruckCraneParameters parameters;
   SimTK::MultibodySystem system;
   SimTK::SimbodyMatterSubsystem matter;
@@ -235,28 +225,48 @@ std::vector<Parameter> TruckCrane::parameters() const {
   return result;
 }
 
-void TruckCrane::SetParameter(const std::string& name, double value) {
+namespace {
+
+// Which joint and which coefficient `name` ("c_alpha", "d_theta") names; throws if none.
+std::pair<int, bool> ParseJointParameter(const std::string& name, double value) {
   for (int i = 0; i < kDofs; ++i) {
-    JointSpringDamper& joint = impl_->parameters.joints[i];
-    if (name == "c_" + kCoordinates[i]) {
-      if (!(std::isfinite(value) && value > 0)) {
-        throw InputError("model", name, "stiffness " + std::to_string(value),
-                         "a positive finite value in N*m/rad");
-      }
-      joint.stiffness_Nm_per_rad = value;
-      return;
+    const bool stiffness = name == "c_" + kCoordinates[i];
+    if (!stiffness && name != "d_" + kCoordinates[i]) continue;
+    if (stiffness && !(std::isfinite(value) && value > 0)) {
+      throw InputError("model", name, "stiffness " + std::to_string(value),
+                       "a positive finite value in N*m/rad");
     }
-    if (name == "d_" + kCoordinates[i]) {
-      if (!(std::isfinite(value) && value >= 0)) {
-        throw InputError("model", name, "damping " + std::to_string(value),
-                         "a non-negative finite value in N*m*s/rad");
-      }
-      joint.damping_Nms_per_rad = value;
-      return;
+    if (!stiffness && !(std::isfinite(value) && value >= 0)) {
+      throw InputError("model", name, "damping " + std::to_string(value),
+                       "a non-negative finite value in N*m*s/rad");
     }
+    return {i, stiffness};
   }
   throw InputError("model", name, "unknown parameter",
                    "c_<joint> or d_<joint> with joint in alpha, gamma, eta, theta");
+}
+
+}  // namespace
+
+void TruckCrane::SetParameter(const std::string& name, double value) {
+  const auto [joint, stiffness] = ParseJointParameter(name, value);
+  if (stiffness) {
+    impl_->parameters.joints[joint].stiffness_Nm_per_rad = value;
+  } else {
+    impl_->parameters.joints[joint].damping_Nms_per_rad = value;
+  }
+}
+
+void TruckCrane::ApplyParameterToState(SimTK::State& state, const std::string& name,
+                                       double value) const {
+  const auto [joint, stiffness] = ParseJointParameter(name, value);
+  if (stiffness) {
+    impl_->springs[joint].setStiffness(state, value);
+    // The preload rule holds for every stiffness: the unloaded crane rests at q = 0.
+    impl_->springs[joint].setQZero(state, -impl_->unloaded_gravity_force[joint] / value);
+  } else {
+    impl_->dampers[joint].setDamping(state, value);
+  }
 }
 
 const SimTK::MultibodySystem& TruckCrane::system() const { return impl_->system; }
@@ -266,7 +276,12 @@ SimTK::State TruckCrane::MakeState(const Eigen::VectorXd& q, const Eigen::Vector
     throw std::invalid_argument("TruckCrane::MakeState: q and u need 4 entries");
   }
   SimTK::State s = impl_->default_state;
-  impl_->ApplyJointParameters(s);
+  for (int i = 0; i < kDofs; ++i) {
+    ApplyParameterToState(s, "c_" + kCoordinates[i],
+                          impl_->parameters.joints[i].stiffness_Nm_per_rad);
+    ApplyParameterToState(s, "d_" + kCoordinates[i],
+                          impl_->parameters.joints[i].damping_Nms_per_rad);
+  }
   s.setTime(0.0);
   s.updQ() = ToVector(q);
   s.updU() = ToVector(u);

@@ -206,3 +206,27 @@ TEST(TruckCraneTest, ValidationRejectsUnphysicalData) {
 
 }  // namespace
 }  // namespace mbid::model
+
+namespace mbid::model {
+namespace {
+
+TEST(TruckCraneTest, ApplyParameterToStateMatchesSetParameter) {
+  // Same accelerations, bit for bit, whether the parameter comes from the model or the state.
+  TruckCrane crane(ReferenceParameters());
+  Eigen::VectorXd q(4), u(4);
+  q << 0.001, -0.002, 0.003, 0.004;  // a generic state: every spring and damper acts
+  u << 0.01, 0.02, -0.03, 0.04;
+  SimTK::State in_state = crane.MakeState(q, u);
+  crane.ApplyParameterToState(in_state, "c_theta", 1.2e7);
+  crane.ApplyParameterToState(in_state, "d_gamma", 9e4);
+  crane.SetParameter("c_theta", 1.2e7);
+  crane.SetParameter("d_gamma", 9e4);
+  SimTK::State in_model = crane.MakeState(q, u);
+  crane.system().realize(in_state, SimTK::Stage::Acceleration);
+  crane.system().realize(in_model, SimTK::Stage::Acceleration);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(in_state.getUDot()[i], in_model.getUDot()[i]) << i;
+  EXPECT_THROW(crane.ApplyParameterToState(in_state, "c_theta", 0.0), InputError);
+}
+
+}  // namespace
+}  // namespace mbid::model

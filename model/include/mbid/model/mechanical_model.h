@@ -57,6 +57,11 @@ class MechanicalModel {
   // Throws InputError for an unknown name or a value outside (lower, upper).
   virtual void SetParameter(const std::string& name, double value) = 0;
   double GetParameter(const std::string& name) const;
+  // Sets a parameter in `state` alone (as SetParameter would for states made afterwards),
+  // leaving the model unchanged: for right-hand sides that read parameters, e.g. CVODES forward
+  // sensitivities. Invalidates the state's Instance stage. Same checks as SetParameter.
+  virtual void ApplyParameterToState(SimTK::State& state, const std::string& name,
+                                     double value) const = 0;
 
   // The Simbody system; realized to Topology.
   virtual const SimTK::MultibodySystem& system() const = 0;

@@ -73,6 +73,8 @@ class TruckCrane final : public MechanicalModel {
 
   std::vector<Parameter> parameters() const override;
   void SetParameter(const std::string& name, double value) override;
+  void ApplyParameterToState(SimTK::State& state, const std::string& name,
+                             double value) const override;
 
   const SimTK::MultibodySystem& system() const override;
   SimTK::State MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const override;
