@@ -1,0 +1,251 @@
+// The mbid command as users' scripts see it: exit codes, one-line errors naming file and field,
+// no output left behind on failure, and files that other tools (h5py) read.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kMbid = std::string(MBID_BINARY_DIR) + "/app/mbid";
+const std::string kReference = std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("mbid_cli_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  CommandResult Run(const std::string& arguments) const {
+    const fs::path out = dir_ / "stdout.txt";
+    const fs::path err = dir_ / "stderr.txt";
+    const std::string command =
+        kMbid + " " + arguments + " > " + out.string() + " 2> " + err.string();
+    const int status = std::system(command.c_str());
+    CommandResult result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = ReadText(out);
+    result.err = ReadText(err);
+    fs::remove(out);
+    fs::remove(err);
+    return result;
+  }
+
+  // The reference scenario with `from` replaced by `to` (which must occur).
+  fs::path WriteVariant(const std::string& from, const std::string& to) const {
+    std::string text = ReadText(kReference);
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    const fs::path path = dir_ / "scenario.yaml";
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  // Nothing but what the test itself wrote.
+  void ExpectNoOutputLeft(const fs::path& scenario) const {
+    for (const auto& entry : fs::directory_iterator(dir_)) {
+      EXPECT_EQ(entry.path(), scenario) << "left behind: " << entry.path();
+    }
+  }
+
+  fs::path dir_;
+};
+
+struct BadScenario {
+  const char* name;
+  const char* from;
+  const char* to;
+  const char* field;     // the field the message must name
+  const char* expected;  // a phrase the message must contain
+};
+
+// One bad input per validation rule the scenario reader enforces.
+const BadScenario kBadScenarios[] = {
+    {"UnknownKeySuggestsClosest", "    mass_kg: 15160.0", "    mas_kg: 15160.0",
+     "model.base.mas_kg", "mass_kg"},
+    {"NumberWithoutUnit", "  duration_s: 8", "  duration: 8", "simulation.duration", "duration_s"},
+    {"NegativeMass", "mass_kg: 6838.0", "mass_kg: -6838.0", "model.slewing.mass_kg", "> 0"},
+    {"NotANumber", "length_m: 10.0", "length_m: .nan", "model.boom.length_m", "finite"},
+    {"Infinite", "gravity_mps2: 9.81", "gravity_mps2: .inf", "model.gravity_mps2", "finite"},
+    {"WrongType", "  duration_s: 8", "  duration_s: 8 s", "simulation.duration_s", "number"},
+    {"ElevationOutOfRange", "boom_elevation_deg: 16.0", "boom_elevation_deg: 95.0",
+     "boom_elevation_deg", "(-90, 90)"},
+    {"InertiaTriangle", "inertia_kgm2: [4765.0, 14100.0, 18100.0]",
+     "inertia_kgm2: [4765.0, 14100.0, 28100.0]", "model.slewing.inertia_kgm2", "triangle"},
+    {"UnknownExcitation", "type: initial_deflection", "type: initial_deflexion", "excitation.type",
+     "initial_deflection"},
+    {"UnknownChannel", "channels: [psi, phi]", "channels: [psi, phj]", "sensors.channels", "phi"},
+    {"UnknownCoordinate", "deflection_rad: {alpha:", "deflection_rad: {alpah:",
+     "excitation.deflection_rad.alpah", "alpha"},
+    {"BadVector", "com_m: [0.3, 0, 0.3]", "com_m: [0.3, 0]", "model.slewing.com_m", "3"},
+    {"UnknownModelType", "type: truck_crane", "type: truck_crain", "model.type", "truck_crane"},
+    {"NegativeNoise", "noise_std_rad: 1.0e-05", "noise_std_rad: -1.0e-05", "sensors.noise_std_rad",
+     ">= 0"},
+    {"UnknownIntegrator", "method: bdf", "method: rk4", "simulation.integrator.method", "adams"},
+    {"MissingModel", "model:\n  type: truck_crane", "modell:\n  type: truck_crane", "modell",
+     "model"},
+};
+
+class BadScenarioTest : public CliTest, public ::testing::WithParamInterface<BadScenario> {};
+
+TEST_P(BadScenarioTest, SimulateFailsWithOneLineNamingTheField) {
+  const BadScenario& bad = GetParam();
+  const fs::path scenario = WriteVariant(bad.from, bad.to);
+  const fs::path output = dir_ / "out.h5";
+  const CommandResult result = Run("simulate " + scenario.string() + " -o " + output.string() +
+                                   " --json " + (dir_ / "out.json").string());
+  EXPECT_EQ(result.exit_code, 2) << result.err;  // invalid input (interfaces.md)
+  EXPECT_EQ(result.err.rfind("mbid: error: " + scenario.string() + ":", 0), 0u) << result.err;
+  EXPECT_NE(result.err.find(bad.field), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("expected"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find(bad.expected), std::string::npos) << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;  // one line
+  ExpectNoOutputLeft(scenario);
+}
+
+INSTANTIATE_TEST_SUITE_P(Rules, BadScenarioTest, ::testing::ValuesIn(kBadScenarios),
+                         [](const ::testing::TestParamInfo<BadScenario>& param_info) {
+                           return std::string(param_info.param.name);
+                         });
+
+TEST_F(CliTest, MissingScenarioFileIsInvalidInput) {
+  const CommandResult result = Run("modes " + (dir_ / "nope.yaml").string());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("nope.yaml"), std::string::npos) << result.err;
+}
+
+TEST_F(CliTest, UnknownFlagIsInvalidInput) {
+  const CommandResult result = Run("modes " + kReference + " --jsn x");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(result.err.rfind("mbid: error:", 0), 0u) << result.err;
+}
+
+TEST_F(CliTest, YamlSyntaxErrorNamesTheLine) {
+  const fs::path scenario = WriteVariant("  duration_s: 8", "  duration_s: [8");
+  const CommandResult result = Run("modes " + scenario.string());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("line"), std::string::npos) << result.err;
+}
+
+TEST_F(CliTest, IntegratorFailureIsNumericalAndLeavesNothing) {
+  // Five steps cannot cover a 0.01 s sample interval at rtol 1e-8: CVODES gives up.
+  const fs::path scenario =
+      WriteVariant("absolute_tolerance: 1.0e-10}", "absolute_tolerance: 1.0e-10, max_steps: 5}");
+  const CommandResult result =
+      Run("simulate " + scenario.string() + " -o " + (dir_ / "x.h5").string());
+  EXPECT_EQ(result.exit_code, 3) << result.err;  // numerical failure (interfaces.md)
+  EXPECT_NE(result.err.find("CV_TOO_MUCH_WORK"), std::string::npos) << result.err;
+  ExpectNoOutputLeft(scenario);
+}
+
+TEST_F(CliTest, OutputIntoMissingFolderIsInvalidInput) {
+  const CommandResult result =
+      Run("simulate " + kReference + " -o " + (dir_ / "no" / "such" / "x.h5").string());
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_FALSE(fs::exists(dir_ / "no"));
+}
+
+TEST_F(CliTest, HelpAndVersion) {
+  const CommandResult help = Run("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("modes"), std::string::npos);
+  EXPECT_NE(help.out.find("simulate"), std::string::npos);
+  const CommandResult version = Run("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_EQ(version.out.rfind("mbid ", 0), 0u) << version.out;
+  EXPECT_EQ(Run("simulate --help").exit_code, 0);
+}
+
+TEST_F(CliTest, ModesJsonFollowsTheContract) {
+  const CommandResult result = Run("modes " + kReference + " --json -");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json json = nlohmann::json::parse(result.out);
+  EXPECT_EQ(json["coordinates"], nlohmann::json({"alpha", "gamma", "eta", "theta"}));
+  EXPECT_EQ(json["outputs"], nlohmann::json({"psi", "phi"}));
+  ASSERT_EQ(json["M"].size(), 4u);
+  ASSERT_EQ(json["H"].size(), 2u);
+  ASSERT_EQ(json["modes"].size(), 4u);
+  const nlohmann::json& mode = json["modes"][1];
+  // reference-crane.md, mode 2; printed with full precision, so 1e-9 relative holds.
+  EXPECT_NEAR(mode["frequency_hz"].get<double>(), 1.512559861, 1e-8);
+  for (const char* field : {"decay_rate_per_s", "damping_ratio", "undamped_frequency_hz",
+                            "log_decrement", "half_life_s", "amplitude", "phase_rad", "shape"}) {
+    EXPECT_TRUE(mode.contains(field)) << field;
+  }
+  EXPECT_EQ(mode["shape"]["theta"].size(), 2u);  // [re, im]
+  EXPECT_TRUE(mode["amplitude"].contains("psi"));
+}
+
+TEST_F(CliTest, SimulateWritesTheMeasurementFileH5pyReads) {
+  const fs::path output = dir_ / "drop.h5";
+  const fs::path json = dir_ / "drop.json";
+  const std::string load_drop =
+      std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane-load-drop.yaml";
+  const CommandResult result =
+      Run("simulate " + load_drop + " -o " + output.string() + " --json " + json.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(json));
+  EXPECT_EQ(summary["samples"], 801);  // 8 s at 100 Hz, both ends
+  // reference-crane.md: the drop starts from alpha = 5.846515e-04 rad (7 digits).
+  EXPECT_NEAR(summary["initial_q"]["alpha"].get<double>(), 5.846515e-04, 1e-10);
+  if (!fs::exists("/usr/bin/python3") ||
+      std::system("/usr/bin/python3 -c 'import h5py' 2>/dev/null") != 0) {
+    GTEST_SKIP() << "h5py not installed";
+  }
+  const std::string script =
+      "import h5py, sys\n"
+      "f = h5py.File(sys.argv[1], 'r')\n"
+      "assert f.attrs['format'] == 'mbid' and f.attrs['format_version'] == 1\n"
+      "m = f['measurement']\n"
+      "assert list(m.attrs['channels']) == ['psi', 'phi'], m.attrs['channels']\n"
+      "assert abs(m.attrs['sample_interval_s'] - 0.01) < 1e-15\n"
+      "assert m['time'].attrs['units'] == 's' and m['psi'].attrs['units'] == 'rad'\n"
+      "assert m['phi'].shape == (801,)\n"
+      "assert 'load_drop' in f['scenario'].attrs['yaml']\n"
+      "assert f['truth/parameters/c_alpha'][()] == 4.9e7\n"
+      "assert f['truth/modes/frequency_hz'].shape == (4,)\n"
+      "print('ok')\n";
+  const fs::path script_path = dir_ / "check.py";
+  std::ofstream(script_path) << script;
+  const std::string command =
+      "/usr/bin/python3 " + script_path.string() + " " + output.string() + " > /dev/null";
+  EXPECT_EQ(std::system(command.c_str()), 0);
+}
+
+TEST_F(CliTest, SimulateIsReproducible) {
+  // Same scenario (and seed), same bits: compare the files byte for byte.
+  const fs::path a = dir_ / "a.h5";
+  const fs::path b = dir_ / "b.h5";
+  ASSERT_EQ(Run("simulate " + kReference + " -o " + a.string()).exit_code, 0);
+  ASSERT_EQ(Run("simulate " + kReference + " -o " + b.string()).exit_code, 0);
+  EXPECT_EQ(Run("simulate " + kReference + " -o " + b.string() + " -q").err, "");  // quiet
+  const std::string command = "h5diff " + a.string() + " " + b.string() + " > /dev/null";
+  EXPECT_EQ(std::system(command.c_str()), 0);
+}
+
+}  // namespace
