@@ -4,6 +4,8 @@
 #include <iostream>
 
 #include "mbid/app/commands.h"
+#include "mbid/app/run_cycle.h"
+#include "mbid/app/scenario.h"
 #include "mbid/app/version.h"
 #include "mbid/common/error.h"
 
@@ -33,12 +35,23 @@ int Main(int argc, char** argv) {
   simulate->add_option("-o,--output", output_path, "Measurement file to write (.h5)")->required();
   simulate->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
 
+  std::string output_dir;
+  CLI::App* run = app.add_subcommand(
+      "run", "The validation cycle on a scenario, with its report (default: the reference crane)");
+  run->add_option("SCENARIO", scenario_path, "Scenario YAML file")
+      ->default_str("scenarios/reference-crane.yaml");
+  run->add_option("-o,--output", output_dir, "Results folder (default results/<scenario name>)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version
     std::cerr << "mbid: error: command line: " << error.what() << "; expected see mbid --help\n";
     return static_cast<int>(mbid::ExitCode::kInvalidInput);
+  }
+  if (run->parsed()) {
+    if (scenario_path.empty()) scenario_path = mbid::app::DefaultScenarioPath();
+    return mbid::app::RunValidationCycle(scenario_path, output_dir, common);
   }
   if (modes->parsed()) return mbid::app::RunModesCommand(scenario_path, common);
   if (simulate->parsed()) {
