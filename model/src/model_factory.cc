@@ -90,8 +90,28 @@ TruckCraneParameters ReadTruckCraneParameters(const YamlReader& model) {
   return p;
 }
 
+TorsionalOscillatorParameters ReadTorsionalOscillatorParameters(const YamlReader& model) {
+  model.ExpectMap({"type", "inertia_kgm2", "joints"});
+  TorsionalOscillatorParameters p;
+  p.inertia_kgm2 = model.PositiveDouble("inertia_kgm2");
+  const YamlReader joints = model.Child("joints");
+  joints.ExpectMap({"angle"});
+  const YamlReader joint = joints.Child("angle");
+  joint.ExpectMap({"stiffness_Nm_per_rad", "damping_Nms_per_rad"});
+  p.stiffness_Nm_per_rad = joint.PositiveDouble("stiffness_Nm_per_rad");
+  p.damping_Nms_per_rad = joint.Double("damping_Nms_per_rad", 0.0);
+  if (p.damping_Nms_per_rad < 0) {
+    joint.FailAt("damping_Nms_per_rad", "negative damping", "a value >= 0 in N*m*s/rad");
+  }
+  return p;
+}
+
 std::unique_ptr<MechanicalModel> MakeModel(const YamlReader& model) {
-  const std::string type = model.Choice("type", {"truck_crane"}, "truck_crane");
+  const std::string type =
+      model.Choice("type", {"truck_crane", "torsional_oscillator"}, "truck_crane");
+  if (type == "torsional_oscillator") {
+    return std::make_unique<TorsionalOscillator>(ReadTorsionalOscillatorParameters(model));
+  }
   return std::make_unique<TruckCrane>(ReadTruckCraneParameters(model));
 }
 
