@@ -104,8 +104,8 @@ SimulationOptions ReadSimulationOptions(const YamlReader& node) {
   options.duration_s = node.PositiveDouble("duration_s", options.duration_s);
   if (node.Has("integrator")) {
     const YamlReader integrator = node.Child("integrator");
-    integrator.ExpectMap(
-        {"method", "relative_tolerance", "absolute_tolerance", "max_steps", "max_step_s"});
+    integrator.ExpectMap({"method", "relative_tolerance", "absolute_tolerance", "max_steps",
+                          "max_step_s", "interpolate_outputs"});
     IntegratorOptions& o = options.integrator;
     o.method = integrator.Choice("method", {"bdf", "adams"}, "bdf") == "adams"
                    ? IntegratorOptions::Method::kAdams
@@ -114,6 +114,7 @@ SimulationOptions ReadSimulationOptions(const YamlReader& node) {
     o.absolute_tolerance = integrator.PositiveDouble("absolute_tolerance", o.absolute_tolerance);
     o.max_steps = integrator.Int("max_steps", o.max_steps);
     o.max_step_s = integrator.Double("max_step_s", o.max_step_s);
+    o.interpolate_outputs = integrator.Bool("interpolate_outputs", o.interpolate_outputs);
     std::string why;
     if (!o.IsValid(&why)) integrator.Fail(why, "valid integrator options (docs/scenarios.md)");
   }

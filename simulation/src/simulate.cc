@@ -41,6 +41,19 @@ std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
   return sources;
 }
 
+// Counters of two integration stretches (the forced one and the free decay).
+IntegratorStatistics AddStatistics(IntegratorStatistics total, const IntegratorStatistics& more) {
+  total.steps += more.steps;
+  total.rhs_evaluations += more.rhs_evaluations;
+  total.rhs_evaluations_for_jacobian += more.rhs_evaluations_for_jacobian;
+  total.jacobian_evaluations += more.jacobian_evaluations;
+  total.error_test_failures += more.error_test_failures;
+  total.linear_solver_setups += more.linear_solver_setups;
+  total.nonlinear_iterations += more.nonlinear_iterations;
+  total.nonlinear_convergence_failures += more.nonlinear_convergence_failures;
+  return total;
+}
+
 }  // namespace
 
 SimulationResult Simulate(const model::MechanicalModel& model, const Excitation& excitation,
@@ -82,7 +95,11 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
         });
   }
   const model::MechanicalModel& simulated = forced ? *forced_model : model;
-  CvodesIntegrator integrator(simulated.system(), options.integrator);
+  // While forced, stop at every sample and at the forcing's end: no step may straddle the kink
+  // where the load switches off. The free decay may use dense output.
+  IntegratorOptions forced_options = options.integrator;
+  forced_options.interpolate_outputs = false;
+  CvodesIntegrator integrator(simulated.system(), forced ? forced_options : options.integrator);
   integrator.Initialize(
       simulated.MakeState(result.initial_q, Eigen::VectorXd::Zero(model.coordinate_count())));
 
@@ -100,9 +117,10 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
     if (!forcing_done && t >= result.forcing_end_s) {
       // Stop exactly where the forcing switches off (a kink in the load) and restart the
       // multistep history there.
-      integrator.AdvanceTo(result.forcing_end_s);
+      const SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s);
       before_restart = integrator.statistics();
-      integrator.Initialize(SimTK::State(integrator.state()));
+      integrator = CvodesIntegrator(simulated.system(), options.integrator);
+      integrator.Initialize(at_end);
       forcing_done = true;
     }
     const SimTK::State& state = j == 0 ? integrator.state() : integrator.AdvanceTo(t);
@@ -112,16 +130,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
           sources[c].is_output ? y[sources[c].index] : state.getQ()[sources[c].index];
     }
   }
-  result.statistics = integrator.statistics();
-  // Counters restart with Initialize(); add the forced stretch back.
-  result.statistics.steps += before_restart.steps;
-  result.statistics.rhs_evaluations += before_restart.rhs_evaluations;
-  result.statistics.rhs_evaluations_for_jacobian += before_restart.rhs_evaluations_for_jacobian;
-  result.statistics.jacobian_evaluations += before_restart.jacobian_evaluations;
-  result.statistics.error_test_failures += before_restart.error_test_failures;
-  result.statistics.linear_solver_setups += before_restart.linear_solver_setups;
-  result.statistics.nonlinear_iterations += before_restart.nonlinear_iterations;
-  result.statistics.nonlinear_convergence_failures += before_restart.nonlinear_convergence_failures;
+  result.statistics = AddStatistics(integrator.statistics(), before_restart);
   result.exact = exact;
   result.measured = ApplySensor(exact, sensors);
   return result;

@@ -12,7 +12,10 @@ namespace mbid::simulation {
 
 // `simulation:` of a scenario.
 struct SimulationOptions {
+  SimulationOptions() { integrator.interpolate_outputs = true; }
   double duration_s = 10.0;
+  // Free decays use CVODES' dense output at the sample times (its error is of the order of the
+  // local error test, i.e. within the tolerances); forced stretches always stop at each sample.
   IntegratorOptions integrator;
 };
 
@@ -26,8 +29,9 @@ struct SimulationResult {
 
 // Simulates a test: the initial state of `excitation`, CVODES integration of the model's
 // Simbody system, outputs (and coordinates, if asked as channels) sampled exactly at
-// t_j = j / sample_rate, j = 0..floor(duration * rate). The integrator stops at each sample time
-// and at the end of the forcing, so no output is interpolated. CVODES failures propagate as
+// t_j = j / sample_rate, j = 0..floor(duration * rate). While a forcing acts the integrator stops
+// at each sample time and at the forcing's end; the free decay after it uses dense output when
+// options.integrator.interpolate_outputs (the default) is set. CVODES failures propagate as
 // NumericalError("CVODES", reason).
 SimulationResult Simulate(const model::MechanicalModel& model, const Excitation& excitation,
                           const SimulationOptions& options, const SensorOptions& sensors);
