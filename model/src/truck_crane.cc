@@ -127,21 +127,25 @@ struct TruckCrane::Impl {
       springs[i].setStiffness(s, 0.0);
       dampers[i].setDamping(s, 0.0);
     }
-    s.updQ() = 0;
-    s.updU() = 0;
-    const Eigen::VectorXd payload_force = CalcPointLoadForce(
-        s, {"boom_tip",
-            Eigen::Vector3d(0, 0, -parameters.attached_payload_kg * parameters.gravity_mps2)});
-    return CalcRestForce(s) - payload_force;
+    // Everything at rest minus the attached payload's weight.
+    const double payload_weight_N = parameters.attached_payload_kg * parameters.gravity_mps2;
+    return CalcStaticForceAt(s, Eigen::VectorXd::Zero(kDofs),
+                             {{"boom_tip", Eigen::Vector3d(0, 0, payload_weight_N)}});
   }
 
-  // Generalized force M(q) u' at rest: all applied forces projected on the coordinates (velocity
-  // terms vanish at u = 0). Works on a copy so callers keep const states.
-  Eigen::VectorXd CalcRestForce(SimTK::State s) const {
-    system.realize(s, SimTK::Stage::Acceleration);
+  // The generalized force at rest at q, M(q) u' with u = 0 (velocity terms vanish), computed on
+  // `scratch` (a state carrying the parameters; its q and u are overwritten): springs, gravity
+  // and the point loads.
+  Eigen::VectorXd CalcStaticForceAt(SimTK::State& scratch, const Eigen::VectorXd& q,
+                                    const std::vector<PointLoad>& loads) const {
+    scratch.updQ() = ToVector(q);
+    scratch.updU() = 0;
+    system.realize(scratch, SimTK::Stage::Acceleration);
     SimTK::Vector m_udot;
-    matter.multiplyByM(s, s.getUDot(), m_udot);
-    return ToEigen(m_udot);
+    matter.multiplyByM(scratch, scratch.getUDot(), m_udot);
+    Eigen::VectorXd force = ToEigen(m_udot);
+    for (const PointLoad& load : loads) force += CalcPointLoadForce(scratch, load);
+    return force;
   }
 
   Eigen::VectorXd CalcPointLoadForce(const SimTK::State& s, const PointLoad& load) const {
@@ -310,43 +314,45 @@ double TruckCrane::CalcEnergy(const SimTK::State& state) const {
 Eigen::VectorXd TruckCrane::CalcStaticGeneralizedForce(const Eigen::VectorXd& q,
                                                        const std::vector<PointLoad>& loads) const {
   SimTK::State s = MakeState(q, Eigen::VectorXd::Zero(kDofs));
-  Eigen::VectorXd force = impl_->CalcRestForce(s);
-  for (const PointLoad& load : loads) force += impl_->CalcPointLoadForce(s, load);
-  return force;
+  return impl_->CalcStaticForceAt(s, q, loads);
 }
 
 Eigen::VectorXd TruckCrane::SolveStaticEquilibrium(const std::vector<PointLoad>& loads) const {
-  // Newton on f(q) = 0 with the tangent stiffness -df/dq by central differences; the root's
-  // accuracy depends only on f, so Newton reaches machine precision. Start at the unloaded rest.
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(kDofs);
-  const double scale = impl_->parameters.joints[0].stiffness_Nm_per_rad;
-  Eigen::VectorXd f = CalcStaticGeneralizedForce(q, loads);
-  double last_step = std::numeric_limits<double>::infinity();
-  for (int iteration = 0; iteration < 50; ++iteration) {
+  // Newton's chord method on f(q) = 0: the tangent stiffness -df/dq by central differences at
+  // the start, kept while the steps shrink fast (the loads are small against the springs, so
+  // the tangent hardly changes) and refreshed when they do not. The root's accuracy depends only
+  // on f, so the iteration reaches machine precision. One scratch state serves every evaluation.
+  SimTK::State s = MakeState(Eigen::VectorXd::Zero(kDofs), Eigen::VectorXd::Zero(kDofs));
+  auto force = [&](const Eigen::VectorXd& q) { return impl_->CalcStaticForceAt(s, q, loads); };
+  auto tangent = [&](const Eigen::VectorXd& q) {
     Eigen::Matrix4d jacobian;
     const double h = 1e-7;  // rad; smooth forces, curvature scale ~1 rad
     for (int j = 0; j < kDofs; ++j) {
       Eigen::VectorXd dq = Eigen::VectorXd::Zero(kDofs);
       dq[j] = h;
-      jacobian.col(j) =
-          (CalcStaticGeneralizedForce(q + dq, loads) - CalcStaticGeneralizedForce(q - dq, loads)) /
-          (2 * h);
+      jacobian.col(j) = (force(q + dq) - force(q - dq)) / (2 * h);
     }
-    const Eigen::VectorXd step = jacobian.partialPivLu().solve(-f);
+    return Eigen::PartialPivLU<Eigen::Matrix4d>(jacobian);
+  };
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(kDofs);
+  Eigen::VectorXd f = force(q);
+  Eigen::PartialPivLU<Eigen::Matrix4d> lu = tangent(q);
+  double last_step = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    const Eigen::VectorXd step = lu.solve(-f);
     q += step;
-    f = CalcStaticGeneralizedForce(q, loads);
+    f = force(q);
     const double step_norm = step.lpNorm<Eigen::Infinity>();
     // Converged when the step is at roundoff of q, or stops shrinking after being tiny.
     if (step_norm <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, q.norm()) ||
         (step_norm < 1e-12 && step_norm >= last_step)) {
       return q;
     }
+    if (step_norm > 0.1 * last_step) lu = tangent(q);  // slow contraction: refresh the tangent
     last_step = step_norm;
   }
   throw NumericalError("static equilibrium", "Newton did not converge in 50 iterations; residual " +
-                                                 std::to_string(f.norm()) +
-                                                 " N*m (stiffness scale " + std::to_string(scale) +
-                                                 ")");
+                                                 std::to_string(f.norm()) + " N*m");
 }
 
 LinearModel TruckCrane::Linearize() const {
@@ -368,9 +374,7 @@ LinearModel TruckCrane::Linearize() const {
     impl_->dampers[i].setDamping(gravity_only, 0.0);
   }
   auto gravity_force = [&](const Eigen::VectorXd& q) {
-    SimTK::State t = gravity_only;
-    t.updQ() = ToVector(q);
-    return impl_->CalcRestForce(t);
+    return impl_->CalcStaticForceAt(gravity_only, q, {});
   };
   auto central = [&](int j, double h) {
     Eigen::VectorXd dq = Eigen::VectorXd::Zero(kDofs);
