@@ -111,6 +111,9 @@ const BadScenario kBadScenarios[] = {
      "model"},
 };
 
+// Test names and failure messages show the rule, not the struct's bytes.
+void PrintTo(const BadScenario& bad, std::ostream* os) { *os << bad.name; }
+
 class BadScenarioTest : public CliTest, public ::testing::WithParamInterface<BadScenario> {};
 
 TEST_P(BadScenarioTest, SimulateFailsWithOneLineNamingTheField) {
