@@ -1,0 +1,106 @@
+#include "mbid/simulation/modal_record.h"
+
+#include <cmath>
+#include <random>
+
+#include "mbid/common/error.h"
+
+namespace mbid::simulation {
+namespace {
+
+double Lookup(const std::map<std::string, double>& values, const std::string& key) {
+  const auto found = values.find(key);
+  return found == values.end() ? 0.0 : found->second;
+}
+
+std::map<std::string, double> ReadChannelMap(const YamlReader& node, const std::string& key,
+                                             const std::vector<std::string>& channels) {
+  std::map<std::string, double> values;
+  if (!node.Has(key)) return values;
+  const YamlReader map = node.Child(key);
+  if (!map.IsMap()) {
+    const double value = node.Double(key);
+    for (const std::string& channel : channels) values[channel] = value;
+    return values;
+  }
+  map.ExpectMap(channels);
+  for (const std::string& channel : map.Keys()) values[channel] = map.Double(channel);
+  return values;
+}
+
+}  // namespace
+
+Measurement SynthesizeModalRecord(const ModalRecordSpec& spec, Measurement* exact) {
+  const double tau = 1.0 / spec.sample_rate_hz;
+  const int samples = static_cast<int>(std::floor(spec.duration_s / tau + 1e-9)) + 1;
+  Measurement clean;
+  clean.channels = spec.channels;
+  clean.units.assign(spec.channels.size(), "rad");
+  clean.sample_interval_s = tau;
+  clean.source = "synthetic";
+  clean.values = Eigen::MatrixXd::Zero(samples, static_cast<Eigen::Index>(spec.channels.size()));
+  for (size_t c = 0; c < spec.channels.size(); ++c) {
+    for (const ModalComponent& mode : spec.modes) {
+      const double amplitude = Lookup(mode.amplitude, spec.channels[c]);
+      const double phase = Lookup(mode.phase_rad, spec.channels[c]);
+      for (int j = 0; j < samples; ++j) {
+        const double t = j * tau;
+        clean.values(j, static_cast<Eigen::Index>(c)) +=
+            amplitude * std::exp(-mode.decay_rate_per_s * t) *
+            std::cos(2 * M_PI * mode.frequency_hz * t + phase);
+      }
+    }
+  }
+  Measurement noisy = clean;
+  std::mt19937_64 generator(spec.seed);
+  std::normal_distribution<double> unit_normal(0.0, 1.0);
+  for (size_t c = 0; c < spec.channels.size(); ++c) {
+    const double std_dev = Lookup(spec.noise_std, spec.channels[c]);
+    for (int j = 0; j < samples; ++j) {
+      noisy.values(j, static_cast<Eigen::Index>(c)) += std_dev * unit_normal(generator);
+    }
+  }
+  if (exact != nullptr) *exact = clean;
+  return noisy;
+}
+
+ModalRecordSpec ReadModalRecordSpec(const YamlReader& node) {
+  node.ExpectMap({"channels", "sample_rate_hz", "duration_s", "modes", "noise_std_rad", "seed"});
+  ModalRecordSpec spec;
+  spec.channels = node.StringList("channels");
+  if (spec.channels.empty()) node.FailAt("channels", "no channel", "at least one channel name");
+  spec.sample_rate_hz = node.PositiveDouble("sample_rate_hz", spec.sample_rate_hz);
+  spec.duration_s = node.PositiveDouble("duration_s", spec.duration_s);
+  spec.noise_std = ReadChannelMap(node, "noise_std_rad", spec.channels);
+  for (const auto& [channel, value] : spec.noise_std) {
+    if (value < 0) node.FailAt("noise_std_rad", "negative noise for " + channel, "a value >= 0");
+  }
+  const int seed = node.Int("seed", 1);
+  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
+  spec.seed = static_cast<std::uint64_t>(seed);
+  const YamlReader modes = node.Child("modes");
+  if (!modes.node().IsSequence() || modes.node().size() == 0) {
+    modes.Fail("not a list of modes", "a list of {frequency_hz, decay_rate_per_s, amplitude_rad}");
+  }
+  for (size_t k = 0; k < modes.node().size(); ++k) {
+    const YamlReader mode(modes.node()[k], node.source(),
+                          modes.field() + "[" + std::to_string(k) + "]");
+    mode.ExpectMap({"frequency_hz", "decay_rate_per_s", "amplitude_rad", "phase_rad"});
+    ModalComponent component;
+    component.frequency_hz = mode.PositiveDouble("frequency_hz");
+    component.decay_rate_per_s = mode.Double("decay_rate_per_s");
+    if (component.frequency_hz >= spec.sample_rate_hz / 2) {
+      mode.FailAt("frequency_hz", "at or above the Nyquist frequency",
+                  "a frequency below sample_rate_hz / 2");
+    }
+    component.amplitude = ReadChannelMap(mode, "amplitude_rad", spec.channels);
+    if (component.amplitude.empty()) {
+      mode.FailAt("amplitude_rad", "missing", "the amplitude per channel, rad");
+    }
+    component.phase_rad = ReadChannelMap(mode, "phase_rad", spec.channels);
+    spec.modes.push_back(component);
+  }
+  return spec;
+}
+
+}  // namespace mbid::simulation
