@@ -48,6 +48,23 @@ struct NonlinearSolverDeleter {
 struct CvodeDeleter {
   void operator()(void* memory) const { CVodeFree(&memory); }
 };
+// An array of `count` vectors (N_VCloneVectorArray), e.g. the sensitivities s_i.
+struct VectorArray {
+  VectorArray() = default;
+  VectorArray(const VectorArray&) = delete;
+  VectorArray& operator=(const VectorArray&) = delete;
+  ~VectorArray() { Reset(); }
+  void Reset(N_Vector* vectors = nullptr, int count = 0) {
+    if (vectors_ != nullptr) N_VDestroyVectorArray(vectors_, count_);
+    vectors_ = vectors;
+    count_ = count;
+  }
+  N_Vector* get() const { return vectors_; }
+
+ private:
+  N_Vector* vectors_ = nullptr;
+  int count_ = 0;
+};
 
 template <typename Handle, typename Deleter>
 using Owned = std::unique_ptr<std::remove_pointer_t<Handle>, Deleter>;
@@ -160,11 +177,102 @@ class CvodesIntegrator::Impl {
         CopyToState(N_VGetArrayPointer(y_.get()));
         throw NumericalError("CVODES", DescribeFailure(flag, t_reached, t));
       }
+      // At t itself (a stop time, or interpolated); before the first step they are the initial
+      // ones, which InitializeSensitivities stored.
+      if (sensitivity_count_ > 0) {
+        realtype t_sensitivities = t;
+        Check(CVodeGetSens(cvode_.get(), &t_sensitivities, sensitivity_vectors_.get()),
+              "CVodeGetSens");
+        for (int i = 0; i < sensitivity_count_; ++i) {
+          const realtype* s = N_VGetArrayPointer(sensitivity_vectors_.get()[i]);
+          for (Eigen::Index r = 0; r < sensitivities_.rows(); ++r) sensitivities_(r, i) = s[r];
+        }
+      }
     }
     SetTimeAndY(t, N_VGetArrayPointer(y_.get()));
     system_->realize(state_, SimTK::Stage::Acceleration);
     return state_;
   }
+
+  void InitializeSensitivities(const std::vector<double>& p, const std::vector<double>& scale,
+                               const Eigen::MatrixXd& initial, const SensitivityOptions& options) {
+    if (!initialized_) {
+      throw std::logic_error(
+          "CvodesIntegrator::InitializeSensitivities: call Initialize() first (and again after "
+          "a failure)");
+    }
+    const int count = static_cast<int>(p.size());
+    const int n = static_cast<int>(N_VGetLength(y_.get()));
+    if (count == 0 || scale.size() != p.size() || initial.rows() != n || initial.cols() != count) {
+      std::ostringstream why;
+      why << "CvodesIntegrator::InitializeSensitivities: " << p.size() << " parameters, "
+          << scale.size() << " scales, initial sensitivities " << initial.rows() << " x "
+          << initial.cols() << "; expected at least one parameter, one scale each and a " << n
+          << " x " << p.size() << " matrix";
+      throw std::invalid_argument(why.str());
+    }
+    for (int i = 0; i < count; ++i) {
+      if (!std::isfinite(p[i]) || !(scale[i] > 0 && std::isfinite(scale[i]))) {
+        std::ostringstream why;
+        why << "CvodesIntegrator::InitializeSensitivities: parameter " << i << " = " << p[i]
+            << " with scale " << scale[i] << "; expected a finite value and a finite scale > 0";
+        throw std::invalid_argument(why.str());
+      }
+    }
+    std::string why;
+    if (!options.IsValid(&why)) {
+      throw std::invalid_argument("CvodesIntegrator: invalid SensitivityOptions: " + why);
+    }
+    void* cv = cvode_.get();
+    if (sensitivity_count_ > 0) CVodeSensFree(cv);
+    sensitivity_count_ = 0;
+    sensitivity_nonlinear_solver_.reset();
+    sensitivity_vectors_.Reset(N_VCloneVectorArray(count, y_.get()), count);
+    if (sensitivity_vectors_.get() == nullptr) {
+      throw NumericalError("CVODES", "N_VCloneVectorArray returned NULL");
+    }
+    for (int i = 0; i < count; ++i) {
+      realtype* s = N_VGetArrayPointer(sensitivity_vectors_.get()[i]);
+      for (int r = 0; r < n; ++r) s[r] = initial(r, i);
+    }
+    // CVODES keeps the pointer to p and perturbs it in place for its difference quotients.
+    sensitivity_p_ = p;
+    sensitivity_scale_ = scale;
+    const bool simultaneous = options.corrector == SensitivityOptions::Corrector::kSimultaneous;
+    Check(CVodeSensInit1(cv, count, simultaneous ? CV_SIMULTANEOUS : CV_STAGGERED, nullptr,
+                         sensitivity_vectors_.get()),
+          "CVodeSensInit1");
+    sensitivity_count_ = count;
+    Check(CVodeSetSensParams(cv, sensitivity_p_.data(), sensitivity_scale_.data(), nullptr),
+          "CVodeSetSensParams");
+    // s_i has the unit of Y / p_i: the absolute tolerance scales like the sensitivity.
+    std::vector<realtype> absolute(count);
+    for (int i = 0; i < count; ++i) absolute[i] = options.absolute_tolerance / scale[i];
+    Check(CVodeSensSStolerances(cv, options.relative_tolerance, absolute.data()),
+          "CVodeSensSStolerances");
+    const bool centered =
+        options.difference_quotient == SensitivityOptions::DifferenceQuotient::kCentered;
+    // rhomax = 0: perturb Y and p together, one quotient per sensitivity.
+    Check(CVodeSetSensDQMethod(cv, centered ? CV_CENTERED : CV_FORWARD, 0.0),
+          "CVodeSetSensDQMethod");
+    Check(CVodeSetSensErrCon(cv, options.error_control ? SUNTRUE : SUNFALSE), "CVodeSetSensErrCon");
+    if (options_.method == IntegratorOptions::Method::kAdams) {
+      // Without a linear solver the sensitivities need fixed-point iteration too; CVODES'
+      // default would be Newton.
+      sensitivity_nonlinear_solver_.reset(SUNNonlinSol_FixedPointSens(
+          simultaneous ? count + 1 : count, y_.get(), 0, context_.get()));
+      if (!sensitivity_nonlinear_solver_) {
+        throw NumericalError("CVODES", "SUNNonlinSol_FixedPointSens returned NULL");
+      }
+      Check(simultaneous ? CVodeSetNonlinearSolverSensSim(cv, sensitivity_nonlinear_solver_.get())
+                         : CVodeSetNonlinearSolverSensStg(cv, sensitivity_nonlinear_solver_.get()),
+            "CVodeSetNonlinearSolverSens");
+    }
+    sensitivities_ = initial;
+  }
+
+  const std::vector<double>& sensitivity_parameters() const { return sensitivity_p_; }
+  const Eigen::MatrixXd& sensitivities() const { return sensitivities_; }
 
   const SimTK::State& state() const {
     if (!has_state_) {
@@ -188,6 +296,7 @@ class CvodesIntegrator::Impl {
       CVodeGetNumJacEvals(cv, &s.jacobian_evaluations);
       CVodeGetNumLinRhsEvals(cv, &s.rhs_evaluations_for_jacobian);
     }
+    if (sensitivity_count_ > 0) CVodeGetNumRhsEvalsSens(cv, &s.rhs_evaluations_for_sensitivities);
     return s;
   }
 
@@ -197,6 +306,10 @@ class CvodesIntegrator::Impl {
   void CreateSolver(int n) {
     // Members referring to others go first.
     cvode_.reset();
+    sensitivity_count_ = 0;
+    sensitivity_nonlinear_solver_.reset();
+    sensitivity_vectors_.Reset();
+    sensitivities_.resize(0, 0);
     nonlinear_solver_.reset();
     linear_solver_.reset();
     matrix_.reset();
@@ -330,6 +443,13 @@ class CvodesIntegrator::Impl {
   Owned<SUNMatrix, MatrixDeleter> matrix_;
   Owned<SUNLinearSolver, LinearSolverDeleter> linear_solver_;
   Owned<SUNNonlinearSolver, NonlinearSolverDeleter> nonlinear_solver_;
+  // Forward sensitivities (InitializeSensitivities); CVODES points into sensitivity_p_.
+  std::vector<double> sensitivity_p_;
+  std::vector<double> sensitivity_scale_;
+  VectorArray sensitivity_vectors_;
+  Owned<SUNNonlinearSolver, NonlinearSolverDeleter> sensitivity_nonlinear_solver_;
+  Eigen::MatrixXd sensitivities_;
+  int sensitivity_count_ = 0;
   Owned<void*, CvodeDeleter> cvode_;
 };
 
@@ -344,6 +464,16 @@ void CvodesIntegrator::set_time_dependent_inputs(TimeDependentInputs hook) {
 }
 void CvodesIntegrator::Initialize(const SimTK::State& initial) { impl_->Initialize(initial); }
 const SimTK::State& CvodesIntegrator::AdvanceTo(double t) { return impl_->AdvanceTo(t); }
+void CvodesIntegrator::InitializeSensitivities(const std::vector<double>& p,
+                                               const std::vector<double>& scale,
+                                               const Eigen::MatrixXd& initial,
+                                               const SensitivityOptions& options) {
+  impl_->InitializeSensitivities(p, scale, initial, options);
+}
+const std::vector<double>& CvodesIntegrator::sensitivity_parameters() const {
+  return impl_->sensitivity_parameters();
+}
+const Eigen::MatrixXd& CvodesIntegrator::sensitivities() const { return impl_->sensitivities(); }
 const SimTK::State& CvodesIntegrator::state() const { return impl_->state(); }
 double CvodesIntegrator::time() const { return impl_->state().getTime(); }
 IntegratorStatistics CvodesIntegrator::statistics() const { return impl_->statistics(); }

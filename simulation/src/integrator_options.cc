@@ -40,4 +40,27 @@ bool IntegratorOptions::IsValid(std::string* why) const {
   return true;
 }
 
+bool SensitivityOptions::IsValid(std::string* why) const {
+  auto fail = [why](std::string reason) {
+    if (why != nullptr) *why = std::move(reason);
+    return false;
+  };
+  if (corrector != Corrector::kSimultaneous && corrector != Corrector::kStaggered) {
+    return fail("corrector: unknown value; expected kSimultaneous or kStaggered");
+  }
+  if (difference_quotient != DifferenceQuotient::kCentered &&
+      difference_quotient != DifferenceQuotient::kForward) {
+    return fail("difference_quotient: unknown value; expected kCentered or kForward");
+  }
+  if (!(relative_tolerance >= 1e-14 && relative_tolerance < 1.0)) {
+    return fail(
+        Describe("sensitivity relative_tolerance", relative_tolerance, "a value in [1e-14, 1)"));
+  }
+  if (!(absolute_tolerance > 0.0 && std::isfinite(absolute_tolerance))) {
+    return fail(
+        Describe("sensitivity absolute_tolerance", absolute_tolerance, "a finite value > 0"));
+  }
+  return true;
+}
+
 }  // namespace mbid::simulation

@@ -1,7 +1,9 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "mbid/simulation/integrator_options.h"
 
@@ -64,6 +66,21 @@ class CvodesIntegrator {
   // and state() holds the last point CVODES reached. Throws std::logic_error before
   // Initialize() and std::invalid_argument for t < time().
   const SimTK::State& AdvanceTo(double t);
+
+  // Forward sensitivities s_i = dY/dp_i of parameters p (CVodeSensInit1 with CVODES' own
+  // difference quotients of the right-hand side). CVODES perturbs the values it reads through
+  // sensitivity_parameters(), so the right-hand side must take its parameters from there: the
+  // input hook applies them to the working state. `scale` (p_scale_i > 0) sets the size of the
+  // perturbations and the sensitivities' absolute tolerance; `initial` (NY x Np) is s_i at
+  // time(). Call after every Initialize(), which turns sensitivities off. Throws
+  // std::invalid_argument for inconsistent sizes or invalid options and NumericalError if
+  // CVODES cannot set them up.
+  void InitializeSensitivities(const std::vector<double>& p, const std::vector<double>& scale,
+                               const Eigen::MatrixXd& initial, const SensitivityOptions& options);
+  // The parameter values as CVODES currently perturbs them (p while no quotient is formed).
+  const std::vector<double>& sensitivity_parameters() const;
+  // s_i at time(), NY x Np (columns per parameter); empty without sensitivities.
+  const Eigen::MatrixXd& sensitivities() const;
 
   // The working state at time(): realized to Velocity after Initialize(), to Acceleration after
   // AdvanceTo(). Throws std::logic_error before the first Initialize().

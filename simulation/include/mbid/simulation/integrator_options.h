@@ -30,6 +30,32 @@ struct IntegratorOptions {
   bool IsValid(std::string* why) const;
 };
 
+// How CvodesIntegrator integrates forward sensitivities s_i = dY/dp_i (CVODES, with difference
+// quotients of the right-hand side itself; docs/toolchain.md). Checked by IsValid() when the
+// sensitivities are initialized.
+struct SensitivityOptions {
+  enum class Corrector {
+    kSimultaneous,  // state and sensitivities in one nonlinear system (CV_SIMULTANEOUS)
+    kStaggered,     // sensitivities corrected after the state has converged (CV_STAGGERED)
+  };
+  enum class DifferenceQuotient {
+    kCentered,  // two right-hand sides per sensitivity, error O(delta^2)
+    kForward,   // one right-hand side per sensitivity, error O(delta)
+  };
+
+  Corrector corrector = Corrector::kSimultaneous;
+  DifferenceQuotient difference_quotient = DifferenceQuotient::kCentered;
+  // Local error test of the sensitivities: rtol_s * |s_i| + atol_s / p_scale_i. Looser than the
+  // state's on purpose: at the state's tolerance (<= 1e-9) the internal difference quotients are
+  // noisier than the test and CVODES stalls (docs/toolchain.md).
+  double relative_tolerance = 1e-6;
+  double absolute_tolerance = 1e-8;
+  // false leaves the sensitivities out of the error test (steps chosen for the state alone).
+  bool error_control = true;
+
+  bool IsValid(std::string* why) const;
+};
+
 // Counters of CVODES since the last CvodesIntegrator::Initialize().
 struct IntegratorStatistics {
   long steps = 0;
@@ -42,6 +68,8 @@ struct IntegratorStatistics {
   long jacobian_evaluations = 0;
   // Calls of the right-hand side for difference-quotient Jacobians (BDF only).
   long rhs_evaluations_for_jacobian = 0;
+  // Calls of the right-hand side for the sensitivities' difference quotients.
+  long rhs_evaluations_for_sensitivities = 0;
   double last_step_s = 0.0;
   int last_order = 0;
 };

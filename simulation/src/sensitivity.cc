@@ -1,0 +1,244 @@
+#include "mbid/simulation/sensitivity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include "mbid/common/error.h"
+#include "mbid/model/simbody.h"
+#include "mbid/simulation/cvodes_integrator.h"
+
+namespace mbid::simulation {
+namespace {
+
+// Relative step of the central differences of the initial coordinates: the static equilibrium
+// is solved to roundoff and is smooth in the parameters, so the O(h^2) error is ~1e-8.
+constexpr double kInitialStateStep = 1e-4;
+// Step (rad) of dy/dq: outputs are angles smooth on the scale of 1 rad, so the truncation error
+// h^2 ~ 1e-12 and the roundoff 1e-16 / h ~ 1e-10 stay far below the sensitivities' tolerance.
+constexpr double kOutputStep_rad = 1e-6;
+
+// Channel c reads output `index` (is_output) or coordinate `index`.
+struct ChannelSource {
+  bool is_output = true;
+  int index = 0;
+  std::string units;
+};
+
+std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
+                                           const std::vector<std::string>& channels) {
+  std::vector<ChannelSource> sources;
+  for (const std::string& channel : channels) {
+    const auto& outputs = model.output_names();
+    const auto& coordinates = model.coordinate_names();
+    const auto output = std::find(outputs.begin(), outputs.end(), channel);
+    const auto coordinate = std::find(coordinates.begin(), coordinates.end(), channel);
+    if (output != outputs.end()) {
+      const int i = static_cast<int>(output - outputs.begin());
+      sources.push_back({true, i, model.output_units()[i]});
+    } else if (coordinate != coordinates.end()) {
+      sources.push_back({false, static_cast<int>(coordinate - coordinates.begin()), "rad"});
+    } else {
+      throw InputError("sensors", "channels", "unknown channel '" + channel + "'",
+                       "an output or a coordinate of the model");
+    }
+  }
+  return sources;
+}
+
+// The model carrying the excitation's time-dependent load (as Simulate builds it), or null for
+// a free decay.
+std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalModel& model,
+                                                        const Excitation& excitation) {
+  if (!(excitation.CalcForcingEndTime() > 0)) return nullptr;
+  std::unique_ptr<model::MechanicalModel> forced = model.Clone();
+  const int n = model.coordinate_count();
+  int torque_index = -1;
+  for (int i = 0; i < n; ++i) {
+    if (model.coordinate_names()[i] == excitation.coordinate) torque_index = i;
+  }
+  forced->SetExternalLoad([excitation, n, torque_index](double t,
+                                                        std::vector<model::PointLoad>& loads,
+                                                        Eigen::VectorXd& generalized_forces) {
+    const double factor = excitation.CalcForcingFactor(t);
+    if (factor == 0.0) return;
+    if (!excitation.point.empty()) loads.push_back({excitation.point, factor * excitation.force_N});
+    if (torque_index >= 0) {
+      generalized_forces = Eigen::VectorXd::Zero(n);
+      generalized_forces[torque_index] = factor * excitation.torque_Nm;
+    }
+  });
+  return forced;
+}
+
+// dq(0)/dp for each model parameter, by central differences on a clone.
+Eigen::MatrixXd CalcInitialStateSensitivity(const model::MechanicalModel& model,
+                                            const Excitation& excitation,
+                                            const std::vector<std::string>& names) {
+  const int n = model.coordinate_count();
+  Eigen::MatrixXd dq0(n, static_cast<Eigen::Index>(names.size()));
+  if (excitation.type != Excitation::Type::kLoadDrop) {
+    // The other tests start from given coordinates that no model parameter moves.
+    dq0.setZero();
+    return dq0;
+  }
+  std::unique_ptr<model::MechanicalModel> clone = model.Clone();
+  for (size_t k = 0; k < names.size(); ++k) {
+    const double value = model.GetParameter(names[k]);
+    const double h = kInitialStateStep * std::max(std::abs(value), 1e-300);
+    clone->SetParameter(names[k], value + h);
+    const Eigen::VectorXd plus = CalcInitialCoordinates(*clone, excitation);
+    clone->SetParameter(names[k], value - h);
+    const Eigen::VectorXd minus = CalcInitialCoordinates(*clone, excitation);
+    clone->SetParameter(names[k], value);
+    dq0.col(static_cast<Eigen::Index>(k)) = (plus - minus) / (2 * h);
+  }
+  return dq0;
+}
+
+void Accumulate(IntegratorStatistics& total, const IntegratorStatistics& part) {
+  total.steps += part.steps;
+  total.rhs_evaluations += part.rhs_evaluations;
+  total.linear_solver_setups += part.linear_solver_setups;
+  total.error_test_failures += part.error_test_failures;
+  total.nonlinear_iterations += part.nonlinear_iterations;
+  total.nonlinear_convergence_failures += part.nonlinear_convergence_failures;
+  total.jacobian_evaluations += part.jacobian_evaluations;
+  total.rhs_evaluations_for_jacobian += part.rhs_evaluations_for_jacobian;
+  total.rhs_evaluations_for_sensitivities += part.rhs_evaluations_for_sensitivities;
+  total.last_step_s = part.last_step_s;
+  total.last_order = part.last_order;
+}
+
+}  // namespace
+
+SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
+                                            const Excitation& excitation,
+                                            const SimulationOptions& options,
+                                            const SensorOptions& sensors,
+                                            const std::vector<std::string>& model_parameters,
+                                            const std::vector<InitialStateDirection>& directions,
+                                            const SensitivityOptions& sensitivity) {
+  if (!(options.duration_s > 0) || !(sensors.sample_rate_hz > 0)) {
+    throw std::invalid_argument(
+        "SimulateWithSensitivities: duration and sample rate must be positive");
+  }
+  const int n = model.coordinate_count();
+  const int model_count = static_cast<int>(model_parameters.size());
+  const int count = model_count + static_cast<int>(directions.size());
+  if (count == 0) {
+    throw std::invalid_argument("SimulateWithSensitivities: no parameter to differentiate by");
+  }
+  for (const InitialStateDirection& direction : directions) {
+    if (direction.dq0_dp.size() != n || !(direction.scale > 0)) {
+      throw std::invalid_argument("SimulateWithSensitivities: direction '" + direction.name +
+                                  "' needs " + std::to_string(n) +
+                                  " entries of dq0_dp and a scale > 0");
+    }
+  }
+  const std::vector<ChannelSource> sources = ResolveChannels(model, sensors.channels);
+  const double tau = sensors.sample_interval_s();
+  const int samples = static_cast<int>(std::floor(options.duration_s / tau + 1e-9)) + 1;
+
+  SensitivityResult result;
+  result.parameters = model_parameters;
+  for (const InitialStateDirection& direction : directions) {
+    result.parameters.push_back(direction.name);
+  }
+  result.initial_q = CalcInitialCoordinates(model, excitation);
+  result.initial_q_sensitivity.resize(n, count);
+  result.initial_q_sensitivity.leftCols(model_count) =
+      CalcInitialStateSensitivity(model, excitation, model_parameters);
+  std::vector<double> p(count), scale(count);
+  for (int k = 0; k < model_count; ++k) {
+    p[k] = model.GetParameter(model_parameters[k]);
+    scale[k] = std::abs(p[k]) > 0 ? std::abs(p[k]) : 1.0;
+  }
+  for (int k = model_count; k < count; ++k) {
+    const InitialStateDirection& direction = directions[k - model_count];
+    result.initial_q_sensitivity.col(k) = direction.dq0_dp;
+    p[k] = 0.0;  // not read by the right-hand side: its sensitivity is pure J s
+    scale[k] = direction.scale;
+  }
+
+  const std::unique_ptr<model::MechanicalModel> forced_model = MakeForcedModel(model, excitation);
+  const model::MechanicalModel& simulated = forced_model ? *forced_model : model;
+  const double forcing_end_s = excitation.CalcForcingEndTime();
+
+  CvodesIntegrator integrator(simulated.system(), options.integrator);
+  // The right-hand side reads the parameters CVODES perturbs; only changed ones are applied
+  // (each invalidates the state's Instance stage).
+  std::vector<double> applied(p.begin(), p.begin() + model_count);
+  integrator.set_time_dependent_inputs([&](SimTK::State& state) {
+    const std::vector<double>& current = integrator.sensitivity_parameters();
+    if (current.empty()) return;
+    for (int k = 0; k < model_count; ++k) {
+      if (current[k] != applied[k]) {
+        simulated.ApplyParameterToState(state, model_parameters[k], current[k]);
+        applied[k] = current[k];
+      }
+    }
+  });
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  integrator.Initialize(simulated.MakeState(result.initial_q, zero));
+  const int ny = integrator.state().getNY();
+  Eigen::MatrixXd initial_sensitivity = Eigen::MatrixXd::Zero(ny, count);
+  initial_sensitivity.topRows(n) = result.initial_q_sensitivity;  // Y = [q | u | z], u(0) = 0
+  integrator.InitializeSensitivities(p, scale, initial_sensitivity, sensitivity);
+
+  Measurement& exact = result.exact;
+  exact.channels = sensors.channels;
+  for (const ChannelSource& source : sources) exact.units.push_back(source.units);
+  exact.sample_interval_s = tau;
+  exact.source = "simulation";
+  const int channel_count = static_cast<int>(sources.size());
+  exact.values.resize(samples, channel_count);
+  result.output_sensitivities.assign(count, Eigen::MatrixXd(samples, channel_count));
+
+  // Outputs depend on q alone: a scratch state of the same system serves for dy/dq.
+  SimTK::State scratch = simulated.MakeState(result.initial_q, zero);
+  Eigen::MatrixXd dy_dq(simulated.output_count(), n);
+  bool forcing_done = !(forcing_end_s > 0);
+  for (int j = 0; j < samples; ++j) {
+    const double t = j * tau;
+    if (!forcing_done && t >= forcing_end_s) {
+      // Restart the multistep history at the kink of the load, sensitivities carried over.
+      integrator.AdvanceTo(forcing_end_s);
+      Accumulate(result.statistics, integrator.statistics());
+      const Eigen::MatrixXd carried = integrator.sensitivities();
+      integrator.Initialize(SimTK::State(integrator.state()));
+      integrator.InitializeSensitivities(p, scale, carried, sensitivity);
+      forcing_done = true;
+    }
+    const SimTK::State& state = j == 0 ? integrator.state() : integrator.AdvanceTo(t);
+    const Eigen::VectorXd y = simulated.CalcOutputs(state);
+    Eigen::VectorXd q(n);
+    for (int i = 0; i < n; ++i) q[i] = state.getQ()[i];
+    for (int i = 0; i < n; ++i) {
+      for (int sign : {1, -1}) {
+        for (int r = 0; r < n; ++r) scratch.updQ()[r] = q[r];
+        scratch.updQ()[i] += sign * kOutputStep_rad;
+        const Eigen::VectorXd y_step = simulated.CalcOutputs(scratch);
+        if (sign > 0) {
+          dy_dq.col(i) = y_step;
+        } else {
+          dy_dq.col(i) = (dy_dq.col(i) - y_step) / (2 * kOutputStep_rad);
+        }
+      }
+    }
+    const Eigen::MatrixXd& s = integrator.sensitivities();
+    for (int c = 0; c < channel_count; ++c) {
+      const ChannelSource& source = sources[c];
+      exact.values(j, c) = source.is_output ? y[source.index] : q[source.index];
+      for (int k = 0; k < count; ++k) {
+        result.output_sensitivities[k](j, c) =
+            source.is_output ? dy_dq.row(source.index).dot(s.col(k).head(n)) : s(source.index, k);
+      }
+    }
+  }
+  Accumulate(result.statistics, integrator.statistics());
+  return result;
+}
+
+}  // namespace mbid::simulation
