@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "external_load_force.h"
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
 #include "mbid/model/simbody_conversions.h"
@@ -39,19 +40,6 @@ void TorsionalOscillatorParameters::Validate() const {
   CheckParameter("d_angle", damping_Nms_per_rad);
 }
 
-class OscillatorLoadForce : public SimTK::Force::Custom::Implementation {
- public:
-  explicit OscillatorLoadForce(const TorsionalOscillator::Impl& impl) : impl_(impl) {}
-  void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& body_forces,
-                 SimTK::Vector_<SimTK::Vec3>& particle_forces,
-                 SimTK::Vector& mobility_forces) const override;
-  SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
-  bool dependsOnlyOnPositions() const override { return false; }
-
- private:
-  const TorsionalOscillator::Impl& impl_;
-};
-
 struct TorsionalOscillator::Impl {
   explicit Impl(const TorsionalOscillatorParameters& p)
       : parameters(p), matter(system), forces(system) {
@@ -66,7 +54,10 @@ struct TorsionalOscillator::Impl {
                                                 parameters.stiffness_Nm_per_rad, 0.0);
     damper = SimTK::Force::MobilityLinearDamper(forces, body, SimTK::MobilizerUIndex(0),
                                                 parameters.damping_Nms_per_rad);
-    SimTK::Force::Custom(forces, new OscillatorLoadForce(*this));
+    SimTK::Force::Custom(forces,
+                         new ExternalLoadForce(matter, external_load, [this](const std::string&) {
+                           return std::make_pair(body.getMobilizedBodyIndex(), kRim);
+                         }));
     system.realizeTopology();
     default_state = system.getDefaultState();
     system.realizeModel(default_state);
@@ -82,21 +73,6 @@ struct TorsionalOscillator::Impl {
   MechanicalModel::ExternalLoadFunction external_load;
   SimTK::State default_state;
 };
-
-void OscillatorLoadForce::calcForce(const SimTK::State& state,
-                                    SimTK::Vector_<SimTK::SpatialVec>& body_forces,
-                                    SimTK::Vector_<SimTK::Vec3>& /*particle_forces*/,
-                                    SimTK::Vector& mobility_forces) const {
-  if (!impl_.external_load) return;
-  std::vector<PointLoad> loads;
-  Eigen::VectorXd generalized;
-  impl_.external_load(state.getTime(), loads, generalized);
-  for (const PointLoad& load : loads) {
-    impl_.matter.addInStationForce(state, impl_.body.getMobilizedBodyIndex(), kRim,
-                                   ToVec3(load.force_G), body_forces);
-  }
-  if (generalized.size() == 1) mobility_forces[0] += generalized[0];
-}
 
 TorsionalOscillator::TorsionalOscillator(const TorsionalOscillatorParameters& parameters)
     : impl_(std::make_unique<Impl>(parameters)) {}

@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 
+#include "external_load_force.h"
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
 #include "mbid/model/simbody_conversions.h"
@@ -36,21 +37,6 @@ Rotation CalcUniversalAxes() {
 double WrapToPi(double angle_rad) { return std::remainder(angle_rad, 2.0 * M_PI); }
 
 }  // namespace
-
-// Applies the model's external load function, evaluated at the state's time. Reading the time
-// from the state keeps Simbody's caching right: a new time invalidates the Dynamics stage.
-class ExternalLoadForce : public SimTK::Force::Custom::Implementation {
- public:
-  explicit ExternalLoadForce(const TruckCrane::Impl& crane) : crane_(crane) {}
-  void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& body_forces,
-                 SimTK::Vector_<SimTK::Vec3>& particle_forces,
-                 SimTK::Vector& mobility_forces) const override;
-  SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
-  bool dependsOnlyOnPositions() const override { return false; }
-
- private:
-  const TruckCrane::Impl& crane_;
-};
 
 struct TruckCrane::Impl {
   explicit Impl(const TruckCraneParameters& p) : parameters(p), matter(system), forces(system) {
@@ -108,7 +94,11 @@ struct TruckCrane::Impl {
       dampers[i] = SimTK::Force::MobilityLinearDamper(forces, *mobod, SimTK::MobilizerUIndex(which),
                                                       parameters.joints[i].damping_Nms_per_rad);
     }
-    SimTK::Force::Custom(forces, new ExternalLoadForce(*this));
+    SimTK::Force::Custom(
+        forces, new ExternalLoadForce(matter, external_load, [this](const std::string& point) {
+          return std::make_pair(FindLoadBody(point).getMobilizedBodyIndex(),
+                                FindLoadStation(point));
+        }));
 
     system.realizeTopology();
     default_state = system.getDefaultState();
@@ -179,26 +169,6 @@ struct TruckCrane::Impl {
   SimTK::State default_state;
   Eigen::Vector4d unloaded_gravity_force;
 };
-
-void ExternalLoadForce::calcForce(const SimTK::State& state,
-                                  SimTK::Vector_<SimTK::SpatialVec>& body_forces,
-                                  SimTK::Vector_<SimTK::Vec3>& /*particle_forces*/,
-                                  SimTK::Vector& mobility_forces) const {
-  if (!crane_.external_load) return;
-  std::vector<PointLoad> loads;
-  Eigen::VectorXd generalized_forces;
-  crane_.external_load(state.getTime(), loads, generalized_forces);
-  for (const PointLoad& load : loads) {
-    crane_.matter.addInStationForce(state, crane_.FindLoadBody(load.point).getMobilizedBodyIndex(),
-                                    crane_.FindLoadStation(load.point), ToVec3(load.force_G),
-                                    body_forces);
-  }
-  if (generalized_forces.size() == 0) return;
-  if (generalized_forces.size() != kDofs) {
-    throw std::invalid_argument("TruckCrane external load: 4 generalized forces expected");
-  }
-  for (int i = 0; i < kDofs; ++i) mobility_forces[i] += generalized_forces[i];
-}
 
 TruckCrane::TruckCrane(const TruckCraneParameters& parameters)
     : impl_(std::make_unique<Impl>(parameters)) {}

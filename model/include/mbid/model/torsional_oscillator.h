@@ -48,7 +48,6 @@ class TorsionalOscillator final : public MechanicalModel {
   std::unique_ptr<MechanicalModel> Clone() const override;
 
  private:
-  friend class OscillatorLoadForce;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

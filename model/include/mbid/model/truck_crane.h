@@ -93,7 +93,6 @@ class TruckCrane final : public MechanicalModel {
                                              const std::vector<PointLoad>& loads) const;
 
  private:
-  friend class ExternalLoadForce;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
