@@ -1,0 +1,96 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <complex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "mbid/common/hdf5_io.h"
+#include "mbid/identification/spectrum.h"
+
+namespace mbid::identification {
+
+// One identified oscillatory mode (docs/notation: sign conventions of modal quantities).
+struct IdentifiedMode {
+  std::complex<double> lambda;       // continuous pole, 1/s, Im > 0 (eq. 4)
+  double frequency_hz = 0;           // Im(lambda) / (2 pi), damped
+  double decay_rate_per_s = 0;       // -Re(lambda); the paper's beta is its negative
+  double damping_ratio = 0;          // -Re(lambda) / |lambda|
+  double undamped_frequency_hz = 0;  // |lambda| / (2 pi)
+  double log_decrement = 0;          // 2 pi decay / omega_d
+  double half_life_s = 0;            // ln 2 / decay (+inf if not decaying)
+  // Per channel (in ModalResult::channels order): y_c(t) contains
+  // amplitude_c exp(-decay t) cos(omega t + phase_c), t from the first analysed sample
+  // (modal_fit.h), so amplitude is the peak amplitude at t = 0 as in the paper's Table 1.
+  Eigen::VectorXd amplitude;  // channel units
+  Eigen::VectorXd phase_rad;  // (-pi, pi]
+  // One standard deviation from the Fisher information at the estimate (refinement.h); NaN
+  // when not computed.
+  double std_frequency_hz = 0;
+  double std_decay_rate_per_s = 0;
+  // A chi-square statistic of "the mode is absent" (significance.h) and whether it reaches
+  // ModalResult::significance_threshold.
+  double significance = 0;
+  bool significant = true;
+
+  // Fills the derived quantities from lambda.
+  void SetPole(std::complex<double> pole);
+};
+
+// The poles a method finds at one model order (for a stabilization diagram).
+struct StabilizationOrder {
+  int order = 0;
+  std::vector<std::complex<double>> lambda;  // Im >= 0 members only, 1/s
+  std::vector<bool> stable;                  // reappears at the next higher orders
+};
+
+// What `mbid identify` reports (docs/interfaces: JSON `identify`; HDF5 /identification).
+struct ModalResult {
+  std::vector<std::string> channels;  // analysed channels, in order
+  std::vector<std::string> units;     // of each channel
+  double sample_interval_s = 0;       // of the record (before decimation)
+  int samples = 0;                    // analysed (in the time window, full rate)
+  double start_time_s = 0;            // time of the first analysed sample: t = 0 of the modes
+  int decimation = 1;
+  std::string method;  // "hankel-nls" | "prony-svd"
+  // prony-svd: p of eq. 3 and the effective rank k of step 3. hankel-nls: the largest order the
+  // Hankel matrix can represent (columns - 1) and the number of singular values above the
+  // noise floor.
+  int model_order = 0;
+  int effective_rank = 0;
+  std::vector<IdentifiedMode> modes;  // ascending frequency
+  double significance_threshold = 0;  // IdentificationOptions::significance_false_alarm
+  Eigen::VectorXd correlation;        // per channel: Pearson's K of record and reconstruction
+  Eigen::VectorXd offset;             // per channel constant (0 unless fitted or removed)
+  Eigen::VectorXd noise_std;          // per channel: residual standard deviation
+  Eigen::MatrixXd reconstruction;     // samples x channels, offset included
+  // eq. 5: [A1 ... Ap] of eq. 2 (m x m p) from the modes' poles and output vectors; empty if
+  // not computed.
+  Eigen::MatrixXd eq2_coefficients;
+  std::vector<StabilizationOrder> stabilization;
+  bool has_spectrum = false;
+  Spectrum spectrum;
+  // Solver and selection notes: refinement termination, dropped or insignificant modes.
+  std::string termination = "converged";  // as RefinementSummary; "converged" for prony-svd
+  int iterations = 0;
+  std::vector<std::string> warnings;
+};
+
+// The `identify` JSON of docs/interfaces, field for field, plus optional fields:
+// per mode std_frequency_hz, std_decay_rate_per_s, significance, significant; top level
+// start_time_s, decimation, significance_threshold, offset, noise_std, termination, iterations,
+// spectrum_peaks, stabilization, eq2_coefficients, warnings. Non-finite numbers (a non-decaying
+// mode's half life, an uncomputed std) become null.
+nlohmann::json ModalResultToJson(const ModalResult& result);
+
+// The /identification group: attributes method, channels; scalars sample_interval_s,
+// samples, model_order, effective_rank, start_time_s, decimation; /identification/modes with
+// one vector per quantity (names as in the JSON, units attributes) and amplitude/<channel>,
+// phase_rad/<channel>; correlation/<channel>, offset/<channel>, noise_std/<channel>;
+// reconstruction/time and reconstruction/<channel>; spectrum/frequency_hz,
+// spectrum/<channel>, spectrum/peaks_*; stabilization/order, frequency_hz, decay_rate_per_s,
+// damping_ratio, stable (one row per pole); eq2_coefficients.
+void WriteModalResult(H5Writer& writer, const ModalResult& result);
+
+}  // namespace mbid::identification

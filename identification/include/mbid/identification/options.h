@@ -1,0 +1,142 @@
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace mbid::identification {
+
+// The estimator of the poles.
+enum class Method {
+  // Default: block-Hankel SVD (matrix pencil) initialization with the order from the noise
+  // floor and stability across orders, then a Ceres refinement of all poles and amplitudes.
+  kHankelNls,
+  // The paper's method, steps 2-5 of method.md (vector AR with constant term, eq. 3-4).
+  kPronySvd,
+};
+
+// "hankel-nls" or "prony-svd", as in the JSON field `method` and the `--method` flag.
+std::string MethodName(Method method);
+// Parses a method name; false (and `method` unchanged) for an unknown name.
+bool ParseMethod(const std::string& name, Method* method);
+
+enum class SpectrumWindow { kNone, kHann };
+
+// How a constant offset (a new static equilibrium after the load drop) is handled.
+enum class OffsetRemoval {
+  kNone,  // the record decays to zero
+  kMean,  // the mean of the window is subtracted (biased for short, strongly decaying records)
+  kFit,   // a constant per channel is estimated with the modes (the paper's B0 of eq. 3)
+};
+
+// Step 1 of method.md: the amplitude spectrum and its peaks.
+struct SpectrumOptions {
+  SpectrumWindow window = SpectrumWindow::kHann;
+  // The FFT length is at least this factor times the samples, rounded up to a power of 2;
+  // padding interpolates the spectrum so that peaks of short records are placed finely.
+  int zero_padding_factor = 4;
+  // A local maximum is a peak if its topographic prominence (its height above the higher of
+  // the lowest points that separate it from a higher peak, or from the spectrum's ends) is at
+  // least this fraction of the channel's largest amplitude.
+  double min_peak_prominence = 0.05;
+};
+
+// Steps 2-4 of method.md.
+struct PronySvdOptions {
+  int order = 40;  // p of eq. 3, chosen generously (more poles than spectral peaks)
+  // Effective rank k of step 3: singular values of the regression matrix above this fraction
+  // of the largest are kept. The default keeps every singular value above round-off, i.e.
+  // plain least squares on noisy data (the paper's method as usually applied, biased under
+  // noise); noiseless data need it to drop the exactly zero directions.
+  double rank_tolerance = 1e-9;
+};
+
+// The block-Hankel SVD (matrix pencil) initialization of the default method.
+struct HankelOptions {
+  // Columns of each channel's Hankel matrix: min(samples / 3, max_columns). More columns
+  // separate close modes better but cost O(columns^3); the refinement removes most of the
+  // estimation error that fewer columns leave.
+  int max_columns = 100;
+  // A singular value is signal if its square exceeds this factor times the largest that white
+  // noise gives: the noise floor (median of the trailing squared singular values of the
+  // noise-normalized matrix) times the Marchenko-Pastur edge (1 + sqrt(columns / rows))^2.
+  // Hankel structure spreads noise a little beyond that edge (about 1.3x); 1.5 leaves a margin.
+  double noise_floor_factor = 1.5;
+  // Singular values below this fraction of the largest are round-off (noiseless records).
+  double min_relative_singular_value = 1e-7;
+  // A pole is stable if it reappears, within stability_tolerance * |lambda|, at each of this
+  // many higher orders (order + 2, order + 4, ...); 0 turns the check off.
+  int stability_orders = 2;
+  double stability_tolerance = 0.1;
+};
+
+// The Ceres refinement of the default method.
+struct RefinementOptions {
+  int max_iterations = 100;
+  // Ceres: relative change of the cost. At 1e-10 the remaining parameter change is below 1e-3
+  // of its standard deviation for records up to 1e6 samples.
+  double function_tolerance = 1e-10;
+  double parameter_tolerance = 1e-10;  // Ceres: relative change of the parameters
+  double gradient_tolerance = 1e-14;   // Ceres: max norm of the projected gradient
+  // Weigh each channel by the inverse of its noise standard deviation (maximum likelihood for
+  // white Gaussian noise of different levels per channel).
+  bool weight_channels_by_noise = true;
+};
+
+// Everything the identification of a free-decay record can be told. Defaults are meant for
+// records like the paper's (a few modes, damping ratio up to 0.8, 10-40 dB SNR).
+struct IdentificationOptions {
+  Method method = Method::kHankelNls;
+
+  // The part of the record that is analysed, in the record's own time (s), inclusive.
+  double window_start_s = -std::numeric_limits<double>::infinity();
+  double window_end_s = std::numeric_limits<double>::infinity();
+  std::vector<std::string> channels;  // empty: all, in the record's order
+  OffsetRemoval offset = OffsetRemoval::kFit;
+  // Poles are estimated on the record low-pass filtered (zero-phase FIR, cutoff 0.8 of the new
+  // Nyquist frequency) and downsampled by this factor; amplitudes, phases and the
+  // reconstruction always use the full-rate record. The filter loses the first and last
+  // 10 * decimation samples for the pole estimate.
+  int decimation = 1;
+
+  // Step 5 of method.md: poles outside these limits are dropped. Modes are oscillatory:
+  // frequency_hz > min_frequency_hz >= 0.
+  double min_frequency_hz = 0.0;
+  // 0: up to the Nyquist frequency of the (decimated) record; a larger value than that
+  // Nyquist frequency is an input error.
+  double max_frequency_hz = 0.0;
+  // Slightly negative: a lightly damped mode may be estimated with a tiny negative decay.
+  double min_damping_ratio = -0.01;
+  // Keeps heavily damped modes (the paper's mode 1 has 0.68); 1 would admit real-pole pairs.
+  double max_damping_ratio = 0.95;
+  double max_decay_rate_per_s = std::numeric_limits<double>::infinity();
+  int max_modes = 20;
+
+  // Significance of a mode (significance.h): a chi-square statistic of "the mode is absent".
+  // A mode is significant if it exceeds the threshold that pure white noise exceeds with this
+  // probability per record (CalcSignificanceThreshold: about 38 for 2 x 1000 samples).
+  double significance_false_alarm = 1e-3;
+  // If > 0, this threshold is used instead of the one derived from significance_false_alarm.
+  double min_significance = 0.0;
+  // true: modes below the threshold are dropped (and the fit repeated without them);
+  // false: they are kept with significant = false.
+  bool drop_insignificant = true;
+
+  bool compute_spectrum = true;
+  bool compute_stabilization = true;
+  // Highest order of the stabilization data; 0: automatic (max(2 * effective rank + 10, 20),
+  // at most what the method can compute).
+  int stabilization_max_order = 0;
+  bool compute_uncertainty = true;
+
+  SpectrumOptions spectrum;
+  PronySvdOptions prony;
+  HankelOptions hankel;
+  RefinementOptions refinement;
+
+  // Ceres style: true if every option is in range; otherwise false with `error` (if given)
+  // naming the option, its value and what was expected.
+  bool IsValid(std::string* error = nullptr) const;
+};
+
+}  // namespace mbid::identification

@@ -1,0 +1,87 @@
+#include "mbid/identification/hankel_svd.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+
+namespace mbid::identification {
+namespace {
+
+// G[a][b] = sum_(i=0)^(R-1) y[i+a] y[i+b] for a, b = 0..L, R = N - L. Row 0 by dot products,
+// then along each diagonal G[a+1][b+1] = G[a][b] - y[a] y[b] + y[a+R] y[b+R].
+Eigen::MatrixXd CalcHankelGram(const Eigen::VectorXd& y, int columns) {
+  const int n = static_cast<int>(y.size());
+  const int rows = n - columns + 1;
+  Eigen::MatrixXd gram(columns, columns);
+  for (int b = 0; b < columns; ++b) gram(0, b) = y.segment(0, rows).dot(y.segment(b, rows));
+  for (int a = 0; a + 1 < columns; ++a) {
+    for (int b = a; b + 1 < columns; ++b) {
+      gram(a + 1, b + 1) = gram(a, b) - y(a) * y(b) + y(a + rows) * y(b + rows);
+    }
+  }
+  return gram.selfadjointView<Eigen::Upper>();
+}
+
+// The median of the smallest values of an ascending vector, beyond the `skip` largest.
+double MedianOfTail(const Eigen::VectorXd& ascending, int skip) {
+  const int count = std::max<int>(1, static_cast<int>(ascending.size()) - skip);
+  return ascending(count / 2);
+}
+
+}  // namespace
+
+HankelSvd::HankelSvd(const Eigen::MatrixXd& values, int columns, int max_signal_order) {
+  const int channels = static_cast<int>(values.cols());
+  const int rows = static_cast<int>(values.rows()) - columns + 1;
+  // At least half of the spectrum stays for the noise floor.
+  const int skip = std::min(max_signal_order, columns / 2);
+  channel_noise_std_.resize(channels);
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(columns, columns);
+  for (int c = 0; c < channels; ++c) {
+    const Eigen::MatrixXd channel_gram = CalcHankelGram(values.col(c), columns);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(channel_gram, Eigen::EigenvaluesOnly);
+    const double largest = std::max(eigen.eigenvalues()(columns - 1), 0.0);
+    // Noiseless channels have a floor of round-off; keep it above zero and comparable.
+    const double floor = std::max(MedianOfTail(eigen.eigenvalues(), skip),
+                                  largest * 1e-15 + std::numeric_limits<double>::min());
+    channel_noise_std_(c) = std::sqrt(floor / rows);
+    gram += channel_gram / floor;
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(gram);
+  // Ascending from Eigen; reversed to descending.
+  const Eigen::VectorXd ascending = eigen.eigenvalues();
+  noise_floor_ = MedianOfTail(ascending, skip);
+  // Marchenko-Pastur: white noise in a tall matrix of aspect ratio c = columns / rows has
+  // squared singular values up to about (1 + sqrt(c))^2 times their typical value.
+  const double aspect = static_cast<double>(columns) / (static_cast<double>(rows) * channels);
+  noise_edge_ = (1 + std::sqrt(aspect)) * (1 + std::sqrt(aspect));
+  singular_values_ = ascending.reverse().cwiseMax(0.0).cwiseSqrt();
+  right_vectors_ = eigen.eigenvectors().rowwise().reverse();
+}
+
+int HankelSvd::CountSignal(double noise_floor_factor, double min_relative, int max_order) const {
+  const double largest = singular_values_(0);
+  int count = 0;
+  while (count < max_order && count < columns() - 1) {
+    const double s = singular_values_(count);
+    if (s * s <= noise_floor_factor * noise_edge_ * noise_floor_ || s <= min_relative * largest) {
+      break;
+    }
+    ++count;
+  }
+  return count;
+}
+
+std::vector<std::complex<double>> HankelSvd::CalcPoles(int order) const {
+  const int l = columns() - 1;
+  const Eigen::MatrixXd v = right_vectors_.leftCols(order);
+  // V1 Z = V2 in the least-squares sense; eig(Z) are the discrete poles.
+  const Eigen::MatrixXd z = v.topRows(l).colPivHouseholderQr().solve(v.bottomRows(l));
+  Eigen::EigenSolver<Eigen::MatrixXd> eigen(z, /*computeEigenvectors=*/false);
+  std::vector<std::complex<double>> mu(eigen.eigenvalues().data(),
+                                       eigen.eigenvalues().data() + order);
+  return mu;
+}
+
+}  // namespace mbid::identification

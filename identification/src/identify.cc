@@ -1,0 +1,441 @@
+#include "mbid/identification/identify.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "internal.h"
+#include "mbid/common/error.h"
+#include "mbid/identification/hankel_svd.h"
+#include "mbid/identification/modal_fit.h"
+#include "mbid/identification/prony_svd.h"
+#include "mbid/identification/refinement.h"
+#include "mbid/identification/significance.h"
+#include "mbid/identification/spectrum.h"
+#include "record.h"
+
+namespace mbid::identification {
+namespace {
+
+using Poles = std::vector<std::complex<double>>;
+
+[[noreturn]] void NoModes(const std::string& reason) {
+  throw NumericalError("identification", "no modes found: " + reason);
+}
+
+// Step 5 of method.md: a continuous pole is a mode if it oscillates inside the band and its
+// damping and decay are inside the limits.
+bool PassesFilter(std::complex<double> lambda, const IdentificationOptions& options,
+                  double max_frequency_hz) {
+  if (!std::isfinite(lambda.real()) || !std::isfinite(lambda.imag())) return false;
+  const double frequency_hz = lambda.imag() / (2 * M_PI);
+  const double decay = -lambda.real();
+  const double damping_ratio = decay / std::abs(lambda);
+  return frequency_hz > options.min_frequency_hz && frequency_hz <= max_frequency_hz &&
+         damping_ratio >= options.min_damping_ratio && damping_ratio <= options.max_damping_ratio &&
+         decay <= options.max_decay_rate_per_s;
+}
+
+Poles ToContinuous(const Poles& mu, double tau) {
+  Poles lambda;
+  for (const auto& z : mu) lambda.push_back(std::log(z) / tau);  // eq. 4
+  return lambda;
+}
+
+bool HasMatch(std::complex<double> lambda, const Poles& others, double tolerance) {
+  return std::any_of(others.begin(), others.end(), [&](std::complex<double> other) {
+    return std::abs(other - lambda) <= tolerance * std::abs(lambda);
+  });
+}
+
+struct Estimate {
+  Poles lambda;
+  std::vector<double> significance;
+  int model_order = 0;
+  int effective_rank = 0;
+  Eigen::VectorXd weights;  // per channel, for the covariance on the decimated record
+  std::string termination = "converged";
+  int iterations = 0;
+  std::vector<StabilizationOrder> stabilization;
+  std::vector<std::string> warnings;
+};
+
+// Keeps the modes that pass `keep`; returns how many were dropped.
+template <typename Keep>
+int DropModes(Poles* lambda, Keep&& keep) {
+  Poles kept;
+  for (size_t k = 0; k < lambda->size(); ++k) {
+    if (keep(k)) kept.push_back((*lambda)[k]);
+  }
+  const int dropped = static_cast<int>(lambda->size() - kept.size());
+  *lambda = kept;
+  return dropped;
+}
+
+double SignificanceThreshold(const AnalysisRecord& record, const IdentificationOptions& options) {
+  if (options.min_significance > 0) return options.min_significance;
+  return CalcSignificanceThreshold(static_cast<int>(record.values.rows()),
+                                   static_cast<int>(record.values.cols()),
+                                   options.significance_false_alarm);
+}
+
+// Significance on the full-rate record; drops insignificant modes (when asked) until every
+// remaining mode is significant. `refit` re-estimates the poles of a reduced set.
+template <typename Refit>
+void SelectSignificant(const AnalysisRecord& record, const IdentificationOptions& options,
+                       Estimate* estimate, Refit&& refit) {
+  const bool with_offset = options.offset == OffsetRemoval::kFit;
+  const double threshold = SignificanceThreshold(record, options);
+  int dropped = 0;
+  double largest_dropped = 0;
+  const auto note_dropped = [&] {
+    if (dropped > 0) {
+      estimate->warnings.push_back(fmt::format(
+          "dropped {} candidate mode(s) below the significance threshold {:.3g} (largest "
+          "dropped: {:.3g})",
+          dropped, threshold, largest_dropped));
+    }
+  };
+  for (;;) {
+    const AmplitudeFit fit =
+        FitAmplitudes(record.centered, record.sample_interval_s, estimate->lambda, with_offset);
+    const Eigen::VectorXd significance = CalcSignificance(record.centered, record.sample_interval_s,
+                                                          estimate->lambda, with_offset, fit);
+    estimate->significance.assign(significance.data(), significance.data() + significance.size());
+    if (!options.drop_insignificant) {
+      const int weak = static_cast<int>((significance.array() < threshold).count());
+      if (weak > 0) {
+        estimate->warnings.push_back(fmt::format(
+            "{} mode(s) below the significance threshold {:.3g} kept and flagged significant = "
+            "false",
+            weak, threshold));
+      }
+      return;
+    }
+    // Drop the weakest insignificant mode only: two close poles that share one real mode are
+    // each insignificant while together they are not.
+    Eigen::Index weakest = 0;
+    const double smallest = significance.minCoeff(&weakest);
+    if (smallest >= threshold) {
+      note_dropped();
+      return;
+    }
+    if (estimate->lambda.size() == 1) {
+      NoModes(fmt::format(
+          "no candidate mode is significant (largest significance {:.3g}, threshold {:.3g}, "
+          "significance_false_alarm {}): the record looks like noise",
+          std::max(smallest, largest_dropped), threshold, options.significance_false_alarm));
+    }
+    ++dropped;
+    largest_dropped = std::max(largest_dropped, smallest);
+    DropModes(&estimate->lambda, [&](size_t k) { return static_cast<Eigen::Index>(k) != weakest; });
+    refit(estimate);
+  }
+}
+
+int AutoStabilizationOrder(const IdentificationOptions& options, int effective_rank, int cap) {
+  const int wanted = options.stabilization_max_order > 0 ? options.stabilization_max_order
+                                                         : std::max(2 * effective_rank + 10, 20);
+  return std::min(wanted, cap);
+}
+
+// Marks poles of each order that reappear at order + 2 within `tolerance` * |lambda|.
+void MarkStable(std::vector<StabilizationOrder>* orders, double tolerance) {
+  for (size_t i = 0; i < orders->size(); ++i) {
+    StabilizationOrder& entry = (*orders)[i];
+    const StabilizationOrder* next = nullptr;
+    for (size_t j = i + 1; j < orders->size(); ++j) {
+      if ((*orders)[j].order == entry.order + 2) next = &(*orders)[j];
+    }
+    entry.stable.assign(entry.lambda.size(), false);
+    if (next == nullptr) continue;
+    for (size_t k = 0; k < entry.lambda.size(); ++k) {
+      entry.stable[k] = HasMatch(entry.lambda[k], next->lambda, tolerance);
+    }
+  }
+}
+
+StabilizationOrder UpperHalf(int order, const Poles& lambda) {
+  StabilizationOrder entry;
+  entry.order = order;
+  for (const auto& pole : lambda) {
+    if (pole.imag() >= 0 && std::isfinite(pole.real())) entry.lambda.push_back(pole);
+  }
+  return entry;
+}
+
+// ---- hankel-nls ----------------------------------------------------------------------------
+
+Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOptions& options) {
+  const Eigen::MatrixXd& values = record.decimated;
+  const double tau = record.decimated_interval_s;
+  const int samples = static_cast<int>(values.rows());
+  const int columns = std::max(8, std::min(samples / 3, options.hankel.max_columns));
+  const int max_order = 2 * options.max_modes + 1;  // + 1: a constant or real pole
+  const HankelSvd hankel(values, columns, max_order);
+
+  Estimate estimate;
+  estimate.model_order = columns - 1;
+  const int order = hankel.CountSignal(options.hankel.noise_floor_factor,
+                                       options.hankel.min_relative_singular_value, max_order);
+  estimate.effective_rank = order;
+  if (options.compute_stabilization) {
+    const int highest = AutoStabilizationOrder(options, order, columns - 2);
+    for (int m = 1; m <= highest; ++m) {
+      estimate.stabilization.push_back(UpperHalf(m, ToContinuous(hankel.CalcPoles(m), tau)));
+    }
+    MarkStable(&estimate.stabilization, options.hankel.stability_tolerance);
+  }
+  if (order == 0) {
+    const double s = hankel.singular_values()(0);
+    NoModes(fmt::format(
+        "no singular value of the Hankel matrix is above the noise (the largest squared one is "
+        "{:.3g} times what white noise gives, the threshold hankel.noise_floor_factor is {})",
+        s * s / (hankel.noise_floor() * hankel.noise_edge()), options.hankel.noise_floor_factor));
+  }
+
+  // Candidates: upper-half poles at the signal order inside the step-5 limits, stable across
+  // the next orders.
+  const Poles poles = ToContinuous(hankel.CalcPoles(order), tau);
+  int unstable = 0;
+  for (const auto& lambda : poles) {
+    if (lambda.imag() <= 0 || !PassesFilter(lambda, options, record.max_frequency_hz)) continue;
+    bool stable = true;
+    for (int s = 1; s <= options.hankel.stability_orders; ++s) {
+      const int higher = order + 2 * s;
+      if (higher >= columns - 1) break;
+      stable = stable && HasMatch(lambda, ToContinuous(hankel.CalcPoles(higher), tau),
+                                  options.hankel.stability_tolerance);
+    }
+    if (stable) {
+      estimate.lambda.push_back(lambda);
+    } else {
+      ++unstable;
+    }
+  }
+  if (unstable > 0) {
+    estimate.warnings.push_back(fmt::format(
+        "dropped {} pole(s) of order {} that are not stable across orders", unstable, order));
+  }
+  if (estimate.lambda.empty()) {
+    NoModes(
+        fmt::format("none of the {} poles at signal order {} is an oscillation inside the band "
+                    "({} .. {} Hz), the damping limits ({} .. {}) and stable across orders",
+                    poles.size(), order, options.min_frequency_hz, record.max_frequency_hz,
+                    options.min_damping_ratio, options.max_damping_ratio));
+  }
+
+  const bool with_offset = options.offset == OffsetRemoval::kFit;
+  Eigen::VectorXd weights = Eigen::VectorXd::Ones(values.cols());
+  if (options.refinement.weight_channels_by_noise) {
+    weights = hankel.channel_noise_std().cwiseInverse();
+    weights /= weights.maxCoeff();  // only ratios matter; keeps the cost of order one
+  }
+  // Refines the poles of estimate->lambda; drops those that leave the step-5 limits.
+  const auto refine = [&](Estimate* e) {
+    for (;;) {
+      ModalModel initial;
+      initial.lambda = e->lambda;
+      initial.with_offset = with_offset;
+      initial.coefficients = FitAmplitudes(values, tau, e->lambda, with_offset).coefficients;
+      RefinementSummary summary =
+          RefineModalModel(values, tau, weights, initial, options.refinement);
+      // Maximum likelihood weighs channels by their noise; if the Hankel estimate of the
+      // ratios was off by more than 20 %, refine once more with the residuals' levels.
+      if (options.refinement.weight_channels_by_noise && values.cols() > 1) {
+        const AmplitudeFit fit = FitAmplitudes(values, tau, summary.model.lambda, with_offset);
+        const Eigen::VectorXd noise = fit.residual_variance.cwiseSqrt();
+        Eigen::VectorXd updated = noise.cwiseMax(1e-300).cwiseInverse();
+        updated /= updated.maxCoeff();
+        const double change = (updated.array() / weights.array()).maxCoeff() /
+                              (updated.array() / weights.array()).minCoeff();
+        if (change > 1.2) {
+          weights = updated;
+          initial.lambda = summary.model.lambda;
+          initial.coefficients = summary.model.coefficients;
+          const int previous = summary.iterations;
+          summary = RefineModalModel(values, tau, weights, initial, options.refinement);
+          summary.iterations += previous;
+        }
+      }
+      e->termination = summary.termination;
+      e->iterations += summary.iterations;
+      e->lambda = summary.model.lambda;
+      const int left = DropModes(&e->lambda, [&](size_t k) {
+        return PassesFilter(e->lambda[k], options, record.max_frequency_hz);
+      });
+      if (left > 0) {
+        e->warnings.push_back(fmt::format(
+            "dropped {} mode(s) that the refinement moved outside the step-5 limits", left));
+      }
+      if (e->lambda.empty()) {
+        NoModes("every refined pole left the band or the damping limits");
+      }
+      if (left == 0) return;
+    }
+  };
+  refine(&estimate);
+  SelectSignificant(record, options, &estimate, refine);
+  if (estimate.termination == "failure") {
+    throw NumericalError("Ceres", "the refinement of the poles failed");
+  }
+  if (estimate.termination == "no_convergence") {
+    estimate.warnings.push_back(fmt::format(
+        "the refinement stopped at the iteration limit ({}); the last iterate is reported",
+        options.refinement.max_iterations));
+  }
+  estimate.weights = weights;
+  return estimate;
+}
+
+// ---- prony-svd -----------------------------------------------------------------------------
+
+Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOptions& options) {
+  const Eigen::MatrixXd& values = record.decimated;
+  const double tau = record.decimated_interval_s;
+  // Steps 2-4.
+  const PronySvdSolution solution =
+      SolvePronySvd(values, tau, options.prony.order, options.prony.rank_tolerance);
+  Estimate estimate;
+  estimate.model_order = solution.order;
+  estimate.effective_rank = solution.effective_rank;
+  if (options.compute_stabilization) {
+    const int highest = options.stabilization_max_order > 0
+                            ? std::min(options.stabilization_max_order, options.prony.order)
+                            : options.prony.order;
+    // At most about 20 orders: each is an SVD of the whole record.
+    const int step = std::max(1, (highest + 19) / 20);
+    for (int p = step; p <= highest; p += step) {
+      const PronySvdSolution at_order =
+          p == solution.order ? solution
+                              : SolvePronySvd(values, tau, p, options.prony.rank_tolerance);
+      estimate.stabilization.push_back(UpperHalf(p, at_order.lambda));
+    }
+    MarkStable(&estimate.stabilization, options.hankel.stability_tolerance);
+  }
+  // Step 5: the poles inside the limits.
+  for (const auto& lambda : solution.lambda) {
+    if (lambda.imag() > 0 && PassesFilter(lambda, options, record.max_frequency_hz)) {
+      estimate.lambda.push_back(lambda);
+    }
+  }
+  if (estimate.lambda.empty()) {
+    NoModes(
+        fmt::format("none of the {} roots of eq. 3 (p = {}) is an oscillation inside the "
+                    "band and the damping limits",
+                    solution.lambda.size(), solution.order));
+  }
+  if (static_cast<int>(estimate.lambda.size()) > options.max_modes) {
+    // Keep the max_modes most significant candidates.
+    const bool with_offset = options.offset == OffsetRemoval::kFit;
+    const AmplitudeFit fit =
+        FitAmplitudes(record.centered, record.sample_interval_s, estimate.lambda, with_offset);
+    const Eigen::VectorXd significance = CalcSignificance(record.centered, record.sample_interval_s,
+                                                          estimate.lambda, with_offset, fit);
+    std::vector<double> sorted(significance.data(), significance.data() + significance.size());
+    std::nth_element(sorted.begin(), sorted.begin() + options.max_modes - 1, sorted.end(),
+                     std::greater<double>());
+    const double cut = sorted[options.max_modes - 1];
+    const int dropped =
+        DropModes(&estimate.lambda, [&](size_t k) { return significance(k) >= cut; });
+    estimate.warnings.push_back(
+        fmt::format("kept the {} most significant of {} candidate poles (max_modes)",
+                    options.max_modes, options.max_modes + dropped));
+  }
+  SelectSignificant(record, options, &estimate, [](Estimate*) {});
+  estimate.weights = Eigen::VectorXd::Ones(values.cols());
+  const AmplitudeFit fit =
+      FitAmplitudes(values, tau, estimate.lambda, options.offset == OffsetRemoval::kFit);
+  estimate.weights = fit.residual_variance.cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  return estimate;
+}
+
+}  // namespace
+
+ModalResult Identify(const Measurement& measurement, const IdentificationOptions& options,
+                     const std::string& origin) {
+  const AnalysisRecord record = PrepareRecord(measurement, options, origin);
+  ModalResult result;
+  result.channels = record.channels;
+  result.units = record.units;
+  result.sample_interval_s = record.sample_interval_s;
+  result.samples = static_cast<int>(record.values.rows());
+  result.start_time_s = record.start_time_s;
+  result.decimation = options.decimation;
+  result.method = MethodName(options.method);
+  result.significance_threshold = SignificanceThreshold(record, options);
+  if (options.compute_spectrum) {
+    result.spectrum = CalcSpectrum(record.centered, record.sample_interval_s, options.spectrum);
+    result.has_spectrum = true;
+  }
+
+  Estimate estimate = options.method == Method::kPronySvd ? EstimatePronySvd(record, options)
+                                                          : EstimateHankelNls(record, options);
+  result.model_order = estimate.model_order;
+  result.effective_rank = estimate.effective_rank;
+  result.termination = estimate.termination;
+  result.iterations = estimate.iterations;
+  result.stabilization = std::move(estimate.stabilization);
+  result.warnings = std::move(estimate.warnings);
+
+  // Amplitudes, phases, reconstruction and correlation on the full-rate record.
+  const bool with_offset = options.offset == OffsetRemoval::kFit;
+  const AmplitudeFit fit =
+      FitAmplitudes(record.centered, record.sample_interval_s, estimate.lambda, with_offset);
+  result.reconstruction = fit.reconstruction.rowwise() + record.mean.transpose();
+  result.correlation = CalcCorrelation(record.values, result.reconstruction);
+  result.noise_std = fit.residual_variance.cwiseSqrt();
+  result.offset = record.mean;
+  if (with_offset) result.offset += fit.coefficients.row(fit.coefficients.rows() - 1).transpose();
+
+  std::vector<Eigen::Matrix2d> covariance;
+  if (options.compute_uncertainty) {
+    ModalModel model;
+    model.lambda = estimate.lambda;
+    model.with_offset = with_offset;
+    model.coefficients =
+        FitAmplitudes(record.decimated, record.decimated_interval_s, estimate.lambda, with_offset)
+            .coefficients;
+    covariance =
+        CalcPoleCovariance(record.decimated, record.decimated_interval_s, estimate.weights, model);
+  }
+  const int channels = static_cast<int>(record.channels.size());
+  std::vector<Eigen::VectorXcd> shapes;
+  for (size_t k = 0; k < estimate.lambda.size(); ++k) {
+    IdentifiedMode mode;
+    mode.SetPole(estimate.lambda[k]);
+    mode.amplitude.resize(channels);
+    mode.phase_rad.resize(channels);
+    Eigen::VectorXcd shape(channels);
+    for (int c = 0; c < channels; ++c) {
+      mode.amplitude(c) = fit.Amplitude(static_cast<int>(k), c);
+      mode.phase_rad(c) = fit.Phase(static_cast<int>(k), c);
+      shape(c) = std::polar(mode.amplitude(c), mode.phase_rad(c));
+    }
+    shapes.push_back(shape);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    mode.std_decay_rate_per_s = covariance.empty() ? nan : std::sqrt(covariance[k](0, 0));
+    mode.std_frequency_hz = covariance.empty() ? nan : std::sqrt(covariance[k](1, 1)) / (2 * M_PI);
+    mode.significance = estimate.significance.at(k);
+    mode.significant = mode.significance >= result.significance_threshold;
+    result.modes.push_back(mode);
+  }
+  // Eq. 5 with the output vectors w_k = the modes' complex amplitudes per channel.
+  result.eq2_coefficients = CalcEq2Coefficients(estimate.lambda, shapes);
+
+  std::vector<size_t> order(result.modes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return result.modes[a].frequency_hz < result.modes[b].frequency_hz;
+  });
+  std::vector<IdentifiedMode> sorted;
+  for (size_t i : order) sorted.push_back(result.modes[i]);
+  result.modes = std::move(sorted);
+  return result;
+}
+
+}  // namespace mbid::identification

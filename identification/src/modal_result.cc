@@ -1,0 +1,229 @@
+#include "mbid/identification/modal_result.h"
+
+#include <cmath>
+
+namespace mbid::identification {
+namespace {
+
+constexpr char kGroup[] = "/identification";
+
+// JSON has no NaN or infinity; the contract writes null for "not available".
+nlohmann::json Number(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json PerChannel(const std::vector<std::string>& channels, const Eigen::VectorXd& v) {
+  nlohmann::json object = nlohmann::json::object();
+  for (size_t c = 0; c < channels.size() && static_cast<Eigen::Index>(c) < v.size(); ++c) {
+    object[channels[c]] = Number(v(c));
+  }
+  return object;
+}
+
+std::string Sub(const std::string& name) { return std::string(kGroup) + "/" + name; }
+
+template <typename Get>
+Eigen::VectorXd ModeVector(const ModalResult& result, Get&& get) {
+  Eigen::VectorXd v(result.modes.size());
+  for (size_t k = 0; k < result.modes.size(); ++k) v(k) = get(result.modes[k]);
+  return v;
+}
+
+std::string UnitOf(const ModalResult& result, size_t channel) {
+  return channel < result.units.size() ? result.units[channel] : "";
+}
+
+}  // namespace
+
+void IdentifiedMode::SetPole(std::complex<double> pole) {
+  lambda = pole;
+  const double omega = pole.imag();
+  const double decay = -pole.real();
+  const double magnitude = std::abs(pole);
+  frequency_hz = omega / (2 * M_PI);
+  decay_rate_per_s = decay;
+  damping_ratio = magnitude > 0 ? decay / magnitude : 0.0;
+  undamped_frequency_hz = magnitude / (2 * M_PI);
+  log_decrement = omega > 0 ? 2 * M_PI * decay / omega : std::numeric_limits<double>::infinity();
+  half_life_s = decay > 0 ? std::log(2.0) / decay : std::numeric_limits<double>::infinity();
+}
+
+nlohmann::json ModalResultToJson(const ModalResult& result) {
+  nlohmann::json json;
+  json["channels"] = result.channels;
+  json["sample_interval_s"] = result.sample_interval_s;
+  json["samples"] = result.samples;
+  json["method"] = result.method;
+  json["model_order"] = result.model_order;
+  json["effective_rank"] = result.effective_rank;
+  nlohmann::json modes = nlohmann::json::array();
+  for (const IdentifiedMode& mode : result.modes) {
+    nlohmann::json m;
+    m["frequency_hz"] = Number(mode.frequency_hz);
+    m["decay_rate_per_s"] = Number(mode.decay_rate_per_s);
+    m["damping_ratio"] = Number(mode.damping_ratio);
+    m["undamped_frequency_hz"] = Number(mode.undamped_frequency_hz);
+    m["log_decrement"] = Number(mode.log_decrement);
+    m["half_life_s"] = Number(mode.half_life_s);
+    m["amplitude"] = PerChannel(result.channels, mode.amplitude);
+    m["phase_rad"] = PerChannel(result.channels, mode.phase_rad);
+    m["std_frequency_hz"] = Number(mode.std_frequency_hz);
+    m["std_decay_rate_per_s"] = Number(mode.std_decay_rate_per_s);
+    m["significance"] = Number(mode.significance);
+    m["significant"] = mode.significant;
+    modes.push_back(m);
+  }
+  json["modes"] = modes;
+  json["correlation"] = PerChannel(result.channels, result.correlation);
+
+  json["start_time_s"] = result.start_time_s;
+  json["decimation"] = result.decimation;
+  json["significance_threshold"] = Number(result.significance_threshold);
+  json["offset"] = PerChannel(result.channels, result.offset);
+  json["noise_std"] = PerChannel(result.channels, result.noise_std);
+  json["termination"] = result.termination;
+  json["iterations"] = result.iterations;
+  if (result.has_spectrum) {
+    nlohmann::json peaks = nlohmann::json::array();
+    for (const SpectrumPeak& peak : result.spectrum.peaks) {
+      peaks.push_back({{"channel", result.channels.at(peak.channel)},
+                       {"frequency_hz", peak.frequency_hz},
+                       {"amplitude", peak.amplitude},
+                       {"prominence", peak.prominence}});
+    }
+    json["spectrum_peaks"] = peaks;
+  }
+  if (!result.stabilization.empty()) {
+    nlohmann::json orders = nlohmann::json::array();
+    for (const StabilizationOrder& order : result.stabilization) {
+      nlohmann::json frequency = nlohmann::json::array();
+      nlohmann::json decay = nlohmann::json::array();
+      for (const auto& lambda : order.lambda) {
+        frequency.push_back(Number(lambda.imag() / (2 * M_PI)));
+        decay.push_back(Number(-lambda.real()));
+      }
+      orders.push_back({{"order", order.order},
+                        {"frequency_hz", frequency},
+                        {"decay_rate_per_s", decay},
+                        {"stable", order.stable}});
+    }
+    json["stabilization"] = orders;
+  }
+  if (result.eq2_coefficients.size() > 0) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (Eigen::Index r = 0; r < result.eq2_coefficients.rows(); ++r) {
+      nlohmann::json row = nlohmann::json::array();
+      for (Eigen::Index c = 0; c < result.eq2_coefficients.cols(); ++c) {
+        row.push_back(Number(result.eq2_coefficients(r, c)));
+      }
+      rows.push_back(row);
+    }
+    json["eq2_coefficients"] = rows;
+  }
+  json["warnings"] = result.warnings;
+  return json;
+}
+
+void WriteModalResult(H5Writer& writer, const ModalResult& result) {
+  writer.WriteStringAttribute(kGroup, "method", result.method);
+  writer.WriteStrings(kGroup, "channels", result.channels);
+  writer.WriteScalar(kGroup, "sample_interval_s", result.sample_interval_s, "s");
+  writer.WriteScalar(kGroup, "samples", result.samples, "1");
+  writer.WriteScalar(kGroup, "model_order", result.model_order, "1");
+  writer.WriteScalar(kGroup, "effective_rank", result.effective_rank, "1");
+  writer.WriteScalar(kGroup, "start_time_s", result.start_time_s, "s");
+  writer.WriteScalar(kGroup, "decimation", result.decimation, "1");
+  writer.WriteScalar(kGroup, "significance_threshold", result.significance_threshold, "1");
+  writer.WriteScalar(kGroup, "iterations", result.iterations, "1");
+  writer.WriteStringAttribute(kGroup, "termination", result.termination);
+
+  const std::string modes = Sub("modes");
+  const auto write_mode_vector = [&](const char* name, const char* units, auto get) {
+    writer.WriteVector(modes, name, ModeVector(result, get), units);
+  };
+  write_mode_vector("frequency_hz", "Hz", [](const IdentifiedMode& m) { return m.frequency_hz; });
+  write_mode_vector("decay_rate_per_s", "1/s",
+                    [](const IdentifiedMode& m) { return m.decay_rate_per_s; });
+  write_mode_vector("damping_ratio", "1", [](const IdentifiedMode& m) { return m.damping_ratio; });
+  write_mode_vector("undamped_frequency_hz", "Hz",
+                    [](const IdentifiedMode& m) { return m.undamped_frequency_hz; });
+  write_mode_vector("log_decrement", "1", [](const IdentifiedMode& m) { return m.log_decrement; });
+  write_mode_vector("half_life_s", "s", [](const IdentifiedMode& m) { return m.half_life_s; });
+  write_mode_vector("std_frequency_hz", "Hz",
+                    [](const IdentifiedMode& m) { return m.std_frequency_hz; });
+  write_mode_vector("std_decay_rate_per_s", "1/s",
+                    [](const IdentifiedMode& m) { return m.std_decay_rate_per_s; });
+  write_mode_vector("significance", "1", [](const IdentifiedMode& m) { return m.significance; });
+  write_mode_vector("significant", "1",
+                    [](const IdentifiedMode& m) { return m.significant ? 1.0 : 0.0; });
+  for (size_t c = 0; c < result.channels.size(); ++c) {
+    const std::string& channel = result.channels[c];
+    writer.WriteVector(modes + "/amplitude", channel,
+                       ModeVector(result, [c](const IdentifiedMode& m) { return m.amplitude(c); }),
+                       UnitOf(result, c));
+    writer.WriteVector(modes + "/phase_rad", channel,
+                       ModeVector(result, [c](const IdentifiedMode& m) { return m.phase_rad(c); }),
+                       "rad");
+    writer.WriteScalar(Sub("correlation"), channel, result.correlation(c), "1");
+    writer.WriteScalar(Sub("offset"), channel, result.offset(c), UnitOf(result, c));
+    writer.WriteScalar(Sub("noise_std"), channel, result.noise_std(c), UnitOf(result, c));
+    writer.WriteVector(Sub("reconstruction"), channel, result.reconstruction.col(c),
+                       UnitOf(result, c));
+  }
+  writer.WriteVector(Sub("reconstruction"), "time",
+                     Eigen::VectorXd::LinSpaced(result.samples, 0.0, 1.0) * (result.samples - 1) *
+                             result.sample_interval_s +
+                         Eigen::VectorXd::Constant(result.samples, result.start_time_s),
+                     "s");
+
+  if (result.has_spectrum) {
+    const std::string spectrum = Sub("spectrum");
+    writer.WriteVector(spectrum, "frequency_hz", result.spectrum.frequency_hz, "Hz");
+    for (size_t c = 0; c < result.channels.size(); ++c) {
+      writer.WriteVector(spectrum, result.channels[c], result.spectrum.amplitude.col(c),
+                         UnitOf(result, c));
+    }
+    const auto& peaks = result.spectrum.peaks;
+    Eigen::VectorXd channel(peaks.size()), frequency(peaks.size()), amplitude(peaks.size()),
+        prominence(peaks.size());
+    for (size_t i = 0; i < peaks.size(); ++i) {
+      channel(i) = peaks[i].channel;
+      frequency(i) = peaks[i].frequency_hz;
+      amplitude(i) = peaks[i].amplitude;
+      prominence(i) = peaks[i].prominence;
+    }
+    writer.WriteVector(spectrum, "peaks_channel", channel, "1");
+    writer.WriteVector(spectrum, "peaks_frequency_hz", frequency, "Hz");
+    writer.WriteVector(spectrum, "peaks_amplitude", amplitude, "");
+    writer.WriteVector(spectrum, "peaks_prominence", prominence, "");
+  }
+
+  if (!result.stabilization.empty()) {
+    std::vector<double> order, frequency, decay, damping, stable;
+    for (const StabilizationOrder& entry : result.stabilization) {
+      for (size_t i = 0; i < entry.lambda.size(); ++i) {
+        IdentifiedMode pole;
+        pole.SetPole(entry.lambda[i]);
+        order.push_back(entry.order);
+        frequency.push_back(pole.frequency_hz);
+        decay.push_back(pole.decay_rate_per_s);
+        damping.push_back(pole.damping_ratio);
+        stable.push_back(entry.stable[i] ? 1.0 : 0.0);
+      }
+    }
+    const auto as_vector = [](const std::vector<double>& v) {
+      return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+    };
+    const std::string stabilization = Sub("stabilization");
+    writer.WriteVector(stabilization, "order", as_vector(order), "1");
+    writer.WriteVector(stabilization, "frequency_hz", as_vector(frequency), "Hz");
+    writer.WriteVector(stabilization, "decay_rate_per_s", as_vector(decay), "1/s");
+    writer.WriteVector(stabilization, "damping_ratio", as_vector(damping), "1");
+    writer.WriteVector(stabilization, "stable", as_vector(stable), "1");
+  }
+  if (result.eq2_coefficients.size() > 0) {
+    writer.WriteMatrix(kGroup, "eq2_coefficients", result.eq2_coefficients, "");
+  }
+}
+
+}  // namespace mbid::identification

@@ -1,0 +1,81 @@
+#include "mbid/identification/prony_svd.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+
+namespace mbid::identification {
+
+PronySvdSolution SolvePronySvd(const Eigen::MatrixXd& values, double sample_interval_s, int order,
+                               double rank_tolerance) {
+  const int m = static_cast<int>(values.cols());
+  const int p = order;
+  const int rows = static_cast<int>(values.rows()) - p;  // j = 0..s-p
+  const int unknowns = m * p + 1;
+
+  // Eq. 3 as X [B1 ... Bp B0]^T = -[y_(j+p)]^T, one column per channel.
+  Eigen::MatrixXd X(rows, unknowns);
+  for (int i = 1; i <= p; ++i) X.middleCols(m * (i - 1), m) = values.middleRows(p - i, rows);
+  X.col(unknowns - 1).setOnes();
+  const Eigen::MatrixXd rhs = -values.bottomRows(rows);
+
+  // Step 3: minimum-norm solution through the SVD truncated at the effective rank.
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(X, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  PronySvdSolution solution;
+  solution.order = p;
+  solution.singular_values = svd.singularValues();
+  const Eigen::VectorXd& s = solution.singular_values;
+  int k = 0;
+  while (k < s.size() && s(k) > rank_tolerance * s(0)) ++k;
+  solution.effective_rank = k;
+  const Eigen::MatrixXd theta = svd.matrixV().leftCols(k) * s.head(k).cwiseInverse().asDiagonal() *
+                                (svd.matrixU().leftCols(k).transpose() * rhs);  // unknowns x m
+  solution.B = theta.topRows(m * p).transpose();
+  solution.B0 = theta.row(unknowns - 1).transpose();
+
+  // Step 4: roots of the matrix polynomial = eigenvalues of the block companion matrix.
+  Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(m * p, m * p);
+  companion.topRows(m) = -solution.B;
+  if (p > 1) companion.bottomLeftCorner(m * (p - 1), m * (p - 1)).setIdentity();
+  Eigen::EigenSolver<Eigen::MatrixXd> eigen(companion, /*computeEigenvectors=*/true);
+  for (int i = 0; i < m * p; ++i) {
+    const std::complex<double> mu = eigen.eigenvalues()(i);
+    solution.mu.push_back(mu);
+    solution.lambda.push_back(std::log(mu) / sample_interval_s);  // eq. 4
+    // The eigenvector is [mu^(p-1) w; ...; mu w; w]: its last block is the output vector.
+    Eigen::VectorXcd w = eigen.eigenvectors().col(i).tail(m);
+    Eigen::Index largest = 0;
+    w.cwiseAbs().maxCoeff(&largest);
+    if (std::abs(w(largest)) > 0) w /= w(largest);
+    solution.w.push_back(w);
+  }
+  return solution;
+}
+
+Eigen::MatrixXd CalcEq2Coefficients(const std::vector<std::complex<double>>& lambda,
+                                    const std::vector<Eigen::VectorXcd>& w) {
+  const int n = static_cast<int>(lambda.size());
+  if (n == 0) return {};
+  const int m = static_cast<int>(w.front().size());
+  const int p = (2 * n + m - 1) / m;
+  // A Z = -W with Z = [lambda^(p-1) w; ...; w] (m p x n) and W = [lambda^p w] (m x n); the real
+  // and imaginary parts side by side give the real system A [Re Z Im Z] = -[Re W Im W].
+  Eigen::MatrixXd Z(m * p, 2 * n);
+  Eigen::MatrixXd W(m, 2 * n);
+  for (int k = 0; k < n; ++k) {
+    for (int i = 1; i <= p; ++i) {
+      const Eigen::VectorXcd block = std::pow(lambda[k], p - i) * w[k];
+      Z.block(m * (i - 1), k, m, 1) = block.real();
+      Z.block(m * (i - 1), n + k, m, 1) = block.imag();
+    }
+    const Eigen::VectorXcd top = std::pow(lambda[k], p) * w[k];
+    W.col(k) = top.real();
+    W.col(n + k) = top.imag();
+  }
+  // Transposed: Z^T A^T = -W^T, minimum norm when under-determined.
+  return Z.transpose().completeOrthogonalDecomposition().solve(-W.transpose()).transpose();
+}
+
+}  // namespace mbid::identification

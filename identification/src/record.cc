@@ -1,0 +1,181 @@
+#include "record.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "internal.h"
+#include "mbid/common/error.h"
+
+namespace mbid::identification {
+namespace {
+
+constexpr char kOptionsSource[] = "identification options";
+// Half-length of the decimation filter in output samples: the stop band of a Blackman-windowed
+// sinc of 2 * 10 q + 1 taps is below -70 dB from 0.5 / q on, so aliasing stays out of the
+// band below 0.8 of the new Nyquist frequency.
+constexpr int kFilterHalfLength = 10;
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string joined;
+  for (const auto& name : names) joined += (joined.empty() ? "" : ", ") + name;
+  return joined;
+}
+
+// Zero-phase low-pass FIR (cutoff 0.8 of the new Nyquist, Blackman window, unit DC gain) and
+// downsampling by q, in "valid" mode: output n is centred on input n q + H.
+Eigen::MatrixXd Decimate(const Eigen::MatrixXd& values, int q) {
+  if (q == 1) return values;
+  const int half = kFilterHalfLength * q;
+  const double cutoff = 0.8 * 0.5 / q;  // cycles per input sample
+  Eigen::VectorXd taps(2 * half + 1);
+  for (int i = -half; i <= half; ++i) {
+    const double x = 2 * cutoff * i;
+    const double sinc = i == 0 ? 1.0 : std::sin(M_PI * x) / (M_PI * x);
+    const double phase = M_PI * (i + half) / half;  // 0..2 pi over the filter
+    const double blackman = 0.42 - 0.5 * std::cos(phase) + 0.08 * std::cos(2 * phase);
+    taps(i + half) = sinc * blackman;
+  }
+  taps /= taps.sum();
+  const int samples = static_cast<int>(values.rows());
+  const int outputs = samples > 2 * half ? (samples - 1 - 2 * half) / q + 1 : 0;
+  Eigen::MatrixXd decimated(outputs, values.cols());
+  for (int n = 0; n < outputs; ++n) {
+    decimated.row(n) = taps.transpose() * values.middleRows(n * q, 2 * half + 1);
+  }
+  return decimated;
+}
+
+}  // namespace
+
+int RequiredSamples(const IdentificationOptions& options, int channels) {
+  if (options.method == Method::kPronySvd) {
+    // Rows j = 0..s-p of eq. 3 must at least match the m p + 1 unknowns per channel.
+    return (channels + 1) * options.prony.order + 1;
+  }
+  // The Hankel matrix needs 8 columns (4 poles plus room for the noise floor) and as many rows.
+  return 24;
+}
+
+AnalysisRecord PrepareRecord(const Measurement& measurement, const IdentificationOptions& options,
+                             const std::string& origin) {
+  if (const auto problem = FindOptionProblem(options)) {
+    throw InputError(kOptionsSource, problem->field, problem->problem, problem->expected);
+  }
+  const double tau = measurement.sample_interval_s;
+  if (!(std::isfinite(tau) && tau > 0)) {
+    throw InputError(origin, "sample_interval_s", fmt::format("{} s", tau),
+                     "a positive finite sample interval");
+  }
+  if (measurement.values.cols() != static_cast<Eigen::Index>(measurement.channels.size())) {
+    throw InputError(origin, "channels",
+                     fmt::format("{} names for {} columns", measurement.channels.size(),
+                                 measurement.values.cols()),
+                     "one name per channel");
+  }
+
+  // Channel selection.
+  std::vector<int> columns;
+  const std::vector<std::string>& wanted =
+      options.channels.empty() ? measurement.channels : options.channels;
+  AnalysisRecord record;
+  for (const std::string& name : wanted) {
+    const int column = measurement.FindChannel(name);
+    if (column < 0) {
+      throw InputError(origin, "channels", fmt::format("no channel '{}' in the record", name),
+                       "one of " + JoinNames(measurement.channels));
+    }
+    if (std::find(columns.begin(), columns.end(), column) != columns.end()) {
+      throw InputError(kOptionsSource, "channels", fmt::format("'{}' is selected twice", name),
+                       "each channel at most once");
+    }
+    columns.push_back(column);
+    record.channels.push_back(name);
+    record.units.push_back(
+        column < static_cast<int>(measurement.units.size()) ? measurement.units[column] : "");
+  }
+  if (columns.empty()) {
+    throw InputError(origin, "channels", "the record has no channels", "at least one channel");
+  }
+
+  // Time window: samples with window_start_s <= t_j <= window_end_s (half a sample of slack
+  // so that a window given on the sample grid keeps its end samples).
+  const int samples = measurement.samples();
+  const double t0 = measurement.start_time_s;
+  int first = 0;
+  while (first < samples && t0 + first * tau < options.window_start_s - 0.5 * tau) ++first;
+  int last = samples - 1;
+  while (last >= first && t0 + last * tau > options.window_end_s + 0.5 * tau) --last;
+  const int count = last - first + 1;
+  record.sample_interval_s = tau;
+  record.start_time_s = t0 + first * tau;
+  const int q = options.decimation;
+  const int required = RequiredSamples(options, static_cast<int>(columns.size()));
+  const int decimated_count =
+      count > 2 * kFilterHalfLength * q ? (count - 1 - 2 * kFilterHalfLength * q) / q + 1 : 0;
+  const int available = q == 1 ? count : decimated_count;
+  if (available < required) {
+    const std::string order =
+        options.method == Method::kPronySvd
+            ? fmt::format("order p = {} with {} channels", options.prony.order, columns.size())
+            : std::string("the Hankel matrix");
+    throw InputError(
+        origin, "samples",
+        fmt::format("{} samples in the window [{}, {}] s{}", count, options.window_start_s,
+                    options.window_end_s,
+                    q == 1 ? "" : fmt::format(", {} after decimation by {}", available, q)),
+        fmt::format("at least {} for {}", required, order));
+  }
+
+  record.values.resize(count, static_cast<Eigen::Index>(columns.size()));
+  for (size_t c = 0; c < columns.size(); ++c) {
+    record.values.col(c) = measurement.values.col(columns[c]).segment(first, count);
+  }
+  for (size_t c = 0; c < columns.size(); ++c) {
+    const auto column = record.values.col(c);
+    for (int j = 0; j < count; ++j) {
+      if (!std::isfinite(column(j))) {
+        throw InputError(
+            origin, record.channels[c],
+            fmt::format("sample {} (t = {} s) is {}", first + j, t0 + (first + j) * tau,
+                        std::isnan(column(j)) ? "NaN" : "infinite"),
+            "finite values");
+      }
+    }
+    if (column.maxCoeff() == column.minCoeff()) {
+      throw InputError(origin, record.channels[c],
+                       column(0) == 0
+                           ? std::string("every sample in the window is zero")
+                           : fmt::format("constant: every sample in the window is {}", column(0)),
+                       "a record that varies (a free decay)");
+    }
+  }
+
+  // Band against the Nyquist frequency of the record the poles are estimated on.
+  record.decimated_interval_s = tau * q;
+  const double nyquist_hz = 0.5 / record.decimated_interval_s;
+  record.max_frequency_hz = options.max_frequency_hz == 0 ? nyquist_hz : options.max_frequency_hz;
+  if (record.max_frequency_hz > nyquist_hz) {
+    throw InputError(origin, "max_frequency_hz",
+                     fmt::format("{} Hz is above the Nyquist frequency {} Hz of the record "
+                                 "(sample interval {} s, decimation {})",
+                                 options.max_frequency_hz, nyquist_hz, tau, q),
+                     fmt::format("at most {} Hz, or a higher sample rate", nyquist_hz));
+  }
+  if (options.min_frequency_hz >= nyquist_hz) {
+    throw InputError(origin, "min_frequency_hz",
+                     fmt::format("{} Hz is not below the Nyquist frequency {} Hz of the record",
+                                 options.min_frequency_hz, nyquist_hz),
+                     fmt::format("below {} Hz", nyquist_hz));
+  }
+
+  record.mean = options.offset == OffsetRemoval::kNone
+                    ? Eigen::VectorXd::Zero(record.values.cols())
+                    : Eigen::VectorXd(record.values.colwise().mean().transpose());
+  record.centered = record.values.rowwise() - record.mean.transpose();
+  record.decimated = Decimate(record.centered, q);
+  return record;
+}
+
+}  // namespace mbid::identification

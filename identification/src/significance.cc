@@ -1,0 +1,70 @@
+#include "mbid/identification/significance.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace mbid::identification {
+namespace {
+
+// log P(chi-square(2 m) > x) = -x/2 + log(sum_(i<m) (x/2)^i / i!).
+double LogChiSquareSurvival(double x, int m) {
+  double term = 1.0;
+  double sum = 1.0;
+  for (int i = 1; i < m; ++i) {
+    term *= 0.5 * x / i;
+    sum += term;
+  }
+  return -0.5 * x + std::log(sum);
+}
+
+}  // namespace
+
+Eigen::VectorXd CalcSignificance(const Eigen::MatrixXd& values, double sample_interval_s,
+                                 const std::vector<std::complex<double>>& lambda, bool with_offset,
+                                 const AmplitudeFit& fit) {
+  const Eigen::MatrixXd basis = CalcDampedSinusoidBasis(
+      lambda, sample_interval_s, static_cast<int>(values.rows()), with_offset);
+  // (Phi^T Phi)^-1 through the Jacobi-scaled Gram matrix; pseudo-inverse for exact collinearity.
+  const Eigen::MatrixXd gram = basis.transpose() * basis;
+  const Eigen::VectorXd scale =
+      gram.diagonal().cwiseMax(std::numeric_limits<double>::min()).cwiseSqrt().cwiseInverse();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scale.asDiagonal() * gram *
+                                                       scale.asDiagonal());
+  const Eigen::VectorXd& d = eigen.eigenvalues();
+  const Eigen::VectorXd inverse_d =
+      (d.array() > 1e-14 * d.maxCoeff()).select(d.cwiseInverse(), 0.0);
+  const Eigen::MatrixXd inverse = scale.asDiagonal() * eigen.eigenvectors() *
+                                  inverse_d.asDiagonal() * eigen.eigenvectors().transpose() *
+                                  scale.asDiagonal();
+  Eigen::VectorXd significance = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(lambda.size()));
+  for (size_t k = 0; k < lambda.size(); ++k) {
+    const Eigen::Matrix2d block = inverse.block<2, 2>(2 * k, 2 * k);
+    const Eigen::Matrix2d information = block.completeOrthogonalDecomposition().pseudoInverse();
+    for (Eigen::Index c = 0; c < values.cols(); ++c) {
+      // Round-off floor: a noiseless record is very significant, not a division by zero.
+      const double floor =
+          1e-30 * values.col(c).squaredNorm() / values.rows() + std::numeric_limits<double>::min();
+      const double variance = std::max(fit.residual_variance(c), floor);
+      const Eigen::Vector2d beta = fit.coefficients.block(2 * k, c, 2, 1);
+      significance(k) += beta.dot(information * beta) / variance;
+    }
+  }
+  return significance;
+}
+
+double CalcSignificanceThreshold(int samples, int channels, double false_alarm) {
+  const double target = std::log(false_alarm / (10.0 * std::max(samples, 1)));
+  // The survival function decreases in x: bisection.
+  double low = 0;
+  double high = 1e4;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (low + high);
+    (LogChiSquareSurvival(mid, channels) > target ? low : high) = mid;
+  }
+  return 0.5 * (low + high);
+}
+
+}  // namespace mbid::identification

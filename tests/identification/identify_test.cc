@@ -1,0 +1,390 @@
+#include "mbid/identification/identify.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "mbid/common/error.h"
+#include "signals.h"
+
+namespace mbid::identification {
+namespace {
+
+using testing::CramerRaoBound;
+using testing::MakeRecord;
+using testing::PaperSignal;
+using testing::SignalSpec;
+using testing::Synthesize;
+
+// Expects the modes of `result` to be those of `spec`, one to one in ascending frequency.
+void ExpectModes(const ModalResult& result, const SignalSpec& spec, double pole_tolerance,
+                 double amplitude_tolerance, double phase_tolerance) {
+  ASSERT_EQ(result.modes.size(), spec.modes.size());
+  for (size_t k = 0; k < spec.modes.size(); ++k) {
+    const IdentifiedMode& mode = result.modes[k];
+    const auto& truth = spec.modes[k];
+    const std::complex<double> lambda(-truth.decay_per_s, 2 * M_PI * truth.frequency_hz);
+    EXPECT_LE(std::abs(mode.lambda - lambda) / std::abs(lambda), pole_tolerance) << "mode " << k;
+    for (size_t c = 0; c < spec.channels.size(); ++c) {
+      EXPECT_NEAR(mode.amplitude(c), truth.amplitude[c], amplitude_tolerance * truth.amplitude[c])
+          << "mode " << k << " channel " << c;
+      EXPECT_NEAR(std::remainder(mode.phase_rad(c) - truth.phase_rad[c], 2 * M_PI), 0.0,
+                  phase_tolerance)
+          << "mode " << k << " channel " << c;
+    }
+  }
+}
+
+// Three modes, two channels, a constant offset in one: the noiseless record is exactly the
+// model, so the poles are exact up to round-off (1e-8 relative, issue 4) and amplitudes and
+// phases to 1e-6 (issue 4).
+SignalSpec ThreeModes() {
+  SignalSpec spec;
+  spec.channels = {"a", "b"};
+  spec.sample_interval_s = 0.005;  // 200 Hz: well above the highest mode
+  spec.samples = 1500;             // 7.5 s: the slowest mode decays to e^-1.5
+  spec.modes = {{0.8, 0.2, {1.0, 0.3}, {0.4, -2.0}},
+                {2.5, 1.5, {0.2, 0.5}, {-1.0, 1.2}},
+                {7.3, 4.0, {0.05, 0.4}, {2.9, 0.1}}};
+  spec.offset = {0.1, -0.02};
+  return spec;
+}
+
+TEST(IdentifyTest, NoiselessDampedSinusoidsAreExact) {
+  const SignalSpec spec = ThreeModes();
+  IdentificationOptions options;
+  for (Method method : {Method::kHankelNls}) {
+    options.method = method;
+    const ModalResult result = Identify(MakeRecord(spec, Synthesize(spec)), options);
+    ExpectModes(result, spec, 1e-8, 1e-6, 1e-6);
+    for (int c = 0; c < 2; ++c) {                           // 2 channels
+      EXPECT_NEAR(result.offset(c), spec.offset[c], 1e-9);  // round-off of the linear fit
+      EXPECT_GT(result.correlation(c), 1 - 1e-12);          // reconstruction is the record
+    }
+  }
+}
+
+TEST(IdentifyTest, NoiselessPaperMethodFindsThePoles) {
+  // The paper's method on the same record: with the effective rank at the signal order (7 =
+  // 2 x 3 modes + the constant) the minimum-norm prediction puts the extra roots inside the unit
+  // circle and the signal roots exactly on the poles. Truncating at a rank is less exact than
+  // the refinement: 1e-6 (measured ~1e-9).
+  const SignalSpec spec = ThreeModes();
+  IdentificationOptions options;
+  options.method = Method::kPronySvd;
+  options.prony.order = 10;             // p: 20 roots for 3 modes and a constant
+  options.prony.rank_tolerance = 1e-8;  // round-off of the noiseless regression matrix is ~1e-13
+  const ModalResult result = Identify(MakeRecord(spec, Synthesize(spec)), options);
+  EXPECT_EQ(result.effective_rank, 7);  // 2 x 3 modes + constant
+  ExpectModes(result, spec, 1e-6, 1e-5, 1e-5);
+}
+
+// Ten seeded records of the paper's four modes (Table 1 amplitudes, 100 Hz, 10 s) at 30 dB SNR
+// per channel. Issue 4 asks for every frequency within 1 % and every decay within 10 %. The
+// Cramer-Rao bound of mode 1's frequency at 30 dB is itself 1.07 % (computed below), so for
+// that one mode "within 1 %" holds for the mean of the ten estimates (standard deviation
+// 0.34 %), and each single estimate is held to 4 sigma of the bound.
+TEST(IdentifyTest, PaperTableOneAt30Db) {
+  const SignalSpec spec = PaperSignal();
+  const Eigen::MatrixXd clean = Synthesize(spec);
+  const Eigen::VectorXd noise_std = testing::NoiseStd(clean, 30);
+  const auto bound = CramerRaoBound(spec, noise_std);
+  EXPECT_NEAR(bound[0].second / spec.modes[0].frequency_hz, 0.0107, 0.0005);  // as stated above
+  std::mt19937_64 rng(4);  // seeded: deterministic
+  constexpr int kRecords = 10;
+  std::vector<double> mean_frequency(4, 0.0);
+  for (int record = 0; record < kRecords; ++record) {
+    const Eigen::MatrixXd noisy = testing::AddNoise(clean, noise_std, &rng);
+    const ModalResult result = Identify(MakeRecord(spec, noisy), IdentificationOptions());
+    ASSERT_EQ(result.modes.size(), 4u) << "four modes, no spurious one, record " << record;
+    for (size_t k = 0; k < 4; ++k) {
+      const auto& truth = spec.modes[k];
+      const IdentifiedMode& mode = result.modes[k];
+      EXPECT_NEAR(mode.decay_rate_per_s, truth.decay_per_s, 0.10 * truth.decay_per_s);
+      EXPECT_NEAR(mode.frequency_hz, truth.frequency_hz,
+                  k == 0 ? 4 * bound[0].second : 0.01 * truth.frequency_hz);
+      EXPECT_TRUE(mode.significant);
+      mean_frequency[k] += mode.frequency_hz / kRecords;
+    }
+    // The paper reports K >= 0.88 on its real record; a noise level of 30 dB leaves ~0.999.
+    for (int c = 0; c < 2; ++c) EXPECT_GT(result.correlation(c), 0.99);
+  }
+  for (size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(mean_frequency[k], spec.modes[k].frequency_hz, 0.01 * spec.modes[k].frequency_hz);
+  }
+}
+
+// Expects each identified pole within `sigmas` Cramer-Rao standard deviations of the truth.
+void ExpectWithinBound(const ModalResult& result, const SignalSpec& spec,
+                       const Eigen::VectorXd& noise_std, double sigmas) {
+  const auto bound = CramerRaoBound(spec, noise_std);
+  ASSERT_EQ(result.modes.size(), spec.modes.size());
+  for (size_t k = 0; k < spec.modes.size(); ++k) {
+    EXPECT_NEAR(result.modes[k].frequency_hz, spec.modes[k].frequency_hz, sigmas * bound[k].second)
+        << "mode " << k;
+    EXPECT_NEAR(result.modes[k].decay_rate_per_s, spec.modes[k].decay_per_s,
+                sigmas * bound[k].first)
+        << "mode " << k;
+  }
+}
+
+// Two modes 1 % apart in frequency (Fourier resolution of the 10 s record is 0.1 Hz, five times
+// their 0.02 Hz spacing), seen with different mixing in two channels, at 40 dB.
+TEST(IdentifyTest, CloselySpacedModes) {
+  SignalSpec spec;
+  spec.channels = {"a", "b"};
+  spec.sample_interval_s = 0.01;
+  spec.samples = 1000;
+  spec.modes = {{2.00, 0.30, {1.0, 0.5}, {0.2, 1.0}}, {2.02, 0.30, {0.8, 1.0}, {-1.3, 2.4}}};
+  const Eigen::MatrixXd clean = Synthesize(spec);
+  const Eigen::VectorXd noise_std = testing::NoiseStd(clean, 40);
+  std::mt19937_64 rng(11);  // seeded: deterministic
+  const ModalResult result = Identify(MakeRecord(spec, testing::AddNoise(clean, noise_std, &rng)),
+                                      IdentificationOptions());
+  // 4 sigma: a single record; the probability of a larger deviation is 6e-5.
+  ExpectWithinBound(result, spec, noise_std, 4);
+}
+
+// A mode with damping ratio 0.8 (decays by e^-1 in 0.1 s, less than a period) beside a lightly
+// damped one, at 40 dB; both must be found and kept (issue 4).
+TEST(IdentifyTest, HeavilyDampedModeIsKept) {
+  const double zeta = 0.8;
+  const double omega_n = 2 * M_PI * 2.0;  // 2 Hz undamped
+  SignalSpec spec;
+  spec.channels = {"a"};
+  spec.sample_interval_s = 0.005;  // 200 Hz: 20 samples per e-fold of the heavy mode
+  spec.samples = 1000;             // 5 s
+  spec.modes = {{omega_n * std::sqrt(1 - zeta * zeta) / (2 * M_PI), zeta * omega_n, {1.0}, {0.5}},
+                {3.0, 0.5, {0.3}, {-1.0}}};
+  const Eigen::MatrixXd clean = Synthesize(spec);
+  const Eigen::VectorXd noise_std = testing::NoiseStd(clean, 40);
+  std::mt19937_64 rng(5);  // seeded: deterministic
+  const ModalResult result = Identify(MakeRecord(spec, testing::AddNoise(clean, noise_std, &rng)),
+                                      IdentificationOptions());
+  ExpectWithinBound(result, spec, noise_std, 4);  // 4 sigma as above
+  ASSERT_EQ(result.modes.size(), 2u);
+  EXPECT_NEAR(result.modes[0].damping_ratio, zeta, 0.02);  // 4 sigma of the bound is ~0.01
+}
+
+// ---- options --------------------------------------------------------------------------
+
+TEST(IdentifyTest, TimeWindowAndChannelSelection) {
+  SignalSpec spec = ThreeModes();
+  Measurement record = MakeRecord(spec, Synthesize(spec));
+  record.start_time_s = 2.0;  // the window is in the record's own time
+  IdentificationOptions options;
+  options.channels = {"b"};
+  options.window_start_s = 3.0;  // skips 1 s = 200 samples
+  options.window_end_s = 8.0;    // 5 s after the start; the record ends at 9.495 s
+  const ModalResult result = Identify(record, options);
+  ASSERT_EQ(result.channels, std::vector<std::string>{"b"});
+  EXPECT_EQ(result.samples, 1001);  // 5 s at 200 Hz, both ends included
+  EXPECT_DOUBLE_EQ(result.start_time_s, 3.0);
+  ASSERT_EQ(result.modes.size(), 3u);
+  // Amplitudes and phases refer to the window's first sample, 1 s into the signal: each mode's
+  // amplitude has decayed by exp(-decay * 1 s) and its phase advanced by omega * 1 s.
+  for (size_t k = 0; k < 3; ++k) {
+    const auto& truth = spec.modes[k];
+    const double t = 1.0;
+    EXPECT_NEAR(result.modes[k].amplitude(0), truth.amplitude[1] * std::exp(-truth.decay_per_s * t),
+                1e-6 * truth.amplitude[1]);  // noiseless: round-off only
+    EXPECT_NEAR(std::remainder(result.modes[k].phase_rad(0) - truth.phase_rad[1] -
+                                   2 * M_PI * truth.frequency_hz * t,
+                               2 * M_PI),
+                0.0, 1e-6);
+  }
+}
+
+TEST(IdentifyTest, OffsetRemovalOptions) {
+  const SignalSpec spec = ThreeModes();  // offsets 0.1 and -0.02
+  const Measurement record = MakeRecord(spec, Synthesize(spec));
+  IdentificationOptions options;
+  options.offset = OffsetRemoval::kFit;  // estimated with the modes: exact
+  EXPECT_NEAR(Identify(record, options).offset(0), 0.1, 1e-9);
+  // kMean subtracts the window mean, which also contains the modes' mean: the record is then
+  // no longer a sum of decaying modes, so the poles are only approximate and the reported
+  // offset is the mean itself.
+  options.offset = OffsetRemoval::kMean;
+  const ModalResult mean = Identify(record, options);
+  EXPECT_DOUBLE_EQ(mean.offset(0), record.values.col(0).mean());
+  // kNone: the constant is an unmodelled component; it cannot be a mode (a real pole at 0 Hz).
+  options.offset = OffsetRemoval::kNone;
+  const ModalResult none = Identify(record, options);
+  EXPECT_EQ(none.offset(0), 0.0);
+  for (const IdentifiedMode& mode : none.modes) EXPECT_GT(mode.frequency_hz, 0.1);
+}
+
+TEST(IdentifyTest, DecimationKeepsThePoles) {
+  // The paper's signal sampled at 400 Hz and decimated by 4 to 100 Hz: the filter maps each
+  // mode z^j to H(z) z^j, so poles stay exact on noiseless data; amplitudes come from the
+  // full-rate record.
+  SignalSpec spec = PaperSignal();
+  spec.sample_interval_s = 0.0025;
+  spec.samples = 4000;
+  IdentificationOptions options;
+  options.decimation = 4;
+  const ModalResult result = Identify(MakeRecord(spec, Synthesize(spec)), options);
+  EXPECT_EQ(result.samples, 4000);
+  EXPECT_EQ(result.decimation, 4);
+  ExpectModes(result, spec, 1e-7, 1e-5, 1e-5);  // measured ~1e-10; filter round-off
+}
+
+TEST(IdentifyTest, StabilizationDataMarksTheTruePolesStable) {
+  const SignalSpec spec = ThreeModes();
+  const ModalResult result = Identify(MakeRecord(spec, Synthesize(spec)), IdentificationOptions());
+  ASSERT_FALSE(result.stabilization.empty());
+  // At the signal order (7: three pairs and the constant) every true pole is present and
+  // stable (it reappears at order 9).
+  const auto at_order = std::find_if(result.stabilization.begin(), result.stabilization.end(),
+                                     [](const StabilizationOrder& o) { return o.order == 7; });
+  ASSERT_NE(at_order, result.stabilization.end());
+  for (const auto& truth : spec.modes) {
+    const std::complex<double> lambda(-truth.decay_per_s, 2 * M_PI * truth.frequency_hz);
+    bool found = false;
+    for (size_t i = 0; i < at_order->lambda.size(); ++i) {
+      if (std::abs(at_order->lambda[i] - lambda) < 1e-6 * std::abs(lambda)) {
+        found = true;
+        EXPECT_TRUE(at_order->stable[i]);
+      }
+    }
+    EXPECT_TRUE(found) << truth.frequency_hz << " Hz";
+  }
+  EXPECT_EQ(result.effective_rank, 7);
+}
+
+TEST(IdentifyTest, InsignificantModesAreFlaggedWhenKept) {
+  // A third mode 1e-5 of the others' amplitude, below the noise: with drop_insignificant off it
+  // may be kept, but only flagged.
+  SignalSpec spec = ThreeModes();
+  spec.modes[2].amplitude = {1e-6, 1e-6};
+  const Eigen::MatrixXd clean = Synthesize(spec);
+  std::mt19937_64 rng(3);  // seeded: deterministic
+  const Eigen::MatrixXd noisy = testing::AddNoise(clean, Eigen::Vector2d(1e-3, 1e-3), &rng);
+  IdentificationOptions options;
+  options.drop_insignificant = false;
+  options.hankel.noise_floor_factor = 1.0;  // let noise into the candidates on purpose
+  const ModalResult result = Identify(MakeRecord(spec, noisy), options);
+  int flagged = 0;
+  for (const IdentifiedMode& mode : result.modes) {
+    flagged += mode.significant ? 0 : 1;
+    EXPECT_EQ(mode.significant, mode.significance >= result.significance_threshold);
+    if (std::abs(mode.frequency_hz - 0.8) > 0.05 && std::abs(mode.frequency_hz - 2.5) > 0.05) {
+      EXPECT_FALSE(mode.significant) << mode.frequency_hz << " Hz";
+    }
+  }
+  EXPECT_GT(flagged, 0);  // this seed lets noise modes through: the check above is not vacuous
+}
+
+// ---- bad input ------------------------------------------------------------------------
+
+template <typename Error>
+Error Catch(const Measurement& record, const IdentificationOptions& options) {
+  try {
+    Identify(record, options, "record.h5");
+  } catch (const Error& e) {
+    return e;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "another exception: " << e.what();
+    throw;
+  }
+  ADD_FAILURE() << "nothing thrown";
+  throw std::logic_error("nothing thrown");
+}
+
+TEST(IdentifyTest, NonFiniteSampleNamesChannelAndSample) {
+  const SignalSpec spec = ThreeModes();
+  Measurement record = MakeRecord(spec, Synthesize(spec));
+  record.values(17, 1) = std::numeric_limits<double>::quiet_NaN();
+  const InputError nan = Catch<InputError>(record, IdentificationOptions());
+  EXPECT_EQ(nan.source(), "record.h5");
+  EXPECT_EQ(nan.field(), "b");
+  EXPECT_NE(nan.problem().find("sample 17"), std::string::npos) << nan.what();
+  EXPECT_NE(nan.problem().find("NaN"), std::string::npos) << nan.what();
+  record.values(17, 1) = std::numeric_limits<double>::infinity();
+  EXPECT_NE(Catch<InputError>(record, IdentificationOptions()).problem().find("infinite"),
+            std::string::npos);
+}
+
+TEST(IdentifyTest, ConstantOrZeroChannelIsAnInputError) {
+  const SignalSpec spec = ThreeModes();
+  Measurement record = MakeRecord(spec, Synthesize(spec));
+  record.values.col(0).setConstant(0.25);
+  const InputError constant = Catch<InputError>(record, IdentificationOptions());
+  EXPECT_EQ(constant.field(), "a");
+  EXPECT_NE(constant.problem().find("constant"), std::string::npos) << constant.what();
+  record.values.col(0).setZero();
+  const InputError zero = Catch<InputError>(record, IdentificationOptions());
+  EXPECT_NE(zero.problem().find("zero"), std::string::npos) << zero.what();
+}
+
+TEST(IdentifyTest, TooFewSamplesForTheOrder) {
+  SignalSpec spec = ThreeModes();
+  spec.samples = 100;
+  IdentificationOptions options;
+  options.method = Method::kPronySvd;  // p = 40, 2 channels: (2 + 1) 40 + 1 = 121 samples needed
+  const InputError error = Catch<InputError>(MakeRecord(spec, Synthesize(spec)), options);
+  EXPECT_EQ(error.field(), "samples");
+  EXPECT_NE(error.expected().find("at least 121"), std::string::npos) << error.what();
+  // The Hankel matrix needs 24; a window of 10 samples leaves too few.
+  options.method = Method::kHankelNls;
+  options.window_end_s = 0.045;  // 10 samples at 200 Hz
+  EXPECT_EQ(Catch<InputError>(MakeRecord(spec, Synthesize(spec)), options).field(), "samples");
+}
+
+TEST(IdentifyTest, BandAboveNyquistIsAnInputError) {
+  const SignalSpec spec = ThreeModes();  // 200 Hz: Nyquist 100 Hz
+  IdentificationOptions options;
+  options.max_frequency_hz = 120;
+  const InputError error = Catch<InputError>(MakeRecord(spec, Synthesize(spec)), options);
+  EXPECT_EQ(error.field(), "max_frequency_hz");
+  EXPECT_NE(error.problem().find("Nyquist"), std::string::npos) << error.what();
+  // Decimation by 4 lowers the Nyquist frequency to 25 Hz.
+  options.max_frequency_hz = 30;
+  options.decimation = 4;
+  EXPECT_EQ(Catch<InputError>(MakeRecord(spec, Synthesize(spec)), options).field(),
+            "max_frequency_hz");
+}
+
+TEST(IdentifyTest, UnknownChannelAndBadOptions) {
+  const SignalSpec spec = ThreeModes();
+  const Measurement record = MakeRecord(spec, Synthesize(spec));
+  IdentificationOptions options;
+  options.channels = {"psi"};
+  const InputError channel = Catch<InputError>(record, options);
+  EXPECT_EQ(channel.field(), "channels");
+  EXPECT_NE(channel.expected().find("a, b"), std::string::npos) << channel.what();
+
+  options = IdentificationOptions();
+  options.max_damping_ratio = 1.5;
+  std::string message;
+  EXPECT_FALSE(options.IsValid(&message));
+  EXPECT_NE(message.find("max_damping_ratio"), std::string::npos) << message;
+  const InputError invalid = Catch<InputError>(record, options);
+  EXPECT_EQ(invalid.source(), "identification options");
+  EXPECT_EQ(invalid.field(), "max_damping_ratio");
+  EXPECT_TRUE(IdentificationOptions().IsValid());
+}
+
+TEST(IdentifyTest, PureNoiseFindsNoModes) {
+  SignalSpec spec = PaperSignal();
+  std::mt19937_64 rng(9);  // seeded: deterministic
+  for (Method method : {Method::kHankelNls, Method::kPronySvd}) {
+    IdentificationOptions options;
+    options.method = method;
+    for (int record = 0; record < 5; ++record) {  // a few draws, each must fail the same way
+      const Eigen::MatrixXd noise =
+          testing::AddNoise(Eigen::MatrixXd::Zero(spec.samples, 2), Eigen::Vector2d(1, 2), &rng);
+      const NumericalError error = Catch<NumericalError>(MakeRecord(spec, noise), options);
+      EXPECT_EQ(error.stage(), "identification");
+      EXPECT_EQ(error.reason().rfind("no modes found: ", 0), 0u) << error.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mbid::identification
