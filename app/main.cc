@@ -8,6 +8,7 @@
 #include "mbid/app/scenario.h"
 #include "mbid/app/version.h"
 #include "mbid/common/error.h"
+#include "mbid/identification/options.h"
 
 namespace {
 
@@ -42,6 +43,41 @@ int Main(int argc, char** argv) {
       ->default_str("scenarios/reference-crane.yaml");
   run->add_option("-o,--output", output_dir, "Results folder (default results/<scenario name>)");
 
+  std::string data_path;
+  mbid::identification::IdentificationOptions identify_options;
+  std::string identify_method = "hankel-nls";
+  std::string identify_offset = "fit";
+  CLI::App* identify = app.add_subcommand(
+      "identify", "Identify the modes of a free-decay record (HDF5 or CSV measurement file)");
+  identify->add_option("DATA", data_path, "Measurement file (.h5 or .csv)")->required();
+  identify->add_option("-o,--output", output_path, "Write /measurement and /identification (.h5)");
+  identify->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
+  identify
+      ->add_option("--method", identify_method, "hankel-nls (default) or prony-svd (the paper's)")
+      ->check(CLI::IsMember({"hankel-nls", "prony-svd"}));
+  identify->add_option("--order", identify_options.prony.order, "prony-svd: order p of eq. 3")
+      ->capture_default_str();
+  identify->add_option("--channels", identify_options.channels, "Channels to analyse (default all)")
+      ->delimiter(',');
+  identify->add_option("--window-start-s", identify_options.window_start_s,
+                       "Analyse from this time, s");
+  identify->add_option("--window-end-s", identify_options.window_end_s,
+                       "Analyse up to this time, s");
+  identify->add_option("--offset", identify_offset, "Constant offset: none, mean or fit (default)")
+      ->check(CLI::IsMember({"none", "mean", "fit"}));
+  identify->add_option("--decimate", identify_options.decimation, "Decimation factor for the poles")
+      ->capture_default_str();
+  identify->add_option("--min-frequency-hz", identify_options.min_frequency_hz,
+                       "Step 5: lowest frequency, Hz");
+  identify->add_option("--max-frequency-hz", identify_options.max_frequency_hz,
+                       "Step 5: highest frequency, Hz (0 = Nyquist)");
+  identify
+      ->add_option("--max-damping-ratio", identify_options.max_damping_ratio,
+                   "Step 5: largest damping ratio")
+      ->capture_default_str();
+  identify->add_option("--max-modes", identify_options.max_modes, "At most this many modes")
+      ->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -52,6 +88,14 @@ int Main(int argc, char** argv) {
   if (run->parsed()) {
     if (scenario_path.empty()) scenario_path = mbid::app::DefaultScenarioPath();
     return mbid::app::RunValidationCycle(scenario_path, output_dir, common);
+  }
+  if (identify->parsed()) {
+    mbid::identification::ParseMethod(identify_method, &identify_options.method);
+    identify_options.offset = identify_offset == "none" ? mbid::identification::OffsetRemoval::kNone
+                              : identify_offset == "mean"
+                                  ? mbid::identification::OffsetRemoval::kMean
+                                  : mbid::identification::OffsetRemoval::kFit;
+    return mbid::app::RunIdentifyCommand(data_path, identify_options, output_path, common);
   }
   if (modes->parsed()) return mbid::app::RunModesCommand(scenario_path, common);
   if (simulate->parsed()) {

@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "mbid/identification/options.h"
+
 namespace mbid::app {
 
 // Options every command shares.
@@ -16,5 +18,10 @@ int RunModesCommand(const std::string& scenario_path, const CommonOptions& commo
 // `mbid simulate SCENARIO -o FILE.h5 [--json FILE]`: a synthetic measurement from the model.
 int RunSimulateCommand(const std::string& scenario_path, const std::string& output_path,
                        const CommonOptions& common);
+
+// `mbid identify DATA [options] [-o FILE.h5] [--json FILE]`: the modes of a free-decay record.
+int RunIdentifyCommand(const std::string& data_path,
+                       const identification::IdentificationOptions& options,
+                       const std::string& output_path, const CommonOptions& common);
 
 }  // namespace mbid::app

@@ -1,0 +1,69 @@
+#include <fmt/format.h>
+
+#include <iostream>
+
+#include "mbid/app/commands.h"
+#include "mbid/common/error.h"
+#include "mbid/common/hdf5_io.h"
+#include "mbid/common/json_io.h"
+#include "mbid/identification/identify.h"
+
+namespace mbid::app {
+
+int RunIdentifyCommand(const std::string& data_path,
+                       const identification::IdentificationOptions& options,
+                       const std::string& output_path, const CommonOptions& common) {
+  std::string why;
+  if (!options.IsValid(&why)) {
+    throw InputError("command line", "identification options", why, "see mbid identify --help");
+  }
+  const Measurement measurement = ReadMeasurement(data_path);
+  if (!common.quiet) {
+    std::cerr << fmt::format("mbid: identifying {} ({} samples x {} channels, {} Hz, {})\n",
+                             data_path, measurement.samples(), measurement.channel_count(),
+                             1.0 / measurement.sample_interval_s,
+                             identification::MethodName(options.method));
+  }
+  const identification::ModalResult result =
+      identification::Identify(measurement, options, data_path);
+
+  std::unique_ptr<H5Writer> file;
+  if (!output_path.empty()) {
+    file = std::make_unique<H5Writer>(output_path);
+    file->WriteMeasurement(measurement);
+    const std::string scenario =
+        data_path.size() > 3 && data_path.substr(data_path.size() - 3) == ".h5"
+            ? ReadScenarioYaml(data_path)
+            : std::string();
+    if (!scenario.empty()) file->WriteScenarioYaml(scenario);
+    identification::WriteModalResult(*file, result);
+  }
+  if (!common.json_path.empty())
+    WriteJson(identification::ModalResultToJson(result), common.json_path);
+  if (file) file->Commit();  // only when everything else succeeded
+
+  for (const std::string& warning : result.warnings) {
+    if (!common.quiet) std::cerr << "mbid: warning: " << warning << "\n";
+  }
+  if (common.json_path != "-") {
+    std::cout << fmt::format("{} modes ({}, model order {}, effective rank {})\n",
+                             result.modes.size(), result.method, result.model_order,
+                             result.effective_rank);
+    std::cout << fmt::format("{:>4} {:>13} {:>12} {:>16} {:>12} {:>13}\n", "mode", "frequency_hz",
+                             "std_hz", "decay_rate_per_s", "std_per_s", "damping_ratio");
+    for (size_t k = 0; k < result.modes.size(); ++k) {
+      const identification::IdentifiedMode& mode = result.modes[k];
+      std::cout << fmt::format("{:>4} {:>13.6f} {:>12.2e} {:>16.6f} {:>12.2e} {:>13.6f}{}\n", k + 1,
+                               mode.frequency_hz, mode.std_frequency_hz, mode.decay_rate_per_s,
+                               mode.std_decay_rate_per_s, mode.damping_ratio,
+                               mode.significant ? "" : "  (not significant)");
+    }
+    for (size_t c = 0; c < result.channels.size(); ++c) {
+      std::cout << fmt::format("correlation K({}) = {:.4f}\n", result.channels[c],
+                               result.correlation[static_cast<Eigen::Index>(c)]);
+    }
+  }
+  return 0;
+}
+
+}  // namespace mbid::app
