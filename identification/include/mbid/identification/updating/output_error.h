@@ -1,0 +1,192 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mbid/common/error.h"
+#include "mbid/common/measurement.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/excitation.h"
+#include "mbid/simulation/integrator_options.h"
+
+namespace mbid::updating {
+
+// Route 2 of model updating: time-domain output error. Ceres minimizes
+//   cost = 1/2 sum_tests sum_j sum_c ((y_c(t_j; p) - y_meas_c(t_j)) / sigma_c)^2
+// over the selected parameters p (shared joint parameters c_<joint>, d_<joint>; optionally
+// nuisance parameters of each test), where y(t; p) is the model simulated for the test's
+// excitation. The Jacobian comes from CVODES forward sensitivities (default) or from central
+// differences of whole simulations.
+
+// A parameter to tune: a model parameter ("c_alpha", "d_theta", ...).
+struct ParameterSetting {
+  std::string name;
+  // NaN: the model's current value.
+  double initial = std::numeric_limits<double>::quiet_NaN();
+  // NaN: initial / 100 and initial * 100 (within the model's own range).
+  double lower = std::numeric_limits<double>::quiet_NaN();
+  double upper = std::numeric_limits<double>::quiet_NaN();
+  // Ceres works on log(p): positive parameters spanning decades get steps relative to their
+  // size, and the reported standard deviation of log(p) is the relative one.
+  bool log_scale = true;
+};
+
+// One test: a record and the excitation that produced it. Its first sample is at
+// record.start_time_s, a whole number of sample intervals after the excitation's t = 0.
+struct TestRecord {
+  std::string name;  // e.g. the file name; names nuisance parameters "<name>:payload_mass_kg"
+  Measurement record;
+  simulation::Excitation excitation;
+  // Noise standard deviation per channel (channel units), e.g. the identification's residual.
+  // Channels without a value get one estimated from the residual of a first fit.
+  std::map<std::string, double> noise_std;
+  // Nuisance parameters of this test, fitted with the shared ones: the payload mass of a load
+  // drop ("<name>:payload_mass_kg", kg, log scale), the initial deflections of an
+  // initial_deflection test ("<name>:deflection_<coordinate>", rad, linear scale).
+  bool fit_payload_mass = false;
+  bool fit_initial_deflection = false;
+};
+
+struct UpdateOptions {
+  enum class Jacobian { kSensitivities, kNumeric };
+
+  // The parameters to tune; empty: every parameter of the model.
+  std::vector<ParameterSetting> parameters;
+  Jacobian jacobian = Jacobian::kSensitivities;
+  // The simulations of the fit (the records' own rate and length). Outputs interpolated from
+  // CVODES' history by default: stopping at every sample would double the steps, and the tests'
+  // inputs depend on time alone.
+  simulation::IntegratorOptions integrator = [] {
+    simulation::IntegratorOptions o;
+    o.interpolate_outputs = true;
+    return o;
+  }();
+  simulation::SensitivityOptions sensitivity;
+  // kNumeric: central differences with this step in Ceres' coordinates (log p: relative).
+  double numeric_step = 1e-4;
+  int max_iterations = 50;
+  // Ceres: relative decrease of the cost. With residuals in units of their noise the cost is
+  // about half the sample count, so 1e-6 stops when a step changes it by ~1e-3: statistically
+  // nothing (a parameter moving by a few percent of its std). Noiseless records reach the
+  // integration error's floor first.
+  double function_tolerance = 1e-6;
+  double gradient_tolerance = 1e-10;
+  // Relative step (|dx| <= tol (|x| + tol), x in log p): 1e-8 stops before the steps drown in
+  // the integration error (~1e-9 relative) yet far below any parameter's uncertainty.
+  double parameter_tolerance = 1e-8;
+  // Noise estimated from a first fit's residual is refined by a second fit with those weights.
+  bool refit_after_noise_estimate = true;
+  // A parameter is undetermined when its relative standard deviation (log-scale parameters;
+  // std / max(|value|, 1e-6) otherwise) exceeds this, or it lies in the numerical null space of
+  // the weighted Jacobian (singular values below rank_tolerance times the largest; 1e-7 is
+  // Ceres' own limit for inverting J^T J, a reciprocal condition number of 1e-14).
+  double undetermined_relative_std = 0.3;
+  double rank_tolerance = 1e-7;
+  // Ceres' Levenberg-Marquardt starts with this trust region radius (Ceres' default is 1e4):
+  // strong regularization at first keeps the early steps from jumping into the far local
+  // minima that oscillatory records have.
+  double initial_trust_region_radius = 10.0;
+  // Continuation in time: fit the first fraction(s) of each record first (ascending, each in
+  // (0, 1)), then the whole record from there. Short windows have fewer cycles to slip, so fewer
+  // local minima; e.g. {0.25}. Empty: fit the whole record at once.
+  std::vector<double> continuation_fractions;
+  // Simulations in parallel: tests, and parameter groups of one test's sensitivities.
+  int threads = 1;
+  // Progress (iteration, cost, step) on standard error unless quiet.
+  bool quiet = false;
+
+  bool IsValid(std::string* why) const;
+};
+
+struct ParameterEstimate {
+  std::string name;
+  std::string units;
+  std::string test;  // a nuisance parameter's test; empty for shared ones
+  bool log_scale = true;
+  double value = 0;
+  double initial = 0;
+  double lower = 0;
+  double upper = 0;
+  // One standard deviation (parameter units) from Ceres' covariance at the estimate, by the
+  // delta method for log-scale parameters (std = value * std(log p)). NaN when the covariance
+  // is undefined (a rank-deficient Jacobian).
+  double std = std::numeric_limits<double>::quiet_NaN();
+  double relative_std = std::numeric_limits<double>::quiet_NaN();
+  bool determined = true;
+  bool at_bound = false;  // within 1e-6 (relative) of a bound: the std means little there
+};
+
+struct IterationRecord {
+  int iteration = 0;
+  double cost = 0;
+  double step_norm = 0;  // in Ceres' coordinates (log p)
+  double gradient_max_norm = 0;
+  double trust_region_radius = 0;
+  bool successful = true;
+  double cumulative_time_s = 0;
+  // 1-based: the continuation windows first, then the whole record; a refit after a noise
+  // estimate is a stage of its own (its cost has other weights).
+  int stage = 1;
+};
+
+// The tuned model against one test.
+struct TestFit {
+  std::string name;
+  std::vector<std::string> channels;
+  Eigen::VectorXd noise_std;  // used weights, per channel
+  std::vector<bool> noise_estimated;
+  Eigen::VectorXd residual_rms;  // per channel, channel units
+  Eigen::VectorXd correlation;   // per channel: Pearson's K of record and re-simulation
+  Measurement simulated;         // re-simulation with the tuned values, record's samples
+};
+
+struct UpdateResult {
+  enum class Termination { kConverged, kNoConvergence, kFailure };
+
+  std::vector<ParameterEstimate> parameters;
+  // Correlation of the estimates (in Ceres' coordinates); NaN where undefined.
+  Eigen::MatrixXd correlation;
+  Eigen::MatrixXd covariance;  // of Ceres' coordinates (log p for log-scale parameters)
+  Termination termination = Termination::kFailure;
+  std::string message;  // Ceres' own words, plus ours
+  int iterations = 0;
+  double initial_cost = 0;
+  double final_cost = 0;
+  // Every Ceres iteration of every stage and pass (see IterationRecord::stage).
+  std::vector<IterationRecord> history;
+  // Identifiability: singular values of the weighted Jacobian in Ceres' coordinates, its
+  // numerical rank and the parameters the records leave undetermined.
+  Eigen::VectorXd singular_values;
+  int rank = 0;
+  std::vector<std::string> undetermined;
+  std::vector<std::string> warnings;
+  std::vector<TestFit> tests;
+  // Work: simulations (with and without sensitivities), right-hand-side evaluations (all
+  // kinds), wall time.
+  long simulations = 0;
+  long sensitivity_simulations = 0;
+  long rhs_evaluations = 0;
+  double wall_time_s = 0;
+  std::string jacobian;  // "sensitivities" | "numeric"
+
+  std::string termination_name() const;  // "converged" | "no_convergence" | "failure"
+  // converged: 0; otherwise 3 (the contract's numerical failure).
+  ExitCode exit_code() const;
+  // The estimate named `name`; throws std::out_of_range if absent.
+  const ParameterEstimate& Find(const std::string& name) const;
+};
+
+// Tunes the parameters of `model` (left unchanged) to the tests. Throws InputError for unknown
+// parameters, bounds that do not bracket the start, records whose channels the model lacks,
+// records not on the simulation's sample grid; a failing simulation inside the fit is a
+// Termination::kFailure result, not an exception.
+UpdateResult UpdateModel(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
+                         const UpdateOptions& options);
+
+// Sets each tuned shared parameter of `model` to its estimate.
+void ApplyEstimates(const UpdateResult& result, model::MechanicalModel& model);
+
+}  // namespace mbid::updating

@@ -1,0 +1,104 @@
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "mbid/common/yaml_reader.h"
+#include "mbid/identification/updating/characteristic.h"
+#include "mbid/identification/updating/output_error.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/integrator_options.h"
+
+namespace mbid::updating {
+
+// The `updating:` section of a scenario (docs/scenarios.md), read strictly: unknown keys are
+// errors naming the closest known key. Every key is optional:
+//
+//   updating:
+//     parameters: [c_alpha, d_alpha, ...]  # parameters to tune; default: all c_<joint>, d_<joint>
+//     start: {c_alpha: 3.0e7}              # start values in the parameter's units (N*m/rad,
+//                                          #   N*m*s/rad); default: Route 1's chosen set if
+//                                          #   algebraic_start, else the model section's values
+//     bounds: {c_alpha: [1.0e5, 1.0e9]}    # [lower, upper]; default [start / 100, start * 100]
+//     log_scale: true                      # Ceres works on log(p) (recommended)
+//     algebraic_start: true                # start from Route 1 (eqs. 6-8) when identified poles
+//                                          #   give an admissible set; explicit starts win
+//     jacobian: sensitivities              # sensitivities (CVODES) | numeric (central
+//                                          #   differences of whole simulations)
+//     numeric_step: 1.0e-4                 # relative step of the numeric Jacobian
+//     noise_std_rad: 1.0e-5                # or {psi: 1.0e-5, phi: 2.0e-5}: residual weights;
+//                                          #   default: the identification's residual noise,
+//                                          #   else estimated from a first fit
+//     fit_payload_mass: false              # nuisance: each load drop's payload mass
+//     fit_initial_deflection: false        # nuisance: each initial_deflection test's angles
+//     max_iterations: 50
+//     function_tolerance: 1.0e-6           # Ceres: relative cost decrease
+//     gradient_tolerance: 1.0e-10
+//     parameter_tolerance: 1.0e-8          # Ceres: relative step in log(p)
+//     undetermined_relative_std: 0.3       # relative std above which a parameter is reported
+//                                          #   as undetermined by the records
+//     rank_tolerance: 1.0e-7               # singular-value ratio of the numerical null space
+//     threads: 1                           # parallel simulations (tests, sensitivity groups)
+//     initial_trust_region_radius: 10      # Ceres LM; small = cautious first steps
+//     continuation_fractions: []           # e.g. [0.25]: fit the first quarter of each record
+//                                          #   first, then the whole (fewer local minima)
+//     integrator:                          # the fit's simulations; default: the scenario's
+//       method: bdf                        #   simulation.integrator with outputs interpolated
+//       relative_tolerance: 1.0e-8
+//       absolute_tolerance: 1.0e-10
+//       max_steps: 100000
+//       max_step_s: 0
+//       interpolate_outputs: true
+//     sensitivity:                         # CVODES forward sensitivities (docs/toolchain.md)
+//       corrector: simultaneous            # simultaneous | staggered
+//       difference_quotient: centered      # centered | forward
+//       relative_tolerance: 1.0e-6         # looser than the state's on purpose
+//       absolute_tolerance: 1.0e-8         # divided by each parameter's magnitude
+//       error_control: true
+//     algebraic:                           # Route 1 (eq. 7)
+//       starts: 100                        # multi-start points
+//       seed: 1
+//       start_spread: 10                   # starts within [reference / 10, reference * 10]
+//       max_iterations: 100
+//       residual_tolerance: 1.0e-9         # scaled |det| below which a start has converged
+//       duplicate_tolerance: 1.0e-6        # relative distance of two equal sets
+//       fit_offset: false                  # eq. 8 with a constant per channel
+//       ambiguity_ratio: 2                 # runner-up mismatch within this factor: ambiguous
+struct UpdatingSettings {
+  UpdateOptions options;  // parameters carry NaN where the section gives no start or bounds
+  CharacteristicOptions algebraic;
+  bool algebraic_start = true;
+  std::map<std::string, double> noise_std;  // per channel; empty: not given
+  bool fit_payload_mass = false;
+  bool fit_initial_deflection = false;
+};
+
+// The defaults: every parameter of `model`, the scenario's integrator with outputs interpolated.
+UpdatingSettings MakeDefaultUpdatingSettings(const model::MechanicalModel& model,
+                                             const simulation::IntegratorOptions& integrator);
+
+// Reads the section (a map, or null for the defaults); names are checked against `model`.
+UpdatingSettings ReadUpdatingSettings(const YamlReader& updating,
+                                      const model::MechanicalModel& model,
+                                      const simulation::IntegratorOptions& integrator);
+
+// Starts the parameters without an explicit start at Route 1's chosen set (c_<coordinate>,
+// d_<coordinate>). Returns false, leaving `options` unchanged, unless `algebraic` is solved and
+// every such start lies within the parameter's explicit bounds; `why` says why not.
+bool ApplyAlgebraicStart(const CharacteristicResult& algebraic, UpdateOptions& options,
+                         std::string* why = nullptr);
+
+// When Route 1's choice was ambiguous, the parameters in which its rival sets differ from the
+// chosen one by more than `relative_difference` are not determined by the record either, even
+// if Route 2's local standard deviations look small (a second minimum of equal fit): marks them
+// undetermined in `result` with a warning. Returns their names.
+std::vector<std::string> MarkAlgebraicAmbiguity(const CharacteristicResult& algebraic,
+                                                UpdateResult& result,
+                                                double relative_difference = 0.1);
+
+// A test record with the settings' noise levels and nuisance switches.
+TestRecord MakeTestRecord(const std::string& name, const Measurement& record,
+                          const simulation::Excitation& excitation,
+                          const UpdatingSettings& settings);
+
+}  // namespace mbid::updating

@@ -1,0 +1,284 @@
+#include "mbid/identification/updating/result_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+namespace mbid::updating {
+namespace {
+
+// JSON has no NaN or infinity: undefined numbers are null.
+nlohmann::json Number(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json PerName(const std::vector<std::string>& names, const Eigen::VectorXd& values) {
+  nlohmann::json json = nlohmann::json::object();
+  for (size_t i = 0; i < names.size() && static_cast<Eigen::Index>(i) < values.size(); ++i) {
+    json[names[i]] = Number(values[static_cast<Eigen::Index>(i)]);
+  }
+  return json;
+}
+
+std::string ObjectName(std::string name) {
+  std::replace(name.begin(), name.end(), '/', '_');
+  return name;
+}
+
+// The smallest K of each channel over the records.
+std::map<std::string, double> WorstCorrelation(const UpdateResult& result) {
+  std::map<std::string, double> worst;
+  for (const TestFit& test : result.tests) {
+    for (size_t c = 0; c < test.channels.size(); ++c) {
+      if (test.correlation.size() <= static_cast<Eigen::Index>(c)) continue;
+      const double k = test.correlation[static_cast<Eigen::Index>(c)];
+      const auto found = worst.find(test.channels[c]);
+      if (found == worst.end() || k < found->second) worst[test.channels[c]] = k;
+    }
+  }
+  return worst;
+}
+
+}  // namespace
+
+nlohmann::json CharacteristicResultToJson(const CharacteristicResult& result) {
+  nlohmann::json json;
+  json["status"] = result.status_name();
+  json["message"] = result.message;
+  json["starts"] = result.starts;
+  json["converged_starts"] = result.converged_starts;
+  json["best_residual"] = Number(result.best_residual);
+  json["chosen"] = result.chosen;
+  json["ambiguous"] = result.ambiguous;
+  json["poles"] = nlohmann::json::array();
+  for (const std::complex<double>& lambda : result.lambda) {
+    json["poles"].push_back({{"re", lambda.real()},
+                             {"im", lambda.imag()},
+                             {"frequency_hz", lambda.imag() / (2 * M_PI)},
+                             {"decay_rate_per_s", -lambda.real()}});
+  }
+  json["sets"] = nlohmann::json::array();
+  for (const CharacteristicSolution& set : result.solutions) {
+    nlohmann::json entry;
+    entry["c"] = PerName(result.coordinates, set.c);
+    entry["d"] = PerName(result.coordinates, set.d);
+    entry["residual"] = Number(set.residual);
+    entry["hits"] = set.hits;
+    entry["admissible"] = set.admissible;
+    if (!set.reason.empty()) entry["reason"] = set.reason;
+    if (set.admissible) {
+      entry["mismatch"] = Number(set.mismatch);
+      entry["displacement_mismatch"] = Number(set.displacement_mismatch);
+      entry["velocity_mismatch"] = Number(set.velocity_mismatch);
+      if (set.initial_q.size() > 0) {
+        entry["initial_q"] = PerName(result.coordinates, set.initial_q);
+        entry["initial_u"] = PerName(result.coordinates, set.initial_u);
+        entry["correlation"] = PerName(result.outputs, set.correlation);
+      }
+      if (set.expected_initial_q.size() > 0) {
+        entry["expected_initial_q"] = PerName(result.coordinates, set.expected_initial_q);
+      }
+    }
+    json["sets"].push_back(entry);
+  }
+  return json;
+}
+
+nlohmann::json UpdateResultToJson(const UpdateResult& result,
+                                  const CharacteristicResult* algebraic) {
+  nlohmann::json json;
+  nlohmann::json parameters = nlohmann::json::object();
+  std::vector<std::string> names;
+  for (const ParameterEstimate& p : result.parameters) {
+    names.push_back(p.name);
+    nlohmann::json entry = {{"value", Number(p.value)},
+                            {"initial", Number(p.initial)},
+                            {"lower", Number(p.lower)},
+                            {"upper", Number(p.upper)},
+                            {"std", Number(p.std)},
+                            {"units", p.units},
+                            {"relative_std", Number(p.relative_std)},
+                            {"determined", p.determined},
+                            {"at_bound", p.at_bound}};
+    if (!p.test.empty()) entry["test"] = p.test;
+    parameters[p.name] = entry;
+  }
+  json["parameters"] = parameters;
+  json["termination"] = result.termination_name();
+  json["iterations"] = result.iterations;
+  json["cost"] = {{"initial", Number(result.initial_cost)}, {"final", Number(result.final_cost)}};
+  nlohmann::json correlation = nlohmann::json::object();
+  for (const auto& [channel, k] : WorstCorrelation(result)) correlation[channel] = Number(k);
+  json["correlation"] = correlation;
+
+  json["message"] = result.message;
+  json["jacobian"] = result.jacobian;
+  json["undetermined"] = result.undetermined;
+  json["rank"] = result.rank;
+  json["singular_values"] = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < result.singular_values.size(); ++i) {
+    json["singular_values"].push_back(Number(result.singular_values[i]));
+  }
+  nlohmann::json matrix = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < result.correlation.rows(); ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (Eigen::Index j = 0; j < result.correlation.cols(); ++j) {
+      row.push_back(Number(result.correlation(i, j)));
+    }
+    matrix.push_back(row);
+  }
+  json["parameter_correlation"] = {{"names", names}, {"matrix", matrix}};
+  json["warnings"] = result.warnings;
+  json["tests"] = nlohmann::json::array();
+  for (const TestFit& test : result.tests) {
+    nlohmann::json estimated = nlohmann::json::object();
+    for (size_t c = 0; c < test.channels.size() && c < test.noise_estimated.size(); ++c) {
+      estimated[test.channels[c]] = static_cast<bool>(test.noise_estimated[c]);
+    }
+    json["tests"].push_back({{"name", test.name},
+                             {"correlation", PerName(test.channels, test.correlation)},
+                             {"noise_std", PerName(test.channels, test.noise_std)},
+                             {"noise_estimated", estimated},
+                             {"residual_rms", PerName(test.channels, test.residual_rms)}});
+  }
+  json["history"] = nlohmann::json::array();
+  for (const IterationRecord& record : result.history) {
+    json["history"].push_back({{"iteration", record.iteration},
+                               {"cost", Number(record.cost)},
+                               {"step_norm", Number(record.step_norm)},
+                               {"gradient_max_norm", Number(record.gradient_max_norm)},
+                               {"successful", record.successful}});
+  }
+  json["work"] = {{"simulations", result.simulations},
+                  {"sensitivity_simulations", result.sensitivity_simulations},
+                  {"rhs_evaluations", result.rhs_evaluations},
+                  {"wall_time_s", Number(result.wall_time_s)}};
+  if (algebraic != nullptr) json["algebraic"] = CharacteristicResultToJson(*algebraic);
+  return json;
+}
+
+void WriteCharacteristicGroup(H5Writer& file, const CharacteristicResult& result,
+                              const std::string& group) {
+  file.WriteStringAttribute(group, "status", result.status_name());
+  file.WriteStringAttribute(group, "message", result.message);
+  file.WriteScalar(group, "chosen", result.chosen, "1");
+  file.WriteScalar(group, "ambiguous", result.ambiguous ? 1.0 : 0.0, "1");
+  file.WriteScalar(group, "starts", result.starts, "1");
+  file.WriteScalar(group, "converged_starts", result.converged_starts, "1");
+  file.WriteStrings(group, "coordinates", result.coordinates);
+  Eigen::VectorXd re(static_cast<Eigen::Index>(result.lambda.size()));
+  Eigen::VectorXd im(re.size());
+  for (size_t k = 0; k < result.lambda.size(); ++k) {
+    re[static_cast<Eigen::Index>(k)] = result.lambda[k].real();
+    im[static_cast<Eigen::Index>(k)] = result.lambda[k].imag();
+  }
+  file.WriteVector(group, "lambda_re", re, "1/s");
+  file.WriteVector(group, "lambda_im", im, "1/s");
+  const Eigen::Index sets = static_cast<Eigen::Index>(result.solutions.size());
+  const Eigen::Index n = static_cast<Eigen::Index>(result.coordinates.size());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Eigen::MatrixXd c(sets, n), d(sets, n), q0 = Eigen::MatrixXd::Constant(sets, n, nan);
+  Eigen::MatrixXd u0 = q0;
+  Eigen::VectorXd residual(sets), admissible(sets), mismatch(sets), displacement(sets),
+      velocity(sets);
+  for (Eigen::Index s = 0; s < sets; ++s) {
+    const CharacteristicSolution& set = result.solutions[static_cast<size_t>(s)];
+    c.row(s) = set.c.transpose();
+    d.row(s) = set.d.transpose();
+    if (set.initial_q.size() == n) q0.row(s) = set.initial_q.transpose();
+    if (set.initial_u.size() == n) u0.row(s) = set.initial_u.transpose();
+    residual[s] = set.residual;
+    admissible[s] = set.admissible ? 1.0 : 0.0;
+    mismatch[s] = set.admissible ? set.mismatch : nan;
+    displacement[s] = set.admissible ? set.displacement_mismatch : nan;
+    velocity[s] = set.admissible ? set.velocity_mismatch : nan;
+  }
+  file.WriteMatrix(group, "c", c, "N*m/rad");
+  file.WriteMatrix(group, "d", d, "N*m*s/rad");
+  file.WriteMatrix(group, "initial_q", q0, "rad");
+  file.WriteMatrix(group, "initial_u", u0, "rad/s");
+  file.WriteVector(group, "residual", residual, "1");
+  file.WriteVector(group, "admissible", admissible, "1");
+  file.WriteVector(group, "mismatch", mismatch, "1");
+  file.WriteVector(group, "displacement_mismatch", displacement, "1");
+  file.WriteVector(group, "velocity_mismatch", velocity, "1");
+}
+
+void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,
+                        const CharacteristicResult* algebraic) {
+  const std::string root = "/updating";
+  file.WriteStringAttribute(root, "termination", result.termination_name());
+  file.WriteStringAttribute(root, "message", result.message);
+  file.WriteStringAttribute(root, "jacobian", result.jacobian);
+  file.WriteScalar(root, "iterations", result.iterations, "1");
+  file.WriteScalar(root + "/cost", "initial", result.initial_cost, "1");
+  file.WriteScalar(root + "/cost", "final", result.final_cost, "1");
+  file.WriteScalar(root, "rank", result.rank, "1");
+  file.WriteVector(root, "singular_values", result.singular_values, "1");
+  file.WriteStrings(root, "undetermined", result.undetermined);
+  file.WriteStrings(root, "warnings", result.warnings);
+  std::vector<std::string> names;
+  for (const ParameterEstimate& p : result.parameters) {
+    names.push_back(p.name);
+    const std::string group = root + "/parameters/" + ObjectName(p.name);
+    file.WriteScalar(group, "value", p.value, p.units);
+    file.WriteScalar(group, "initial", p.initial, p.units);
+    file.WriteScalar(group, "lower", p.lower, p.units);
+    file.WriteScalar(group, "upper", p.upper, p.units);
+    file.WriteScalar(group, "std", p.std, p.units);
+    file.WriteScalar(group, "relative_std", p.relative_std, "1");
+  }
+  file.WriteStrings(root, "parameter_names", names);
+  file.WriteMatrix(root, "parameter_correlation", result.correlation, "1");
+  file.WriteMatrix(root, "covariance", result.covariance, "1");
+  for (const auto& [channel, k] : WorstCorrelation(result)) {
+    file.WriteScalar(root + "/correlation", channel, k, "1");
+  }
+  const Eigen::Index iterations = static_cast<Eigen::Index>(result.history.size());
+  Eigen::VectorXd iteration(iterations), cost(iterations), step(iterations), gradient(iterations),
+      successful(iterations);
+  for (Eigen::Index i = 0; i < iterations; ++i) {
+    const IterationRecord& record = result.history[static_cast<size_t>(i)];
+    iteration[i] = record.iteration;
+    cost[i] = record.cost;
+    step[i] = record.step_norm;
+    gradient[i] = record.gradient_max_norm;
+    successful[i] = record.successful ? 1.0 : 0.0;
+  }
+  file.WriteVector(root + "/history", "iteration", iteration, "1");
+  file.WriteVector(root + "/history", "cost", cost, "1");
+  file.WriteVector(root + "/history", "step_norm", step, "1");
+  file.WriteVector(root + "/history", "gradient_max_norm", gradient, "1");
+  file.WriteVector(root + "/history", "successful", successful, "1");
+  for (const TestFit& test : result.tests) {
+    const std::string group = root + "/tests/" + ObjectName(test.name);
+    for (size_t c = 0; c < test.channels.size(); ++c) {
+      const Eigen::Index column = static_cast<Eigen::Index>(c);
+      const std::string& channel = test.channels[c];
+      const std::string units =
+          c < test.simulated.units.size() ? test.simulated.units[c] : std::string("rad");
+      if (test.simulated.values.cols() > column) {
+        file.WriteVector(group + "/simulated", channel, test.simulated.values.col(column), units);
+      }
+      if (test.noise_std.size() > column) {
+        file.WriteScalar(group + "/noise_std", channel, test.noise_std[column], units);
+      }
+      if (test.correlation.size() > column) {
+        file.WriteScalar(group + "/correlation", channel, test.correlation[column], "1");
+      }
+      if (test.residual_rms.size() > column) {
+        file.WriteScalar(group + "/residual_rms", channel, test.residual_rms[column], units);
+      }
+    }
+  }
+  file.WriteScalar(root + "/work", "simulations", static_cast<double>(result.simulations), "1");
+  file.WriteScalar(root + "/work", "sensitivity_simulations",
+                   static_cast<double>(result.sensitivity_simulations), "1");
+  file.WriteScalar(root + "/work", "rhs_evaluations", static_cast<double>(result.rhs_evaluations),
+                   "1");
+  file.WriteScalar(root + "/work", "wall_time_s", result.wall_time_s, "s");
+  if (algebraic != nullptr) WriteCharacteristicGroup(file, *algebraic, root + "/algebraic");
+}
+
+}  // namespace mbid::updating

@@ -1,0 +1,343 @@
+#include "mbid/identification/updating/settings.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace mbid::updating {
+namespace {
+
+std::vector<std::string> ParameterNames(const model::MechanicalModel& model) {
+  std::vector<std::string> names;
+  for (const model::Parameter& parameter : model.parameters()) names.push_back(parameter.name);
+  return names;
+}
+
+ParameterSetting* FindSetting(UpdateOptions& options, const std::string& name) {
+  for (ParameterSetting& setting : options.parameters) {
+    if (setting.name == name) return &setting;
+  }
+  return nullptr;
+}
+
+// A map parameter -> value whose names must be tuned parameters.
+void CheckParameterKeys(const YamlReader& node, const UpdateOptions& options) {
+  std::vector<std::string> tuned;
+  for (const ParameterSetting& setting : options.parameters) tuned.push_back(setting.name);
+  for (const std::string& key : node.Keys()) {
+    if (std::find(tuned.begin(), tuned.end(), key) == tuned.end()) {
+      node.FailAt(key, "'" + key + "' is not among the tuned parameters",
+                  "one of updating.parameters; did you mean '" + ClosestMatch(key, tuned) + "'?");
+    }
+  }
+}
+
+simulation::IntegratorOptions ReadIntegrator(const YamlReader& node,
+                                             simulation::IntegratorOptions o) {
+  node.ExpectMap({"method", "relative_tolerance", "absolute_tolerance", "max_steps", "max_step_s",
+                  "interpolate_outputs"});
+  const std::string method =
+      node.Choice("method", {"bdf", "adams"},
+                  o.method == simulation::IntegratorOptions::Method::kAdams ? "adams" : "bdf");
+  o.method = method == "adams" ? simulation::IntegratorOptions::Method::kAdams
+                               : simulation::IntegratorOptions::Method::kBdf;
+  o.relative_tolerance = node.PositiveDouble("relative_tolerance", o.relative_tolerance);
+  o.absolute_tolerance = node.PositiveDouble("absolute_tolerance", o.absolute_tolerance);
+  o.max_steps = node.Int("max_steps", o.max_steps);
+  o.max_step_s = node.Double("max_step_s", o.max_step_s);
+  o.interpolate_outputs = node.Bool("interpolate_outputs", o.interpolate_outputs);
+  std::string why;
+  if (!o.IsValid(&why)) node.Fail(why, "valid integrator options (docs/scenarios.md)");
+  return o;
+}
+
+simulation::SensitivityOptions ReadSensitivity(const YamlReader& node,
+                                               simulation::SensitivityOptions o) {
+  using simulation::SensitivityOptions;
+  node.ExpectMap({"corrector", "difference_quotient", "relative_tolerance", "absolute_tolerance",
+                  "error_control"});
+  o.corrector =
+      node.Choice("corrector", {"simultaneous", "staggered"}, "simultaneous") == "staggered"
+          ? SensitivityOptions::Corrector::kStaggered
+          : SensitivityOptions::Corrector::kSimultaneous;
+  o.difference_quotient =
+      node.Choice("difference_quotient", {"centered", "forward"}, "centered") == "forward"
+          ? SensitivityOptions::DifferenceQuotient::kForward
+          : SensitivityOptions::DifferenceQuotient::kCentered;
+  o.relative_tolerance = node.PositiveDouble("relative_tolerance", o.relative_tolerance);
+  o.absolute_tolerance = node.PositiveDouble("absolute_tolerance", o.absolute_tolerance);
+  o.error_control = node.Bool("error_control", o.error_control);
+  std::string why;
+  if (!o.IsValid(&why)) node.Fail(why, "valid sensitivity options (docs/scenarios.md)");
+  return o;
+}
+
+CharacteristicOptions ReadAlgebraic(const YamlReader& node, CharacteristicOptions o) {
+  node.ExpectMap({"starts", "seed", "start_spread", "max_iterations", "residual_tolerance",
+                  "duplicate_tolerance", "fit_offset", "ambiguity_ratio"});
+  o.starts = node.Int("starts", o.starts);
+  const int seed = node.Int("seed", static_cast<int>(o.seed));
+  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
+  o.seed = static_cast<std::uint64_t>(seed);
+  o.start_spread = node.PositiveDouble("start_spread", o.start_spread);
+  o.max_iterations = node.Int("max_iterations", o.max_iterations);
+  o.residual_tolerance = node.PositiveDouble("residual_tolerance", o.residual_tolerance);
+  o.duplicate_tolerance = node.PositiveDouble("duplicate_tolerance", o.duplicate_tolerance);
+  o.fit_offset = node.Bool("fit_offset", o.fit_offset);
+  o.ambiguity_ratio = node.PositiveDouble("ambiguity_ratio", o.ambiguity_ratio);
+  std::string why;
+  if (!o.IsValid(&why)) node.Fail(why, "valid algebraic options (docs/scenarios.md)");
+  return o;
+}
+
+}  // namespace
+
+UpdatingSettings MakeDefaultUpdatingSettings(const model::MechanicalModel& model,
+                                             const simulation::IntegratorOptions& integrator) {
+  UpdatingSettings settings;
+  for (const std::string& name : ParameterNames(model)) {
+    ParameterSetting setting;
+    setting.name = name;
+    settings.options.parameters.push_back(setting);
+  }
+  settings.options.integrator = integrator;
+  settings.options.integrator.interpolate_outputs = true;
+  return settings;
+}
+
+UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::MechanicalModel& model,
+                                      const simulation::IntegratorOptions& integrator) {
+  UpdatingSettings settings = MakeDefaultUpdatingSettings(model, integrator);
+  node.ExpectMap({"parameters",
+                  "start",
+                  "bounds",
+                  "log_scale",
+                  "algebraic_start",
+                  "jacobian",
+                  "numeric_step",
+                  "noise_std_rad",
+                  "fit_payload_mass",
+                  "fit_initial_deflection",
+                  "max_iterations",
+                  "function_tolerance",
+                  "gradient_tolerance",
+                  "parameter_tolerance",
+                  "undetermined_relative_std",
+                  "rank_tolerance",
+                  "threads",
+                  "initial_trust_region_radius",
+                  "continuation_fractions",
+                  "integrator",
+                  "sensitivity",
+                  "algebraic"});
+  UpdateOptions& options = settings.options;
+  const std::vector<std::string> known = ParameterNames(model);
+  if (node.Has("parameters")) {
+    const std::vector<std::string> names = node.StringList("parameters");
+    if (names.empty()) node.FailAt("parameters", "no parameter", "at least one parameter name");
+    options.parameters.clear();
+    for (const std::string& name : names) {
+      if (std::find(known.begin(), known.end(), name) == known.end()) {
+        node.FailAt("parameters", "unknown parameter '" + name + "'",
+                    "parameters of the model (c_<joint>, d_<joint>); did you mean '" +
+                        ClosestMatch(name, known) + "'?");
+      }
+      if (FindSetting(options, name) != nullptr) {
+        node.FailAt("parameters", "'" + name + "' listed twice", "each parameter once");
+      }
+      ParameterSetting setting;
+      setting.name = name;
+      options.parameters.push_back(setting);
+    }
+  }
+  const bool log_scale = node.Bool("log_scale", true);
+  for (ParameterSetting& setting : options.parameters) setting.log_scale = log_scale;
+  if (node.Has("start")) {
+    const YamlReader start = node.Child("start");
+    CheckParameterKeys(start, options);
+    for (const std::string& name : start.Keys()) {
+      const double value = log_scale ? start.PositiveDouble(name) : start.Double(name);
+      FindSetting(options, name)->initial = value;
+    }
+  }
+  if (node.Has("bounds")) {
+    const YamlReader bounds = node.Child("bounds");
+    CheckParameterKeys(bounds, options);
+    for (const std::string& name : bounds.Keys()) {
+      const YamlReader pair = bounds.Child(name);
+      const std::string expected = "a list [lower, upper] with lower < upper";
+      if (!pair.node().IsSequence() || pair.node().size() != 2) {
+        pair.Fail("is not a list of two numbers", expected);
+      }
+      const double lower =
+          YamlReader(pair.node()[0], pair.source(), pair.field() + "[0]").AsDouble();
+      const double upper =
+          YamlReader(pair.node()[1], pair.source(), pair.field() + "[1]").AsDouble();
+      if (!(lower < upper) || (log_scale && !(lower > 0))) {
+        pair.Fail("bounds [" + std::to_string(lower) + ", " + std::to_string(upper) + "]",
+                  expected + (log_scale ? ", lower > 0 on the log scale" : ""));
+      }
+      ParameterSetting* setting = FindSetting(options, name);
+      setting->lower = lower;
+      setting->upper = upper;
+      if (!std::isnan(setting->initial) &&
+          !(lower <= setting->initial && setting->initial <= upper)) {
+        pair.Fail("does not contain the start " + std::to_string(setting->initial),
+                  "bounds around updating.start." + name);
+      }
+    }
+  }
+  settings.algebraic_start = node.Bool("algebraic_start", settings.algebraic_start);
+  options.jacobian =
+      node.Choice("jacobian", {"sensitivities", "numeric"}, "sensitivities") == "numeric"
+          ? UpdateOptions::Jacobian::kNumeric
+          : UpdateOptions::Jacobian::kSensitivities;
+  options.numeric_step = node.PositiveDouble("numeric_step", options.numeric_step);
+  if (node.Has("noise_std_rad")) {
+    const YamlReader noise = node.Child("noise_std_rad");
+    if (noise.IsMap()) {
+      std::vector<std::string> channels = model.output_names();
+      channels.insert(channels.end(), model.coordinate_names().begin(),
+                      model.coordinate_names().end());
+      noise.ExpectMap(channels);
+      for (const std::string& channel : noise.Keys()) {
+        settings.noise_std[channel] = noise.PositiveDouble(channel);
+      }
+    } else {
+      const double value = node.PositiveDouble("noise_std_rad");
+      for (const std::string& channel : model.output_names()) settings.noise_std[channel] = value;
+      for (const std::string& channel : model.coordinate_names()) {
+        settings.noise_std[channel] = value;
+      }
+    }
+  }
+  settings.fit_payload_mass = node.Bool("fit_payload_mass", false);
+  settings.fit_initial_deflection = node.Bool("fit_initial_deflection", false);
+  options.max_iterations = node.Int("max_iterations", options.max_iterations);
+  options.function_tolerance =
+      node.PositiveDouble("function_tolerance", options.function_tolerance);
+  options.gradient_tolerance =
+      node.PositiveDouble("gradient_tolerance", options.gradient_tolerance);
+  options.parameter_tolerance =
+      node.PositiveDouble("parameter_tolerance", options.parameter_tolerance);
+  options.undetermined_relative_std =
+      node.PositiveDouble("undetermined_relative_std", options.undetermined_relative_std);
+  options.rank_tolerance = node.PositiveDouble("rank_tolerance", options.rank_tolerance);
+  options.threads = node.Int("threads", options.threads);
+  options.initial_trust_region_radius =
+      node.PositiveDouble("initial_trust_region_radius", options.initial_trust_region_radius);
+  if (node.Has("continuation_fractions")) {
+    const YamlReader list = node.Child("continuation_fractions");
+    if (!list.node().IsSequence()) {
+      list.Fail("is not a list", "a list of ascending fractions in (0, 1), e.g. [0.25, 0.5]");
+    }
+    for (size_t i = 0; i < list.node().size(); ++i) {
+      options.continuation_fractions.push_back(
+          YamlReader(list.node()[i], list.source(), list.field() + "[" + std::to_string(i) + "]")
+              .AsDouble());
+    }
+  }
+  if (node.Has("integrator")) {
+    options.integrator = ReadIntegrator(node.Child("integrator"), options.integrator);
+  }
+  if (node.Has("sensitivity")) {
+    options.sensitivity = ReadSensitivity(node.Child("sensitivity"), options.sensitivity);
+  }
+  if (node.Has("algebraic")) {
+    settings.algebraic = ReadAlgebraic(node.Child("algebraic"), settings.algebraic);
+  }
+  std::string why;
+  if (!options.IsValid(&why)) node.Fail(why, "valid updating options (docs/scenarios.md)");
+  return settings;
+}
+
+bool ApplyAlgebraicStart(const CharacteristicResult& algebraic, UpdateOptions& options,
+                         std::string* why) {
+  auto fail = [why](const std::string& reason) {
+    if (why != nullptr) *why = reason;
+    return false;
+  };
+  if (algebraic.status != CharacteristicResult::Status::kSolved || algebraic.chosen < 0) {
+    return fail("Route 1 found no admissible set (" + algebraic.status_name() + ")");
+  }
+  const CharacteristicSolution& set = algebraic.solutions[static_cast<size_t>(algebraic.chosen)];
+  UpdateOptions changed = options;
+  for (size_t i = 0; i < algebraic.coordinates.size(); ++i) {
+    const Eigen::Index k = static_cast<Eigen::Index>(i);
+    for (const auto& [name, value] :
+         {std::pair<std::string, double>{"c_" + algebraic.coordinates[i], set.c[k]},
+          std::pair<std::string, double>{"d_" + algebraic.coordinates[i], set.d[k]}}) {
+      ParameterSetting* setting = FindSetting(changed, name);
+      if (setting == nullptr || !std::isnan(setting->initial)) continue;
+      if ((!std::isnan(setting->lower) && value < setting->lower) ||
+          (!std::isnan(setting->upper) && value > setting->upper) ||
+          (setting->log_scale && !(value > 0))) {
+        std::ostringstream reason;
+        reason << "Route 1's " << name << " = " << value << " lies outside its bounds";
+        return fail(reason.str());
+      }
+      setting->initial = value;
+    }
+  }
+  options = changed;
+  return true;
+}
+
+std::vector<std::string> MarkAlgebraicAmbiguity(const CharacteristicResult& algebraic,
+                                                UpdateResult& result, double relative_difference) {
+  std::vector<std::string> names;
+  if (!algebraic.ambiguous || algebraic.chosen < 0) return names;
+  const CharacteristicSolution& chosen = algebraic.solutions[static_cast<size_t>(algebraic.chosen)];
+  for (int rival : algebraic.rivals) {
+    const CharacteristicSolution& other = algebraic.solutions[static_cast<size_t>(rival)];
+    for (size_t i = 0; i < algebraic.coordinates.size(); ++i) {
+      const Eigen::Index k = static_cast<Eigen::Index>(i);
+      if (std::abs(other.c[k] / chosen.c[k] - 1) > relative_difference) {
+        names.push_back("c_" + algebraic.coordinates[i]);
+      }
+      if (std::abs(other.d[k] / chosen.d[k] - 1) > relative_difference) {
+        names.push_back("d_" + algebraic.coordinates[i]);
+      }
+    }
+  }
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  std::string list;
+  for (const std::string& name : names) {
+    list += (list.empty() ? "" : ", ") + name;
+    for (ParameterEstimate& estimate : result.parameters) {
+      if (estimate.name == name) estimate.determined = false;
+    }
+    if (std::find(result.undetermined.begin(), result.undetermined.end(), name) ==
+        result.undetermined.end()) {
+      result.undetermined.push_back(name);
+    }
+  }
+  if (!names.empty()) {
+    result.warnings.push_back(
+        "Route 1 found sets that reproduce the test's initial state about "
+        "as well as the chosen one but differ in " +
+        list + ": the record does not decide between them");
+  }
+  return names;
+}
+
+TestRecord MakeTestRecord(const std::string& name, const Measurement& record,
+                          const simulation::Excitation& excitation,
+                          const UpdatingSettings& settings) {
+  TestRecord test;
+  test.name = name;
+  test.record = record;
+  test.excitation = excitation;
+  for (const std::string& channel : record.channels) {
+    const auto found = settings.noise_std.find(channel);
+    if (found != settings.noise_std.end()) test.noise_std[channel] = found->second;
+  }
+  test.fit_payload_mass =
+      settings.fit_payload_mass && excitation.type == simulation::Excitation::Type::kLoadDrop;
+  test.fit_initial_deflection = settings.fit_initial_deflection &&
+                                excitation.type == simulation::Excitation::Type::kInitialDeflection;
+  return test;
+}
+
+}  // namespace mbid::updating

@@ -1,0 +1,48 @@
+#pragma once
+
+// The reference crane of docs/reference-crane.md as the updating tests use it: the scenario's
+// model, excitation and simulation, and records simulated from it.
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "mbid/common/yaml_reader.h"
+#include "mbid/model/model_factory.h"
+#include "mbid/simulation/scenario_sections.h"
+#include "mbid/simulation/simulate.h"
+
+namespace mbid::updating::testing {
+
+inline const std::string kReferenceScenario =
+    std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
+inline const std::string kLoadDropScenario =
+    std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane-load-drop.yaml";
+
+struct Crane {
+  std::unique_ptr<model::MechanicalModel> model;
+  simulation::Excitation excitation;
+  simulation::SimulationOptions simulation;
+  simulation::SensorOptions sensors;
+};
+
+inline Crane LoadCrane(const std::string& path) {
+  const YamlReader root = YamlReader::FromFile(path);
+  Crane crane;
+  crane.model = model::MakeModel(root.Child("model"));
+  crane.excitation = simulation::ReadExcitation(root.Child("excitation"), *crane.model);
+  crane.simulation = simulation::ReadSimulationOptions(root.Child("simulation"));
+  crane.sensors = simulation::ReadSensorOptions(root.Child("sensors"), *crane.model);
+  return crane;
+}
+
+// The crane's record of `duration_s` at `rate_hz` without sensor effects.
+inline Measurement SimulateExact(const Crane& crane, double duration_s, double rate_hz) {
+  simulation::SimulationOptions options = crane.simulation;
+  options.duration_s = duration_s;
+  simulation::SensorOptions sensors;
+  sensors.sample_rate_hz = rate_hz;
+  sensors.channels = crane.sensors.channels;
+  return simulation::Simulate(*crane.model, crane.excitation, options, sensors).exact;
+}
+
+}  // namespace mbid::updating::testing

@@ -1,0 +1,153 @@
+// CVODES forward sensitivities of the crane's outputs (simulation/sensitivity.h) against central
+// differences of whole simulations.
+#include "mbid/simulation/sensitivity.h"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "crane_fixture.h"
+#include "mbid/common/error.h"
+
+namespace mbid::simulation {
+namespace {
+
+using updating::testing::Crane;
+using updating::testing::LoadCrane;
+
+const std::vector<std::string> kAllParameters{"c_alpha", "c_gamma", "c_eta", "c_theta",
+                                              "d_alpha", "d_gamma", "d_eta", "d_theta"};
+
+// The reference: Richardson-extrapolated central differences (4 D(h/2) - D(h)) / 3 with
+// h = 1e-3 of the value, simulated with Adams at 1e-12: truncation O(h^4) ~ 1e-12 and
+// integration noise ~1e-12 / 1e-3, both far below the 1e-4 under test.
+Eigen::MatrixXd ReferenceSensitivity(const std::function<Measurement(double)>& simulate_at,
+                                     double value) {
+  auto central = [&](double h) {
+    return Eigen::MatrixXd((simulate_at(value + h).values - simulate_at(value - h).values) /
+                           (2 * h));
+  };
+  const double h = 1e-3 * value;
+  return (4 * central(h / 2) - central(h)) / 3;
+}
+
+SimulationOptions Tight(SimulationOptions options) {
+  options.integrator.method = IntegratorOptions::Method::kAdams;
+  options.integrator.relative_tolerance = 1e-12;
+  options.integrator.absolute_tolerance = 1e-14;
+  return options;
+}
+
+// Largest deviation relative to the largest sensitivity: the 1e-4.
+double RelativeError(const Eigen::MatrixXd& actual, const Eigen::MatrixXd& expected) {
+  return (actual - expected).cwiseAbs().maxCoeff() / expected.cwiseAbs().maxCoeff();
+}
+
+void CheckAgainstDifferences(const Crane& crane, double duration_s,
+                             const std::vector<std::string>& names) {
+  SimulationOptions options = crane.simulation;
+  options.duration_s = duration_s;
+  SensorOptions sensors;
+  sensors.sample_rate_hz = 50.0;               // the sensitivities do not depend on the sampling
+  sensors.channels = {"psi", "phi", "theta"};  // outputs and a coordinate channel
+  // The default settings of the fit: the scenario's BDF at 1e-8, interpolated outputs.
+  options.integrator.interpolate_outputs = true;
+  const SensitivityResult result =
+      SimulateWithSensitivities(*crane.model, crane.excitation, options, sensors, names, {}, {});
+  ASSERT_EQ(result.output_sensitivities.size(), names.size());
+  EXPECT_GT(result.statistics.rhs_evaluations_for_sensitivities, 0);
+  const SimulationOptions tight = Tight(options);
+  for (size_t k = 0; k < names.size(); ++k) {
+    auto simulate_at = [&](double value) {
+      std::unique_ptr<model::MechanicalModel> copy = crane.model->Clone();
+      copy->SetParameter(names[k], value);
+      return Simulate(*copy, crane.excitation, tight, sensors).exact;
+    };
+    const Eigen::MatrixXd expected =
+        ReferenceSensitivity(simulate_at, crane.model->GetParameter(names[k]));
+    const double error = RelativeError(result.output_sensitivities[k], expected);
+    ::testing::Test::RecordProperty("relative_error_" + names[k], std::to_string(error));
+    EXPECT_LT(error, 1e-4) << names[k];
+  }
+}
+
+TEST(SensitivityTest, InitialDeflectionMatchesCentralDifferences) {
+  // 3 s covers about two periods of the slowest mode and ten of the fastest.
+  CheckAgainstDifferences(LoadCrane(updating::testing::kReferenceScenario), 3.0, kAllParameters);
+}
+
+TEST(SensitivityTest, LoadDropMatchesCentralDifferencesIncludingTheInitialState) {
+  // The loaded equilibrium moves with the stiffnesses: s(0) = dq(0)/dc is not zero here.
+  const Crane crane = LoadCrane(updating::testing::kLoadDropScenario);
+  CheckAgainstDifferences(crane, 3.0, kAllParameters);
+  SimulationOptions options = crane.simulation;
+  options.duration_s = 1.0;
+  const SensitivityResult result = SimulateWithSensitivities(
+      *crane.model, crane.excitation, options, crane.sensors, {"c_theta"}, {}, {});
+  EXPECT_GT(result.initial_q_sensitivity.cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(SensitivityTest, ForcedTestCarriesSensitivitiesAcrossTheRestart) {
+  // An impulse: Simulate restarts CVODES where the pulse ends; the sensitivities must carry
+  // over. A torque pulse on theta, 0.2 s, then 1.8 s of free decay.
+  Crane crane = LoadCrane(updating::testing::kReferenceScenario);
+  crane.excitation = Excitation();
+  crane.excitation.type = Excitation::Type::kImpulse;
+  crane.excitation.coordinate = "theta";
+  crane.excitation.torque_Nm = 5e4;
+  crane.excitation.duration_s = 0.2;
+  CheckAgainstDifferences(crane, 2.0, {"c_theta", "d_theta", "c_alpha"});
+}
+
+TEST(SensitivityTest, PayloadMassDirectionMatchesCentralDifferences) {
+  // A nuisance parameter that acts only through the initial state: the outputs' derivative by
+  // the payload mass of a load drop, along dq(0)/dm.
+  const Crane crane = LoadCrane(updating::testing::kLoadDropScenario);
+  SimulationOptions options = crane.simulation;
+  options.duration_s = 2.0;
+  options.integrator.interpolate_outputs = true;
+  SensorOptions sensors;
+  sensors.sample_rate_hz = 50.0;
+  const double mass = crane.excitation.payload_mass_kg;
+  auto initial_q = [&](double m) {
+    Excitation changed = crane.excitation;
+    changed.payload_mass_kg = m;
+    return CalcInitialCoordinates(*crane.model, changed);
+  };
+  InitialStateDirection direction;
+  direction.name = "payload_mass_kg";
+  direction.dq0_dp = (initial_q(mass * 1.0001) - initial_q(mass * 0.9999)) / (2e-4 * mass);
+  direction.scale = mass;
+  const SensitivityResult result = SimulateWithSensitivities(*crane.model, crane.excitation,
+                                                             options, sensors, {}, {direction}, {});
+  const SimulationOptions tight = Tight(options);
+  auto simulate_at = [&](double m) {
+    Excitation changed = crane.excitation;
+    changed.payload_mass_kg = m;
+    return Simulate(*crane.model, changed, tight, sensors).exact;
+  };
+  const Eigen::MatrixXd expected = ReferenceSensitivity(simulate_at, mass);
+  const double error = RelativeError(result.output_sensitivities[0], expected);
+  RecordProperty("relative_error_payload_mass", std::to_string(error));
+  EXPECT_LT(error, 1e-4);
+}
+
+TEST(SensitivityTest, RejectsMisuse) {
+  const Crane crane = LoadCrane(updating::testing::kReferenceScenario);
+  SimulationOptions options = crane.simulation;
+  options.duration_s = 0.1;
+  EXPECT_THROW(
+      SimulateWithSensitivities(*crane.model, crane.excitation, options, crane.sensors, {}, {}, {}),
+      std::invalid_argument);
+  EXPECT_THROW(SimulateWithSensitivities(*crane.model, crane.excitation, options, crane.sensors,
+                                         {"c_beta"}, {}, {}),
+               InputError);
+  SensitivityOptions bad;
+  bad.relative_tolerance = 0;
+  EXPECT_THROW(SimulateWithSensitivities(*crane.model, crane.excitation, options, crane.sensors,
+                                         {"c_alpha"}, {}, bad),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace mbid::simulation
