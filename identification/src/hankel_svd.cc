@@ -4,6 +4,9 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "symmetric_eigen.h"
 
 namespace mbid::identification {
 namespace {
@@ -23,12 +26,6 @@ Eigen::MatrixXd CalcHankelGram(const Eigen::VectorXd& y, int columns) {
   return gram.selfadjointView<Eigen::Upper>();
 }
 
-// The median of the smallest values of an ascending vector, beyond the `skip` largest.
-double MedianOfTail(const Eigen::VectorXd& ascending, int skip) {
-  const int count = std::max<int>(1, static_cast<int>(ascending.size()) - skip);
-  return ascending(count / 2);
-}
-
 }  // namespace
 
 HankelSvd::HankelSvd(const Eigen::MatrixXd& values, int columns, int max_signal_order) {
@@ -36,29 +33,29 @@ HankelSvd::HankelSvd(const Eigen::MatrixXd& values, int columns, int max_signal_
   const int rows = static_cast<int>(values.rows()) - columns + 1;
   // At least half of the spectrum stays for the noise floor.
   const int skip = std::min(max_signal_order, columns / 2);
+  const int median_index = (columns - skip) / 2;  // ascending: the median of the tail
   channel_noise_std_.resize(channels);
   Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(columns, columns);
   for (int c = 0; c < channels; ++c) {
     const Eigen::MatrixXd channel_gram = CalcHankelGram(values.col(c), columns);
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(channel_gram, Eigen::EigenvaluesOnly);
-    const double largest = std::max(eigen.eigenvalues()(columns - 1), 0.0);
     // Noiseless channels have a floor of round-off; keep it above zero and comparable.
-    const double floor = std::max(MedianOfTail(eigen.eigenvalues(), skip),
-                                  largest * 1e-15 + std::numeric_limits<double>::min());
+    const double floor =
+        std::max(CalcEigenvalue(channel_gram, median_index),
+                 channel_gram.trace() * 1e-15 + std::numeric_limits<double>::min());
     channel_noise_std_(c) = std::sqrt(floor / rows);
     gram += channel_gram / floor;
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(gram);
-  // Ascending from Eigen; reversed to descending.
-  const Eigen::VectorXd ascending = eigen.eigenvalues();
-  noise_floor_ = MedianOfTail(ascending, skip);
+  eigen_ = std::make_unique<SymmetricEigen>(gram);
+  const Eigen::VectorXd& eigenvalues = eigen_->values();
+  noise_floor_ = eigenvalues(columns - 1 - median_index);
   // Marchenko-Pastur: white noise in a tall matrix of aspect ratio c = columns / rows has
   // squared singular values up to about (1 + sqrt(c))^2 times their typical value.
   const double aspect = static_cast<double>(columns) / (static_cast<double>(rows) * channels);
   noise_edge_ = (1 + std::sqrt(aspect)) * (1 + std::sqrt(aspect));
-  singular_values_ = ascending.reverse().cwiseMax(0.0).cwiseSqrt();
-  right_vectors_ = eigen.eigenvectors().rowwise().reverse();
+  singular_values_ = eigenvalues.cwiseMax(0.0).cwiseSqrt();
 }
+
+HankelSvd::~HankelSvd() = default;
 
 int HankelSvd::CountSignal(double noise_floor_factor, double min_relative, int max_order) const {
   const double largest = singular_values_(0);
@@ -75,7 +72,8 @@ int HankelSvd::CountSignal(double noise_floor_factor, double min_relative, int m
 
 std::vector<std::complex<double>> HankelSvd::CalcPoles(int order) const {
   const int l = columns() - 1;
-  const Eigen::MatrixXd v = right_vectors_.leftCols(order);
+  // The right singular vectors are the Gram matrix's eigenvectors, computed as far as needed.
+  const Eigen::MatrixXd v = eigen_->LeadingVectors(order);
   // V1 Z = V2 in the least-squares sense; eig(Z) are the discrete poles.
   const Eigen::MatrixXd z = v.topRows(l).colPivHouseholderQr().solve(v.bottomRows(l));
   Eigen::EigenSolver<Eigen::MatrixXd> eigen(z, /*computeEigenvectors=*/false);

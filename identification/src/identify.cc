@@ -58,6 +58,7 @@ struct Estimate {
   int model_order = 0;
   int effective_rank = 0;
   Eigen::VectorXd weights;  // per channel, for the covariance on the decimated record
+  AmplitudeFit fit;         // on the decimated record, for the poles in `lambda`
   std::string termination = "converged";
   int iterations = 0;
   std::vector<StabilizationOrder> stabilization;
@@ -78,13 +79,15 @@ int DropModes(Poles* lambda, Keep&& keep) {
 
 double SignificanceThreshold(const AnalysisRecord& record, const IdentificationOptions& options) {
   if (options.min_significance > 0) return options.min_significance;
-  return CalcSignificanceThreshold(static_cast<int>(record.values.rows()),
+  return CalcSignificanceThreshold(static_cast<int>(record.decimated.rows()),
                                    static_cast<int>(record.values.cols()),
                                    options.significance_false_alarm);
 }
 
-// Significance on the full-rate record; drops insignificant modes (when asked) until every
-// remaining mode is significant. `refit` re-estimates the poles of a reduced set.
+// Significance on the record the poles come from (the decimated one: the band where the modes
+// are, and one fit per dropped mode stays cheap on long records); drops insignificant modes (when
+// asked) until every remaining mode is significant. `refit` re-estimates the poles of a reduced
+// set.
 template <typename Refit>
 void SelectSignificant(const AnalysisRecord& record, const IdentificationOptions& options,
                        Estimate* estimate, Refit&& refit) {
@@ -101,10 +104,9 @@ void SelectSignificant(const AnalysisRecord& record, const IdentificationOptions
     }
   };
   for (;;) {
-    const AmplitudeFit fit =
-        FitAmplitudes(record.centered, record.sample_interval_s, estimate->lambda, with_offset);
-    const Eigen::VectorXd significance = CalcSignificance(record.centered, record.sample_interval_s,
-                                                          estimate->lambda, with_offset, fit);
+    estimate->fit =
+        FitAmplitudes(record.decimated, record.decimated_interval_s, estimate->lambda, with_offset);
+    const Eigen::VectorXd significance = CalcSignificance(estimate->fit);
     estimate->significance.assign(significance.data(), significance.data() + significance.size());
     if (!options.drop_insignificant) {
       const int weak = static_cast<int>((significance.array() < threshold).count());
@@ -333,9 +335,8 @@ Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOpti
     // Keep the max_modes most significant candidates.
     const bool with_offset = options.offset == OffsetRemoval::kFit;
     const AmplitudeFit fit =
-        FitAmplitudes(record.centered, record.sample_interval_s, estimate.lambda, with_offset);
-    const Eigen::VectorXd significance = CalcSignificance(record.centered, record.sample_interval_s,
-                                                          estimate.lambda, with_offset, fit);
+        FitAmplitudes(record.decimated, record.decimated_interval_s, estimate.lambda, with_offset);
+    const Eigen::VectorXd significance = CalcSignificance(fit);
     std::vector<double> sorted(significance.data(), significance.data() + significance.size());
     std::nth_element(sorted.begin(), sorted.begin() + options.max_modes - 1, sorted.end(),
                      std::greater<double>());
@@ -347,10 +348,8 @@ Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOpti
                     options.max_modes, options.max_modes + dropped));
   }
   SelectSignificant(record, options, &estimate, [](Estimate*) {});
-  estimate.weights = Eigen::VectorXd::Ones(values.cols());
-  const AmplitudeFit fit =
-      FitAmplitudes(values, tau, estimate.lambda, options.offset == OffsetRemoval::kFit);
-  estimate.weights = fit.residual_variance.cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  // Maximum-likelihood weights for the covariance: each channel's residual level.
+  estimate.weights = estimate.fit.residual_variance.cwiseSqrt().cwiseInverse();
   return estimate;
 }
 
@@ -385,7 +384,9 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   // Amplitudes, phases, reconstruction and correlation on the full-rate record.
   const bool with_offset = options.offset == OffsetRemoval::kFit;
   const AmplitudeFit fit =
-      FitAmplitudes(record.centered, record.sample_interval_s, estimate.lambda, with_offset);
+      options.decimation == 1
+          ? estimate.fit
+          : FitAmplitudes(record.centered, record.sample_interval_s, estimate.lambda, with_offset);
   result.reconstruction = fit.reconstruction.rowwise() + record.mean.transpose();
   result.correlation = CalcCorrelation(record.values, result.reconstruction);
   result.noise_std = fit.residual_variance.cwiseSqrt();
@@ -397,9 +398,7 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
     ModalModel model;
     model.lambda = estimate.lambda;
     model.with_offset = with_offset;
-    model.coefficients =
-        FitAmplitudes(record.decimated, record.decimated_interval_s, estimate.lambda, with_offset)
-            .coefficients;
+    model.coefficients = estimate.fit.coefficients;
     covariance =
         CalcPoleCovariance(record.decimated, record.decimated_interval_s, estimate.weights, model);
   }

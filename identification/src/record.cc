@@ -41,8 +41,10 @@ Eigen::MatrixXd Decimate(const Eigen::MatrixXd& values, int q) {
   const int samples = static_cast<int>(values.rows());
   const int outputs = samples > 2 * half ? (samples - 1 - 2 * half) / q + 1 : 0;
   Eigen::MatrixXd decimated(outputs, values.cols());
-  for (int n = 0; n < outputs; ++n) {
-    decimated.row(n) = taps.transpose() * values.middleRows(n * q, 2 * half + 1);
+  for (Eigen::Index c = 0; c < values.cols(); ++c) {
+    for (int n = 0; n < outputs; ++n) {
+      decimated(n, c) = taps.dot(values.col(c).segment(n * q, 2 * half + 1));
+    }
   }
   return decimated;
 }

@@ -22,13 +22,9 @@ double LogChiSquareSurvival(double x, int m) {
 
 }  // namespace
 
-Eigen::VectorXd CalcSignificance(const Eigen::MatrixXd& values, double sample_interval_s,
-                                 const std::vector<std::complex<double>>& lambda, bool with_offset,
-                                 const AmplitudeFit& fit) {
-  const Eigen::MatrixXd basis = CalcDampedSinusoidBasis(
-      lambda, sample_interval_s, static_cast<int>(values.rows()), with_offset);
+Eigen::VectorXd CalcSignificance(const AmplitudeFit& fit) {
   // (Phi^T Phi)^-1 through the Jacobi-scaled Gram matrix; pseudo-inverse for exact collinearity.
-  const Eigen::MatrixXd gram = basis.transpose() * basis;
+  const Eigen::MatrixXd& gram = fit.gram;
   const Eigen::VectorXd scale =
       gram.diagonal().cwiseMax(std::numeric_limits<double>::min()).cwiseSqrt().cwiseInverse();
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scale.asDiagonal() * gram *
@@ -39,17 +35,14 @@ Eigen::VectorXd CalcSignificance(const Eigen::MatrixXd& values, double sample_in
   const Eigen::MatrixXd inverse = scale.asDiagonal() * eigen.eigenvectors() *
                                   inverse_d.asDiagonal() * eigen.eigenvectors().transpose() *
                                   scale.asDiagonal();
-  Eigen::VectorXd significance = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(lambda.size()));
-  for (size_t k = 0; k < lambda.size(); ++k) {
+  const Eigen::Index modes = fit.coefficients.rows() / 2;
+  Eigen::VectorXd significance = Eigen::VectorXd::Zero(modes);
+  for (Eigen::Index k = 0; k < modes; ++k) {
     const Eigen::Matrix2d block = inverse.block<2, 2>(2 * k, 2 * k);
     const Eigen::Matrix2d information = block.completeOrthogonalDecomposition().pseudoInverse();
-    for (Eigen::Index c = 0; c < values.cols(); ++c) {
-      // Round-off floor: a noiseless record is very significant, not a division by zero.
-      const double floor =
-          1e-30 * values.col(c).squaredNorm() / values.rows() + std::numeric_limits<double>::min();
-      const double variance = std::max(fit.residual_variance(c), floor);
+    for (Eigen::Index c = 0; c < fit.coefficients.cols(); ++c) {
       const Eigen::Vector2d beta = fit.coefficients.block(2 * k, c, 2, 1);
-      significance(k) += beta.dot(information * beta) / variance;
+      significance(k) += beta.dot(information * beta) / fit.residual_variance(c);
     }
   }
   return significance;

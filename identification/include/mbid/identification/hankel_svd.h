@@ -2,9 +2,12 @@
 
 #include <Eigen/Core>
 #include <complex>
+#include <memory>
 #include <vector>
 
 namespace mbid::identification {
+
+class SymmetricEigen;
 
 // The multichannel matrix pencil (Kumaresan-Tufts / Hua-Sarkar style) behind the default
 // method's initialization. Each channel c gives a Hankel matrix with L + 1 columns,
@@ -17,13 +20,17 @@ namespace mbid::identification {
 // The SVD is taken through the (L+1) x (L+1) Gram matrix sum_c Y_c^T Y_c / floor_c, built in
 // O(N L) per channel by a diagonal recurrence: the eigenvalues are the squared singular
 // values. Squaring costs accuracy only in the smallest singular values, which the refinement
-// does not need.
+// does not need. floor_c is the median of the channel's trailing eigenvalues (one Sturm
+// bisection); only the leading singular vectors that CalcPoles uses are computed.
 class HankelSvd {
  public:
   // values: samples x channels, offset already removed. columns = L + 1 (>= 2,
   // < samples). `max_signal_order` bounds the signal subspace: the noise floor is the median of
   // the squared singular values beyond it.
   HankelSvd(const Eigen::MatrixXd& values, int columns, int max_signal_order);
+  ~HankelSvd();
+  HankelSvd(const HankelSvd&) = delete;
+  HankelSvd& operator=(const HankelSvd&) = delete;
 
   int columns() const { return static_cast<int>(singular_values_.size()); }
   // Of the stacked, noise-normalized Hankel matrix, descending; noise gives about
@@ -44,12 +51,13 @@ class HankelSvd {
   // noise_floor() and above (min_relative * largest singular value)^2, at most max_order.
   int CountSignal(double noise_floor_factor, double min_relative, int max_order) const;
 
-  // The discrete poles mu at order M (1 <= M < columns()).
+  // The discrete poles mu at order M (1 <= M < columns()). The singular vectors are computed
+  // on first use, as many as the highest order asked so far (not thread-safe).
   std::vector<std::complex<double>> CalcPoles(int order) const;
 
  private:
   Eigen::VectorXd singular_values_;
-  Eigen::MatrixXd right_vectors_;  // columns in the order of singular_values_
+  std::unique_ptr<SymmetricEigen> eigen_;  // of the Gram matrix
   Eigen::VectorXd channel_noise_std_;
   double noise_floor_ = 0;
   double noise_edge_ = 1;

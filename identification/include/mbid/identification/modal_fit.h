@@ -29,15 +29,19 @@ Eigen::MatrixXd CalcDampedSinusoidBasis(const std::vector<std::complex<double>>&
 struct AmplitudeFit {
   // (2 K [+1]) x channels: rows C_1, S_1, ..., C_K, S_K [, o] as in CalcDampedSinusoidBasis.
   Eigen::MatrixXd coefficients;
-  Eigen::MatrixXd reconstruction;     // samples x channels
-  Eigen::VectorXd residual_variance;  // per channel: residual sum of squares / (samples - P)
+  Eigen::MatrixXd reconstruction;  // samples x channels
+  // Per channel: residual sum of squares / (samples - P), at least 1e-30 of the channel's mean
+  // square (a noiseless record has a tiny, not a zero, noise level).
+  Eigen::VectorXd residual_variance;
+  Eigen::MatrixXd gram;  // Phi^T Phi (P x P), from the QR's R
 
   // Peak amplitude A_ck and phase phi_ck (rad, in (-pi, pi]) of mode k in channel c.
   double Amplitude(int mode, int channel) const;
   double Phase(int mode, int channel) const;
 };
 
-// Least squares (column-pivoting QR) of `values` (samples x channels) on the basis of `lambda`.
+// Least squares of `values` (samples x channels) on the basis of `lambda`: Householder QR, or
+// column-pivoting QR if the basis is numerically rank deficient (two poles merged).
 AmplitudeFit FitAmplitudes(const Eigen::MatrixXd& values, double sample_interval_s,
                            const std::vector<std::complex<double>>& lambda, bool with_offset);
 

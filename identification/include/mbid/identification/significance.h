@@ -1,8 +1,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <complex>
-#include <vector>
 
 #include "mbid/identification/modal_fit.h"
 
@@ -15,10 +13,9 @@ namespace mbid::identification {
 // This is the Wald statistic of "mode k is absent": chi-square with 2 degrees of freedom per
 // channel under that hypothesis. For well separated modes it is the mode's energy over the
 // noise variance; unlike the energy it stays small for spurious poles whose large amplitudes
-// cancel each other. A noiseless record gets a very large (finite) value.
-Eigen::VectorXd CalcSignificance(const Eigen::MatrixXd& values, double sample_interval_s,
-                                 const std::vector<std::complex<double>>& lambda, bool with_offset,
-                                 const AmplitudeFit& fit);
+// cancel each other. A noiseless record gets a very large (finite) value (the variance floor of
+// AmplitudeFit).
+Eigen::VectorXd CalcSignificance(const AmplitudeFit& fit);
 
 // The significance that pure white noise exceeds with probability `false_alarm` per record:
 // x with P(chi-square(2 m) > x) = false_alarm / (10 samples), a Bonferroni bound over the
