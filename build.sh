@@ -9,7 +9,8 @@ cd "$(dirname "$0")"
 packages=(build-essential cmake ccache pkg-config
   libsimbody-dev libeigen3-dev libsundials-dev libceres-dev libhdf5-dev hdf5-tools
   libyaml-cpp-dev libcli11-dev libfmt-dev nlohmann-json3-dev
-  libgtest-dev libbenchmark-dev gnuplot-nox python3-h5py)
+  libgtest-dev libbenchmark-dev gnuplot-nox python3-h5py
+  openmpi-bin libopenmpi-dev)
 
 missing=()
 for p in "${packages[@]}"; do

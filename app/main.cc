@@ -43,6 +43,17 @@ int Main(int argc, char** argv) {
       ->default_str("scenarios/reference-crane.yaml");
   run->add_option("-o,--output", output_dir, "Results folder (default results/<scenario name>)");
 
+  std::string campaign_path;
+  int campaign_workers = 0;
+  bool campaign_resume = false;
+  CLI::App* campaign = app.add_subcommand(
+      "campaign", "Run a campaign of virtual tests or a design study (threads; MPI under mpirun)");
+  campaign->add_option("CAMPAIGN", campaign_path, "Campaign YAML file")->required();
+  campaign->add_option("-o,--output", output_dir, "Results folder")->required();
+  campaign->add_option("--workers", campaign_workers, "Worker threads (default: one per core)")
+      ->check(CLI::PositiveNumber);
+  campaign->add_flag("--resume", campaign_resume, "Finish a campaign this folder holds");
+
   std::string data_path;
   mbid::identification::IdentificationOptions identify_options;
   std::string identify_method = "hankel-nls";
@@ -88,6 +99,10 @@ int Main(int argc, char** argv) {
   if (run->parsed()) {
     if (scenario_path.empty()) scenario_path = mbid::app::DefaultScenarioPath();
     return mbid::app::RunValidationCycle(scenario_path, output_dir, common);
+  }
+  if (campaign->parsed()) {
+    return mbid::app::RunCampaignCommand(campaign_path, output_dir, campaign_workers,
+                                         campaign_resume, common);
   }
   if (identify->parsed()) {
     mbid::identification::ParseMethod(identify_method, &identify_options.method);

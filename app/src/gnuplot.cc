@@ -52,8 +52,12 @@ void DrawFigure(const Figure& figure, const std::string& png_path) {
     script << "set title " << Quote(figure.title) << "\n";
     script << "set xlabel " << Quote(figure.x_label) << "\n";
     script << "set ylabel " << Quote(figure.y_label) << "\n";
-    script << "set grid\nset key top right box opaque\nset offsets 0, 0, graph 0.05, graph 0.05\n";
+    script << "set grid\nset key " << figure.key << "\nset offsets 0, 0, graph 0.05, graph 0.05\n";
     if (figure.log_y) script << "set logscale y\nset format y '%.0e'\n";
+    if (figure.log_x) script << "set logscale x\nset format x '%g'\n";
+    if (!figure.x_range.empty()) script << "set xrange " << figure.x_range << "\n";
+    if (!figure.y_range.empty()) script << "set yrange " << figure.y_range << "\n";
+    if (figure.pad_x) script << "set offsets graph 0.03, graph 0.03, graph 0.05, graph 0.05\n";
     script << "plot ";
     for (size_t k = 0; k < figure.series.size(); ++k) {
       if (k > 0) script << ", \\\n     ";

@@ -17,6 +17,16 @@ Eigen::VectorXd ModeField(const std::vector<model::Mode>& modes,
 
 void WriteTruth(H5Writer& file, const model::MechanicalModel& model,
                 const simulation::SimulationResult& result) {
+  WriteModelTruth(file, model);
+  file.WriteVector("/truth", "initial_q", result.initial_q, "rad");
+  file.WriteStrings("/truth", "coordinates", model.coordinate_names());
+  for (int c = 0; c < result.exact.channel_count(); ++c) {
+    file.WriteVector("/truth/exact", result.exact.channels[c], result.exact.values.col(c),
+                     result.exact.units[c]);
+  }
+}
+
+void WriteModelTruth(H5Writer& file, const model::MechanicalModel& model) {
   for (const model::Parameter& parameter : model.parameters()) {
     file.WriteScalar("/truth/parameters", parameter.name, parameter.value, parameter.units);
   }
@@ -38,13 +48,6 @@ void WriteTruth(H5Writer& file, const model::MechanicalModel& model,
   file.WriteVector("/truth/modes", "undamped_frequency_hz",
                    ModeField(modes, &model::Mode::undamped_frequency_hz), "Hz");
   file.WriteVector("/truth/modes", "half_life_s", ModeField(modes, &model::Mode::half_life_s), "s");
-
-  file.WriteVector("/truth", "initial_q", result.initial_q, "rad");
-  file.WriteStrings("/truth", "coordinates", model.coordinate_names());
-  for (int c = 0; c < result.exact.channel_count(); ++c) {
-    file.WriteVector("/truth/exact", result.exact.channels[c], result.exact.values.col(c),
-                     result.exact.units[c]);
-  }
 }
 
 void WriteSimulationInfo(H5Writer& file, const simulation::Excitation& excitation,

@@ -24,8 +24,11 @@ Scenario LoadScenario(const std::string& path) {
   if (!in) throw InputError(path, "", "cannot open the scenario file", "a readable YAML file");
   std::stringstream text;
   text << in.rdbuf();
-  Scenario scenario{path,  "", text.str(), YamlReader::FromString(text.str(), path),
-                    false, {}, {},         {}};
+  return LoadScenarioFromText(text.str(), path);
+}
+
+Scenario LoadScenarioFromText(const std::string& text, const std::string& source) {
+  Scenario scenario{source, "", text, YamlReader::FromString(text, source), false, {}, {}, {}};
   if (!scenario.root.IsMap()) scenario.root.Fail("not a mapping", "a YAML mapping of sections");
   scenario.root.ExpectMap(
       {"name", "model", "excitation", "simulation", "sensors", "identification", "updating"});

@@ -19,6 +19,13 @@ int RunModesCommand(const std::string& scenario_path, const CommonOptions& commo
 int RunSimulateCommand(const std::string& scenario_path, const std::string& output_path,
                        const CommonOptions& common);
 
+// `mbid campaign CAMPAIGN.yaml -o DIR [--workers N] [--resume]`: runs a campaign of virtual
+// tests (or a design study) into DIR (docs/campaigns.md); under `mpirun -n K` the cases are
+// spread over the ranks. `workers` = 0 chooses one per hardware thread (one per rank under
+// MPI). Returns the exit code.
+int RunCampaignCommand(const std::string& campaign_path, const std::string& output_dir, int workers,
+                       bool resume, const CommonOptions& common);
+
 // `mbid identify DATA [options] [-o FILE.h5] [--json FILE]`: the modes of a free-decay record.
 int RunIdentifyCommand(const std::string& data_path,
                        const identification::IdentificationOptions& options,

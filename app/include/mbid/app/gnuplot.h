@@ -22,6 +22,10 @@ struct Figure {
   std::string y_label;
   std::vector<PlotSeries> series;
   bool log_y = false;
+  bool log_x = false;
+  bool pad_x = false;  // leave a margin at both ends of x (points on the edges stay visible)
+  std::string key = "top right box opaque";  // gnuplot `set key` options
+  std::string x_range, y_range;              // gnuplot ranges ("[0:*]"); empty = automatic
   int width_px = 1000;
   int height_px = 420;
 };

@@ -16,6 +16,10 @@ namespace mbid::app {
 void WriteTruth(H5Writer& file, const model::MechanicalModel& model,
                 const simulation::SimulationResult& result);
 
+// The model's part of /truth alone (parameters, linear model, exact modes): what a campaign case
+// that does not simulate keeps. WriteTruth writes it too.
+void WriteModelTruth(H5Writer& file, const model::MechanicalModel& model);
+
 // /simulation: excitation type, forcing end, integrator settings and statistics.
 void WriteSimulationInfo(H5Writer& file, const simulation::Excitation& excitation,
                          const simulation::SimulationOptions& options,

@@ -30,6 +30,10 @@ struct Scenario {
 
 Scenario LoadScenario(const std::string& path);
 
+// The same from scenario text already in memory (a campaign's case); `source` names it in errors
+// and becomes Scenario::path.
+Scenario LoadScenarioFromText(const std::string& text, const std::string& source);
+
 // The built-in reference scenario: scenarios/reference-crane.yaml of the source tree, or of the
 // installed share directory.
 std::string DefaultScenarioPath();

@@ -1,0 +1,63 @@
+#pragma once
+
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <optional>
+
+namespace mbid::app::internal {
+
+// The case indices waiting for this process's worker threads. The main thread pushes (all at
+// once, or on demand when cases come from another MPI rank) and closes; workers pop, blocking
+// until a case comes or the queue is closed and empty. Every change wakes the main thread
+// through `main_wakeup`, so that it can fetch more work or report progress at once.
+class WorkQueue {
+ public:
+  explicit WorkQueue(std::condition_variable& main_wakeup) : main_wakeup_(main_wakeup) {}
+
+  void Push(int index) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      queue_.push_back(index);
+    }
+    workers_.notify_one();
+  }
+  void Close() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closed_ = true;
+    }
+    workers_.notify_all();
+  }
+  // The next case, or nothing when the queue is closed and empty.
+  std::optional<int> Pop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ++waiting_;
+    main_wakeup_.notify_all();
+    workers_.wait(lock, [this] { return !queue_.empty() || closed_; });
+    --waiting_;
+    if (queue_.empty()) return std::nullopt;
+    const int index = queue_.front();
+    queue_.pop_front();
+    return index;
+  }
+  // Workers waiting beyond the cases already queued: how many more cases to fetch now.
+  int Hungry() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return closed_ ? 0 : waiting_ - static_cast<int>(queue_.size());
+  }
+  bool closed() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return closed_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable workers_;
+  std::condition_variable& main_wakeup_;
+  std::deque<int> queue_;
+  int waiting_ = 0;
+  bool closed_ = false;
+};
+
+}  // namespace mbid::app::internal

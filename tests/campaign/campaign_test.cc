@@ -1,0 +1,264 @@
+// The campaign library: sweeps, key paths, seeds, the settling time, polynomial laws with their
+// uncertainty, and damper sizing on the one-joint oscillator whose damping ratio is analytic.
+#include "mbid/app/campaign.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <set>
+#include <string>
+
+#include "mbid/app/campaign_case.h"
+#include "mbid/app/campaign_runner.h"
+#include "mbid/app/damper_sizing.h"
+#include "mbid/app/laws.h"
+#include "mbid/common/error.h"
+#include "mbid/common/hdf5_io.h"
+
+namespace mbid::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh folder per test.
+class CampaignTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("mbid_campaign_lib_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Write(const std::string& name, const std::string& text) const {
+    const fs::path path = dir_ / name;
+    std::ofstream(path) << text;
+    return path.string();
+  }
+
+  fs::path dir_;
+};
+
+// J = 4 kg*m^2, c = 100 N*m/rad: damping ratio zeta = d / (2 sqrt(c J)) = d / 40, so the
+// smallest d with zeta >= 0.1 is 2 * 0.1 * sqrt(100 * 4) = 4 N*m*s/rad.
+constexpr char kOscillator[] = R"(name: oscillator
+model:
+  type: torsional_oscillator
+  inertia_kgm2: 4.0
+  joints:
+    angle: {stiffness_Nm_per_rad: 100.0, damping_Nms_per_rad: 1.0}
+excitation:
+  type: initial_deflection
+  deflection_rad: {angle: 0.01}
+simulation:
+  duration_s: 2
+sensors:
+  sample_rate_hz: 20
+  channels: [angle]
+)";
+
+TEST_F(CampaignTest, GridListAndRepeatMultiply) {
+  Write("oscillator.yaml", kOscillator);
+  const Campaign campaign = LoadCampaign(Write("c.yaml", R"(name: c
+base: oscillator.yaml
+sweep:
+  - grid:
+      model.inertia_kgm2: [1, 2, 3]
+      model.joints.angle.stiffness_Nm_per_rad: [100, 200]
+  - list:
+      sensors.noise_std_rad: [0, 1.0e-4]
+      excitation.deflection_rad.angle: [0.01, 0.02]
+  - repeat: 2
+)"));
+  ASSERT_EQ(campaign.cases.size(), 3u * 2 * 2 * 2);  // grid 3 x 2, list of 2, 2 repeats
+  EXPECT_EQ(
+      campaign.swept_keys,
+      (std::vector<std::string>{"model.inertia_kgm2", "model.joints.angle.stiffness_Nm_per_rad",
+                                "sensors.noise_std_rad", "excitation.deflection_rad.angle"}));
+  // Last factor fastest: cases 0-1 are the repeats, 0-3 the list, then the grid's last key.
+  const auto value = [&](int c, int k) {
+    return campaign.cases[static_cast<size_t>(c)].inputs[static_cast<size_t>(k)].value.Scalar();
+  };
+  EXPECT_EQ(value(0, 0), "1");
+  EXPECT_EQ(value(0, 1), "100");
+  EXPECT_EQ(value(2, 2), "1.0e-4");  // the campaign file's text, unchanged
+  EXPECT_EQ(value(4, 1), "200");
+  EXPECT_EQ(value(8, 0), "2");
+  EXPECT_EQ(campaign.cases[5].id, "case_0005");
+  // Repeats differ by their derived sensor seeds only.
+  EXPECT_NE(campaign.cases[0].sensor_seed, campaign.cases[1].sensor_seed);
+  const std::string text = campaign.CaseScenarioText(campaign.cases[3]);
+  EXPECT_NE(text.find("name: c-case_0003"), std::string::npos) << text;
+  EXPECT_NE(text.find("angle: 0.02"), std::string::npos) << text;
+  EXPECT_NE(text.find("noise_std_rad: 1.0e-4"), std::string::npos) << text;
+}
+
+TEST_F(CampaignTest, LatinHypercubePutsOneSampleInEachStratumAndIsSeeded) {
+  Write("oscillator.yaml", kOscillator);
+  const auto load = [&](int seed) {
+    return LoadCampaign(
+        Write("lhs.yaml", "name: lhs\nbase: oscillator.yaml\nseed: " + std::to_string(seed) + R"(
+sweep:
+  - latin_hypercube:
+      samples: 10
+      ranges:
+        model.inertia_kgm2: [1, 3]
+        model.joints.angle.stiffness_Nm_per_rad: {min: 10, max: 1000, scale: log}
+)"));
+  };
+  const Campaign a = load(7), b = load(7), c = load(8);
+  ASSERT_EQ(a.cases.size(), 10u);
+  std::set<int> strata_linear, strata_log;
+  for (size_t i = 0; i < 10; ++i) {
+    const double inertia = std::stod(a.cases[i].inputs[0].value.Scalar());
+    const double stiffness = std::stod(a.cases[i].inputs[1].value.Scalar());
+    // Strata of width (3 - 1) / 10 and, in log10, (3 - 1) / 10 decades.
+    strata_linear.insert(static_cast<int>(std::floor((inertia - 1) / 0.2)));
+    strata_log.insert(static_cast<int>(std::floor((std::log10(stiffness) - 1) / 0.2)));
+    EXPECT_EQ(a.cases[i].inputs[0].value.Scalar(), b.cases[i].inputs[0].value.Scalar());
+  }
+  EXPECT_EQ(strata_linear.size(), 10u);  // one sample in each of the 10 strata
+  EXPECT_EQ(strata_log.size(), 10u);
+  EXPECT_NE(a.cases[0].inputs[0].value.Scalar(), c.cases[0].inputs[0].value.Scalar());
+  EXPECT_NE(a.cases[0].sensor_seed, c.cases[0].sensor_seed);
+}
+
+TEST_F(CampaignTest, AssignmentsCreateMapsAndIndexLists) {
+  YAML::Node tree = YAML::Load("model: {base: {com_m: [1, 2, 3]}}\n");
+  const YamlReader where(YAML::Node(), "c.yaml", "");
+  ApplyAssignment(tree, {"model.base.com_m[2]", YAML::Node("4.5"), "sweep[0].grid.x"}, where);
+  ApplyAssignment(tree, {"sensors.seed", YAML::Node("9"), "set.sensors.seed"}, where);
+  EXPECT_EQ(tree["model"]["base"]["com_m"][2].Scalar(), "4.5");
+  EXPECT_EQ(tree["sensors"]["seed"].Scalar(), "9");
+  try {
+    ApplyAssignment(tree, {"model.base.com_m[3]", YAML::Node("1"), "sweep[0].grid.y"}, where);
+    FAIL() << "an index past the list's end must fail";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.source(), "c.yaml");
+    EXPECT_EQ(error.field(), "sweep[0].grid.y");
+  }
+}
+
+TEST_F(CampaignTest, SettlingTimeOfAnExponentialDecay) {
+  // y = exp(-t) sampled at 0.01 s: |y| <= 0.02 max|y| from t = ln 50 = 3.912 s, i.e. the first
+  // sample after the last one outside the band is t = 3.92 s.
+  Measurement record;
+  record.channels = {"angle"};
+  record.units = {"rad"};
+  record.sample_interval_s = 0.01;
+  record.values.resize(1001, 1);
+  for (int j = 0; j <= 1000; ++j) record.values(j, 0) = std::exp(-0.01 * j);
+  EXPECT_NEAR(CalcSettlingTime(record, 0.0, 0.02, 0.0), 3.92, 1e-9);
+  // An absolute band of 1e-3: exp(-t) <= 1e-3 from t = ln 1000 = 6.908 s.
+  EXPECT_NEAR(CalcSettlingTime(record, 0.0, 0.02, 1e-3), 6.91, 1e-9);
+  // Measured from a forcing's end at 1 s (the band is relative to the peak after it).
+  EXPECT_NEAR(CalcSettlingTime(record, 1.0, 0.02, 0.0), 3.92, 1e-9);
+  // A band never reached within the record.
+  EXPECT_TRUE(std::isinf(CalcSettlingTime(record, 0.0, 0.02, 1e-6)));
+}
+
+TEST_F(CampaignTest, LawOfAStraightLineHasTheTextbookUncertainty) {
+  // y = 3 + 0.5 x + noise at x = 0..19: the least-squares slope has std s / sqrt(Sxx) and the
+  // intercept s sqrt(1/N + mean(x)^2 / Sxx), s^2 = RSS / (N - 2).
+  const int n = 20;
+  Eigen::MatrixXd x(n, 1);
+  Eigen::VectorXd y(n);
+  std::mt19937_64 generator(3);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  for (int i = 0; i < n; ++i) {
+    x(i, 0) = i;
+    y[i] = 3 + 0.5 * i + noise(generator);
+  }
+  const PolynomialLaw law =
+      FitPolynomialLaw(x, y, 1, {"model.configuration.boom_elevation_deg"}, "truth.c_theta");
+  ASSERT_EQ(law.status, "ok");
+  const double mean_x = 9.5;
+  const double sxx = (x.col(0).array() - mean_x).square().sum();
+  const double slope = ((x.col(0).array() - mean_x) * (y.array() - y.mean())).sum() / sxx;
+  const double intercept = y.mean() - slope * mean_x;
+  const double s =
+      std::sqrt((y.array() - intercept - slope * x.col(0).array()).square().sum() / (n - 2));
+  // Closed form vs the scaled SVD fit expanded to raw coefficients: equal to round-off.
+  EXPECT_NEAR(law.coefficients[0], intercept, 1e-12);
+  EXPECT_NEAR(law.coefficients[1], slope, 1e-13);
+  EXPECT_NEAR(law.residual_std, s, 1e-13);
+  EXPECT_NEAR(law.std[1], s / std::sqrt(sxx), 1e-13);
+  EXPECT_NEAR(law.std[0], s * std::sqrt(1.0 / n + mean_x * mean_x / sxx), 1e-13);
+  EXPECT_EQ(law.TermName(1), "boom_elevation_deg");
+  // The fitted value's std at the mean of x is s / sqrt(N).
+  EXPECT_NEAR(law.CalcStd(Eigen::VectorXd::Constant(1, mean_x)), s / std::sqrt(n), 1e-13);
+}
+
+TEST_F(CampaignTest, LawRecoversAnExactQuadraticInTwoVariables) {
+  // c = 1e6 + 2e4 e - 50 e^2 + 3 m + 0.1 e m over a 4 x 3 grid of elevation e (deg) and payload
+  // m (kg): the degree-2 law has all six terms and must reproduce them to round-off
+  // (relative 1e-9 of the largest term).
+  std::vector<Eigen::Vector2d> points;
+  for (double e : {10.0, 30.0, 50.0, 70.0}) {
+    for (double m : {0.0, 500.0, 1000.0}) points.emplace_back(e, m);
+  }
+  Eigen::MatrixXd x(static_cast<Eigen::Index>(points.size()), 2);
+  Eigen::VectorXd y(x.rows());
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const double e = points[static_cast<size_t>(i)][0], m = points[static_cast<size_t>(i)][1];
+    x.row(i) << e, m;
+    y[i] = 1e6 + 2e4 * e - 50 * e * e + 3 * m + 0.1 * e * m;
+  }
+  const PolynomialLaw law = FitPolynomialLaw(x, y, 2, {"e", "m"}, "truth.c_theta");
+  ASSERT_EQ(law.status, "ok");
+  // Terms: 1, e, m, e^2, e*m, m^2.
+  const Eigen::VectorXd expected = (Eigen::VectorXd(6) << 1e6, 2e4, 3, -50, 0.1, 0).finished();
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_NEAR(law.coefficients[j], expected[j], 1e-9 * 1e6) << law.TermName(j);
+  }
+  EXPECT_NEAR(law.r_squared, 1.0, 1e-12);
+  // Too few distinct payloads for the degree: not determined, said so.
+  const PolynomialLaw flat = FitPolynomialLaw(x.topRows(3).replicate(2, 1).eval(),
+                                              y.head(3).replicate(2, 1).eval(), 2, {"e", "m"}, "q");
+  EXPECT_NE(flat.status, "ok");
+}
+
+TEST_F(CampaignTest, DamperSizingFindsTheAnalyticSmallestDamper) {
+  Write("oscillator.yaml", kOscillator);
+  // The sweep 0.5..20 (log, 11 points) brackets d = 4 between 3.16 and 4.57; bisection to a
+  // relative 1e-9 must land within 1e-8 of it (4 * 1e-9 plus the eigenvalue round-off).
+  const Campaign campaign = LoadCampaign(Write("sizing.yaml", R"(name: sizing
+base: oscillator.yaml
+study: damper_sizing
+damper_sizing:
+  joints: [angle]
+  range_Nms_per_rad: [0.5, 20]
+  points: 11
+  relative_tolerance: 1.0e-9
+  targets:
+    min_damping_ratio: 0.1
+)"));
+  EXPECT_FALSE(campaign.steps.simulate);  // the damping ratio needs the modes alone
+  ASSERT_EQ(campaign.cases.size(), 11u);
+  CampaignRunOptions options;
+  options.workers = 2;
+  options.quiet = true;
+  const std::string out = (dir_ / "out").string();
+  const CampaignRunSummary summary = RunCampaign(campaign, out, options);
+  EXPECT_EQ(summary.failed, 0);
+  const H5Reader file(out + "/campaign.h5");
+  const Eigen::VectorXd smallest = file.ReadVector("/damper_sizing/angle", "smallest_Nms_per_rad");
+  ASSERT_EQ(smallest.size(), 1);
+  EXPECT_NEAR(smallest[0], 2 * 0.1 * std::sqrt(100.0 * 4.0), 1e-8);
+  // The curve is the closed form at every sweep point.
+  const Eigen::VectorXd d = file.ReadVector("/damper_sizing/angle", "damping_Nms_per_rad");
+  const Eigen::VectorXd zeta = file.ReadVector("/damper_sizing/angle", "min_damping_ratio");
+  for (Eigen::Index i = 0; i < d.size(); ++i) {
+    // d up to 20 < 2 sqrt(cJ) = 40: underdamped, zeta = d / 40 to eigenvalue round-off.
+    EXPECT_NEAR(zeta[i], d[i] / 40.0, 1e-12) << "d = " << d[i];
+  }
+}
+
+}  // namespace
+}  // namespace mbid::app
