@@ -11,10 +11,12 @@
 #include "mbid/app/gnuplot.h"
 #include "mbid/app/json_summaries.h"
 #include "mbid/app/result_writers.h"
+#include "mbid/app/run_report.h"
 #include "mbid/app/scenario.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
+#include "mbid/identification/identify.h"
 
 namespace mbid::app {
 namespace {
@@ -69,20 +71,6 @@ class StagingFolder {
   bool committed_ = false;
 };
 
-Figure RecordFigure(const Measurement& measured, const Measurement& exact, int channel) {
-  Figure figure;
-  figure.title = fmt::format("Simulated test: {} (sensor record and exact model output)",
-                             measured.channels[channel]);
-  figure.x_label = "time, s";
-  figure.y_label = fmt::format("{}, {}", measured.channels[channel], measured.units[channel]);
-  const Eigen::VectorXd t = measured.CalcTime();
-  figure.series.push_back({"record (with sensor noise)", t, measured.values.col(channel),
-                           "points pt 7 ps 0.35 lc rgb '#1f77b4'"});
-  figure.series.push_back(
-      {"exact model output", t, exact.values.col(channel), "lines lw 1.5 lc rgb '#d62728'"});
-  return figure;
-}
-
 }  // namespace
 
 int RunValidationCycle(const std::string& scenario_path, const std::string& output_dir,
@@ -113,9 +101,16 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   WriteTruth(run, *model, test);
   WriteSimulationInfo(run, excitation, scenario.simulation, test);
 
-  // Identification, updating and the re-simulation join here as those layers land; until then
-  // the run says so instead of reporting anything it did not compute.
-  const std::vector<std::string> not_available{"identification", "updating", "validation"};
+  const identification::IdentificationOptions identify_options;
+  const identification::ModalResult identified =
+      identification::Identify(test.measured, identify_options, scenario_path);
+  identification::WriteModalResult(run, identified);
+  progress.Say(fmt::format("identified {} modes ({}), K = {:.3f}", identified.modes.size(),
+                           identified.method, identified.correlation.minCoeff()));
+
+  // Updating and the re-simulation join here when that layer lands; until then the run says so
+  // instead of reporting anything it did not compute.
+  const std::vector<std::string> not_available{"updating", "validation"};
 
   nlohmann::json summary{{"scenario", scenario.name},
                          {"simulation",
@@ -125,19 +120,27 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
                            {"channels", test.measured.channels},
                            {"integrator", IntegratorStatisticsToJson(test.statistics)}}},
                          {"model", LinearModelToJson(linear, exact_modes)},
+                         {"identification", identification::ModalResultToJson(identified)},
                          {"not_available", not_available}};
 
-  std::vector<std::string> figures;
+  std::vector<std::string> record_figures, identification_figures;
   if (GnuplotAvailable()) {
+    const std::string dir = (folder / "").string();
     for (int c = 0; c < test.measured.channel_count(); ++c) {
-      const std::string name = fmt::format("record_{}.png", test.measured.channels[c]);
-      DrawFigure(RecordFigure(test.measured, test.exact, c), (folder / name).string());
-      figures.push_back(name);
+      record_figures.push_back(DrawRecordFigure(dir, test.measured, &test.exact, c));
     }
-    progress.Say(fmt::format("drew {} figures", figures.size()));
+    identification_figures.push_back(DrawSpectrumFigure(dir, identified));
+    for (int c = 0; c < static_cast<int>(identified.channels.size()); ++c) {
+      identification_figures.push_back(DrawReconstructionFigure(dir, test.measured, identified, c));
+    }
+    const std::string stabilization = DrawStabilizationFigure(dir, identified);
+    if (!stabilization.empty()) identification_figures.push_back(stabilization);
+    progress.Say(
+        fmt::format("drew {} figures", record_figures.size() + identification_figures.size()));
   } else {
     progress.Say("gnuplot with pngcairo not found: the report has no figures");
   }
+  const size_t figure_count = record_figures.size() + identification_figures.size();
 
   {
     std::ofstream report(folder / "report.md");
@@ -147,19 +150,19 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
         "channels {}.\n\n",
         scenario_path, model->type(), excitation.type_name(), test.measured.samples(),
         1.0 / test.measured.sample_interval_s, fmt::join(test.measured.channels, ", "));
-    report << "## Exact modes of the model (linearized at the unloaded rest)\n\n";
-    report << "| mode | frequency, Hz | decay rate, 1/s | damping ratio | half-life, s |\n";
-    report << "|---|---|---|---|---|\n";
-    for (size_t k = 0; k < exact_modes.size(); ++k) {
-      report << fmt::format("| {} | {:.4f} | {:.4f} | {:.4f} | {:.4f} |\n", k + 1,
-                            exact_modes[k].frequency_hz(), exact_modes[k].decay_rate_per_s(),
-                            exact_modes[k].damping_ratio(), exact_modes[k].half_life_s());
+    report << "## The test record\n\n";
+    for (const std::string& figure : record_figures) {
+      report << "![" << figure << "](" << figure << ")\n\n";
     }
-    report << "\n## The simulated test\n\n";
-    for (const std::string& figure : figures) report << "![" << figure << "](" << figure << ")\n\n";
+    report << "## Identified modes (the paper's Table 1), with the model's exact modes\n\n";
+    report << ModalTableMarkdown(identified, &exact_modes) << "\n";
+    for (const std::string& warning : identified.warnings) report << "> " << warning << "\n\n";
+    for (const std::string& figure : identification_figures) {
+      report << "![" << figure << "](" << figure << ")\n\n";
+    }
     report << "## Not in this build\n\n"
-           << "Identification, model updating and the re-simulation are not available yet: this "
-              "report shows the simulated test and the model's exact modes only.\n";
+           << "Model updating and the re-simulation with tuned parameters are not available yet: "
+              "this report stops at the identified modes.\n";
   }
   WriteJson(summary, (folder / "summary.json").string());
   run.Commit();
@@ -167,7 +170,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   progress.Say(
       fmt::format("wrote {}/ (run.h5, summary.json, report.md, {} figures); not yet "
                   "available: {}",
-                  final_dir.string(), figures.size(), fmt::join(not_available, ", ")));
+                  final_dir.string(), figure_count, fmt::join(not_available, ", ")));
   return 0;
 }
 

@@ -6,6 +6,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include "internal.h"
@@ -60,6 +61,7 @@ struct Estimate {
   Eigen::VectorXd weights;  // per channel, for the covariance on the decimated record
   AmplitudeFit fit;         // on the decimated record, for the poles in `lambda`
   std::string termination = "converged";
+  std::string termination_message;
   int iterations = 0;
   std::vector<StabilizationOrder> stabilization;
   std::vector<std::string> warnings;
@@ -180,6 +182,17 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
   const int max_order = 2 * options.max_modes + 1;  // + 1: a constant or real pole
   const HankelSvd hankel(values, columns, max_order);
 
+  // Continuous poles per order, each computed once (the stabilization data and the stability
+  // check ask for the same orders).
+  std::map<int, Poles> poles_by_order;
+  const auto poles_at = [&](int order) -> const Poles& {
+    auto found = poles_by_order.find(order);
+    if (found == poles_by_order.end()) {
+      found = poles_by_order.emplace(order, ToContinuous(hankel.CalcPoles(order), tau)).first;
+    }
+    return found->second;
+  };
+
   Estimate estimate;
   estimate.model_order = columns - 1;
   const int order = hankel.CountSignal(options.hankel.noise_floor_factor,
@@ -187,9 +200,7 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
   estimate.effective_rank = order;
   if (options.compute_stabilization) {
     const int highest = AutoStabilizationOrder(options, order, columns - 2);
-    for (int m = 1; m <= highest; ++m) {
-      estimate.stabilization.push_back(UpperHalf(m, ToContinuous(hankel.CalcPoles(m), tau)));
-    }
+    for (int m = 1; m <= highest; ++m) estimate.stabilization.push_back(UpperHalf(m, poles_at(m)));
     MarkStable(&estimate.stabilization, options.hankel.stability_tolerance);
   }
   if (order == 0) {
@@ -202,7 +213,7 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
 
   // Candidates: upper-half poles at the signal order inside the step-5 limits, stable across
   // the next orders.
-  const Poles poles = ToContinuous(hankel.CalcPoles(order), tau);
+  const Poles& poles = poles_at(order);
   int unstable = 0;
   for (const auto& lambda : poles) {
     if (lambda.imag() <= 0 || !PassesFilter(lambda, options, record.max_frequency_hz)) continue;
@@ -210,8 +221,7 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
     for (int s = 1; s <= options.hankel.stability_orders; ++s) {
       const int higher = order + 2 * s;
       if (higher >= columns - 1) break;
-      stable = stable && HasMatch(lambda, ToContinuous(hankel.CalcPoles(higher), tau),
-                                  options.hankel.stability_tolerance);
+      stable = stable && HasMatch(lambda, poles_at(higher), options.hankel.stability_tolerance);
     }
     if (stable) {
       estimate.lambda.push_back(lambda);
@@ -265,6 +275,7 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
         }
       }
       e->termination = summary.termination;
+      e->termination_message = summary.message;
       e->iterations += summary.iterations;
       e->lambda = summary.model.lambda;
       const int left = DropModes(&e->lambda, [&](size_t k) {
@@ -283,7 +294,8 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
   refine(&estimate);
   SelectSignificant(record, options, &estimate, refine);
   if (estimate.termination == "failure") {
-    throw NumericalError("Ceres", "the refinement of the poles failed");
+    throw NumericalError("Ceres",
+                         "the refinement of the poles failed: " + estimate.termination_message);
   }
   if (estimate.termination == "no_convergence") {
     estimate.warnings.push_back(fmt::format(

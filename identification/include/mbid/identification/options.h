@@ -54,8 +54,9 @@ struct PronySvdOptions {
 // The block-Hankel SVD (matrix pencil) initialization of the default method.
 struct HankelOptions {
   // Columns of each channel's Hankel matrix: min(samples / 3, max_columns). More columns
-  // separate close modes better but cost O(columns^3); the refinement removes most of the
-  // estimation error that fewer columns leave.
+  // detect weak modes and separate close ones better but cost O(columns^3); the refinement
+  // removes the estimation error that fewer columns leave. On the paper's record at 20 dB,
+  // 80 columns miss a mode in 12 % of the records, 100 in none of 200.
   int max_columns = 100;
   // A singular value is signal if its square exceeds this factor times the largest that white
   // noise gives: the noise floor (median of the trailing squared singular values of the
@@ -73,8 +74,9 @@ struct HankelOptions {
 // The Ceres refinement of the default method.
 struct RefinementOptions {
   int max_iterations = 100;
-  // Ceres: relative change of the cost. At 1e-10 the remaining parameter change is below 1e-3
-  // of its standard deviation for records up to 1e6 samples.
+  // Ceres: relative change of the cost. At 1e-10 the parameters stop within about
+  // 1e-5 sqrt(samples * channels) of their standard deviation from the optimum (5e-4 for
+  // 2 x 1000 samples).
   double function_tolerance = 1e-10;
   double parameter_tolerance = 1e-10;  // Ceres: relative change of the parameters
   double gradient_tolerance = 1e-14;   // Ceres: max norm of the projected gradient

@@ -1,0 +1,190 @@
+#include "mbid/app/run_report.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "mbid/app/gnuplot.h"
+
+namespace mbid::app {
+namespace {
+
+std::string Path(const std::string& folder, const std::string& name) {
+  return (std::filesystem::path(folder) / name).string();
+}
+
+const char* kRecordStyle = "points pt 7 ps 0.35 lc rgb '#1f77b4'";
+
+}  // namespace
+
+std::string DrawRecordFigure(const std::string& folder, const Measurement& measured,
+                             const Measurement* exact, int channel) {
+  Figure figure;
+  const std::string& name = measured.channels[channel];
+  figure.title = fmt::format("Test record: {}", name);
+  figure.x_label = "time, s";
+  figure.y_label = fmt::format("{}, {}", name, measured.units[channel]);
+  const Eigen::VectorXd t = measured.CalcTime();
+  figure.series.push_back({"record", t, measured.values.col(channel), kRecordStyle});
+  if (exact != nullptr) {
+    figure.series.push_back({"exact model output (no sensor errors)", t, exact->values.col(channel),
+                             "lines lw 1.5 lc rgb '#d62728'"});
+  }
+  const std::string file = fmt::format("record_{}.png", name);
+  DrawFigure(figure, Path(folder, file));
+  return file;
+}
+
+std::string DrawSpectrumFigure(const std::string& folder,
+                               const identification::ModalResult& result) {
+  Figure figure;
+  figure.title = "Amplitude spectra (step 1), identified frequencies marked";
+  figure.x_label = "frequency, Hz";
+  figure.y_label = fmt::format("amplitude, {}", result.units.empty() ? "rad" : result.units[0]);
+  figure.log_y = true;
+  // Up to twice the highest identified frequency (at least 5 Hz), within the spectrum.
+  double f_max = 5.0;
+  for (const auto& mode : result.modes) f_max = std::max(f_max, 2 * mode.frequency_hz);
+  const Eigen::VectorXd& f = result.spectrum.frequency_hz;
+  Eigen::Index bins = 0;
+  while (bins < f.size() && f[bins] <= f_max) ++bins;
+  const char* colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
+  double floor = std::numeric_limits<double>::infinity(), top = 0;
+  for (size_t c = 0; c < result.channels.size(); ++c) {
+    // Bin 0 holds the offset; the log axis starts above the smallest positive amplitude.
+    Eigen::VectorXd a = result.spectrum.amplitude.col(static_cast<Eigen::Index>(c)).head(bins);
+    for (Eigen::Index i = 1; i < bins; ++i) {
+      if (a[i] > 0) floor = std::min(floor, a[i]);
+      top = std::max(top, a[i]);
+    }
+    figure.series.push_back({result.channels[c], f.segment(1, bins - 1), a.segment(1, bins - 1),
+                             fmt::format("lines lw 1.3 lc rgb '{}'", colors[c % 4])});
+  }
+  for (size_t k = 0; k < result.modes.size(); ++k) {
+    const double fk = result.modes[k].frequency_hz;
+    Eigen::VectorXd x(2), y(2);
+    x << fk, fk;
+    y << std::max(floor, top * 1e-6), top;
+    figure.series.push_back(
+        {k == 0 ? "identified modes" : "", x, y, "lines dt 2 lw 1 lc rgb '#555555'"});
+  }
+  DrawFigure(figure, Path(folder, "spectrum.png"));
+  return "spectrum.png";
+}
+
+std::string DrawReconstructionFigure(const std::string& folder, const Measurement& measured,
+                                     const identification::ModalResult& result, int channel) {
+  Figure figure;
+  const std::string& name = result.channels[channel];
+  const int column = measured.FindChannel(name);
+  figure.title = fmt::format("{}: record and modal reconstruction (K = {:.4f})", name,
+                             result.correlation[channel]);
+  figure.x_label = "time, s";
+  figure.y_label = fmt::format("{}, {}", name, result.units[channel]);
+  const Eigen::VectorXd t_all = measured.CalcTime();
+  const int first = static_cast<int>(
+      std::lround((result.start_time_s - measured.start_time_s) / measured.sample_interval_s));
+  const Eigen::VectorXd t = t_all.segment(first, result.samples);
+  figure.series.push_back(
+      {"record", t, measured.values.col(column).segment(first, result.samples), kRecordStyle});
+  figure.series.push_back({fmt::format("reconstruction ({} modes)", result.modes.size()), t,
+                           result.reconstruction.col(channel), "lines lw 1.5 lc rgb '#d62728'"});
+  const std::string file = fmt::format("reconstruction_{}.png", name);
+  DrawFigure(figure, Path(folder, file));
+  return file;
+}
+
+std::string DrawStabilizationFigure(const std::string& folder,
+                                    const identification::ModalResult& result) {
+  Figure figure;
+  figure.title = "Stabilization diagram: poles per model order (identified modes dashed)";
+  figure.x_label = "frequency, Hz";
+  figure.y_label = "model order";
+  // The band of the identified modes: up to twice the highest (at least 5 Hz).
+  double f_max = 5.0;
+  for (const auto& mode : result.modes) f_max = std::max(f_max, 2 * mode.frequency_hz);
+  std::vector<double> fs, os, fu, ou;
+  for (const auto& order : result.stabilization) {
+    for (size_t k = 0; k < order.lambda.size(); ++k) {
+      const double f = order.lambda[k].imag() / (2 * M_PI);
+      if (f <= 0 || f > f_max) continue;
+      (order.stable[k] ? fs : fu).push_back(f);
+      (order.stable[k] ? os : ou).push_back(order.order);
+    }
+  }
+  auto to_vector = [](const std::vector<double>& v) {
+    return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+  };
+  if (!fu.empty()) {
+    figure.series.push_back(
+        {"pole", to_vector(fu), to_vector(ou), "points pt 6 ps 0.6 lc rgb '#999999'"});
+  }
+  if (!fs.empty()) {
+    figure.series.push_back(
+        {"stable pole", to_vector(fs), to_vector(os), "points pt 7 ps 0.6 lc rgb '#1f77b4'"});
+  }
+  for (size_t k = 0; k < result.modes.size(); ++k) {
+    Eigen::VectorXd x(2), y(2);
+    x << result.modes[k].frequency_hz, result.modes[k].frequency_hz;
+    double lowest = 1e9, highest = 0;
+    for (const auto& order : result.stabilization) {
+      lowest = std::min<double>(lowest, order.order);
+      highest = std::max<double>(highest, order.order);
+    }
+    y << lowest, highest;
+    figure.series.push_back(
+        {k == 0 ? "identified modes" : "", x, y, "lines dt 2 lc rgb '#d62728'"});
+  }
+  if (figure.series.empty()) return "";
+  DrawFigure(figure, Path(folder, "stabilization.png"));
+  return "stabilization.png";
+}
+
+std::string ModalTableMarkdown(const identification::ModalResult& result,
+                               const std::vector<model::Mode>* exact) {
+  std::ostringstream out;
+  out << "| k | frequency, Hz | beta, 1/s | half-life ln2/beta, s | damping ratio |";
+  for (const std::string& channel : result.channels) out << " A_" << channel << ", rad |";
+  out << " mean A, rad |";
+  if (exact != nullptr) out << " exact: frequency, Hz | exact: beta, 1/s |";
+  out << "\n|---|---|---|---|---|";
+  for (size_t c = 0; c <= result.channels.size(); ++c) out << "---|";
+  if (exact != nullptr) out << "---|---|";
+  out << "\n";
+  for (size_t k = 0; k < result.modes.size(); ++k) {
+    const auto& mode = result.modes[k];
+    out << fmt::format("| {} | {:.4f} ± {:.2g} | {:.3f} ± {:.2g} | {:.3f} | {:.3f} |", k + 1,
+                       mode.frequency_hz, mode.std_frequency_hz, -mode.decay_rate_per_s,
+                       mode.std_decay_rate_per_s, mode.half_life_s, mode.damping_ratio);
+    for (Eigen::Index c = 0; c < mode.amplitude.size(); ++c) {
+      out << fmt::format(" {:.2e} |", mode.amplitude[c]);
+    }
+    out << fmt::format(" {:.2e} |", mode.amplitude.mean());
+    if (exact != nullptr) {
+      // The exact mode nearest in frequency.
+      const model::Mode* nearest = nullptr;
+      for (const model::Mode& candidate : *exact) {
+        if (nearest == nullptr || std::abs(candidate.frequency_hz() - mode.frequency_hz) <
+                                      std::abs(nearest->frequency_hz() - mode.frequency_hz)) {
+          nearest = &candidate;
+        }
+      }
+      out << fmt::format(" {:.4f} | {:.3f} |", nearest->frequency_hz(),
+                         -nearest->decay_rate_per_s());
+    }
+    out << "\n";
+  }
+  out << "\nCorrelation of record and reconstruction:";
+  for (size_t c = 0; c < result.channels.size(); ++c) {
+    out << fmt::format(" K({}) = {:.3f}", result.channels[c],
+                       result.correlation[static_cast<Eigen::Index>(c)]);
+  }
+  out << fmt::format(". Method `{}`, model order {}, effective rank {}.\n", result.method,
+                     result.model_order, result.effective_rank);
+  return out.str();
+}
+
+}  // namespace mbid::app
