@@ -223,6 +223,16 @@ class CvodesIntegrator::Impl {
     if (!options.IsValid(&why)) {
       throw std::invalid_argument("CvodesIntegrator: invalid SensitivityOptions: " + why);
     }
+    if (options_.method == IntegratorOptions::Method::kAdams &&
+        options.corrector == SensitivityOptions::Corrector::kSimultaneous &&
+        options.difference_quotient == SensitivityOptions::DifferenceQuotient::kForward) {
+      // Found on the crane: SUNDIALS 6.4.1's simultaneous fixed-point corrector with forward
+      // quotients evaluates the right-hand side at NaN states at once.
+      throw std::invalid_argument(
+          "CvodesIntegrator::InitializeSensitivities: Adams with simultaneous corrector and "
+          "forward difference quotients fails in SUNDIALS 6.4; expected BDF, the staggered "
+          "corrector or centered quotients");
+    }
     void* cv = cvode_.get();
     if (sensitivity_count_ > 0) CVodeSensFree(cv);
     sensitivity_count_ = 0;

@@ -6,12 +6,21 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 
 #include "crane_fixture.h"
 #include "mbid/simulation/sensor.h"
 
 namespace mbid::updating {
 namespace {
+
+// Measured numbers for the XML report, in scientific notation.
+std::string Sci(double value) {
+  std::ostringstream out;
+  out.precision(2);
+  out << std::scientific << value;
+  return out.str();
+}
 
 using testing::Crane;
 using testing::LoadCrane;
@@ -63,9 +72,9 @@ double RelativeError(const UpdateResult& result, const model::MechanicalModel& t
 void Record(const UpdateResult& result, const model::MechanicalModel& truth) {
   for (const ParameterEstimate& estimate : result.parameters) {
     if (!estimate.test.empty()) continue;
-    ::testing::Test::RecordProperty(
-        estimate.name, "error " + std::to_string(RelativeError(result, truth, estimate.name)) +
-                           " relative_std " + std::to_string(estimate.relative_std));
+    ::testing::Test::RecordProperty(estimate.name,
+                                    "error " + Sci(RelativeError(result, truth, estimate.name)) +
+                                        " relative_std " + Sci(estimate.relative_std));
   }
   ::testing::Test::RecordProperty("iterations", result.iterations);
   ::testing::Test::RecordProperty("sensitivity_runs",
@@ -163,6 +172,10 @@ TEST(OutputErrorTest, LoadDropReportsWhatItCannotDetermine) {
   const UpdateResult result = UpdateModel(
       *crane.model, {{"load drop", record, crane.excitation, crane.sensors.noise_std}}, options);
   ASSERT_NE(result.termination, UpdateResult::Termination::kFailure) << result.message;
+  Record(result, *crane.model);
+  std::string undetermined;
+  for (const std::string& name : result.undetermined) undetermined += name + " ";
+  RecordProperty("undetermined", undetermined);
   ASSERT_FALSE(result.undetermined.empty());
   EXPECT_NE(std::find(result.undetermined.begin(), result.undetermined.end(), "d_eta"),
             result.undetermined.end());
@@ -200,6 +213,11 @@ TEST(OutputErrorTest, TwoTestsJointlyGiveSmallerStandardDeviations) {
   const UpdateResult joint = UpdateModel(*deflection.model, {a, b}, options);
   ASSERT_EQ(joint.termination, UpdateResult::Termination::kConverged) << joint.message;
   ASSERT_EQ(joint.tests.size(), 2u);
+  for (const std::string& name : kAllParameters) {
+    RecordProperty(name,
+                   "std joint/deflection " + Sci(joint.Find(name).std / alone_a.Find(name).std) +
+                       " joint/load drop " + Sci(joint.Find(name).std / alone_b.Find(name).std));
+  }
   for (const std::string& name : kAllParameters) {
     const double std_joint = joint.Find(name).std;
     ASSERT_TRUE(std::isfinite(std_joint)) << name;

@@ -63,7 +63,7 @@ updating:
   initial_trust_region_radius: 100
   continuation_fractions: [0.25, 0.5]
   integrator: {method: adams, relative_tolerance: 1.0e-7}
-  sensitivity: {corrector: staggered, difference_quotient: forward, error_control: false}
+  sensitivity: {corrector: staggered, difference_quotient: centered, error_control: false}
   algebraic: {starts: 20, seed: 3, fit_offset: true, ambiguity_ratio: 3}
 )",
                                          *crane.model);
@@ -90,7 +90,7 @@ updating:
   EXPECT_TRUE(o.integrator.interpolate_outputs);  // kept from the default
   EXPECT_EQ(o.sensitivity.corrector, simulation::SensitivityOptions::Corrector::kStaggered);
   EXPECT_EQ(o.sensitivity.difference_quotient,
-            simulation::SensitivityOptions::DifferenceQuotient::kForward);
+            simulation::SensitivityOptions::DifferenceQuotient::kCentered);
   EXPECT_FALSE(o.sensitivity.error_control);
   EXPECT_EQ(settings.algebraic.starts, 20);
   EXPECT_EQ(settings.algebraic.seed, 3u);
@@ -124,6 +124,8 @@ TEST(SettingsTest, ErrorsNameTheFieldAndWhatWasExpected) {
   EXPECT_NE(ErrorOf("updating: {sensitivity: {corrector: simultanous}}", m).find("simultaneous"),
             std::string::npos);
   EXPECT_NE(ErrorOf("updating: {threads: 0}", m).find("threads"), std::string::npos);
+  EXPECT_NE(ErrorOf("updating: {integrator: {method: adams}}", m).find("staggered"),
+            std::string::npos);
   // Errors name the file and the field.
   EXPECT_NE(
       ErrorOf("updating: {algebraic: {starts: 0}}", m).find("scenario.yaml:updating.algebraic"),

@@ -56,14 +56,16 @@ simulation::SensitivityOptions ReadSensitivity(const YamlReader& node,
   using simulation::SensitivityOptions;
   node.ExpectMap({"corrector", "difference_quotient", "relative_tolerance", "absolute_tolerance",
                   "error_control"});
-  o.corrector =
-      node.Choice("corrector", {"simultaneous", "staggered"}, "simultaneous") == "staggered"
-          ? SensitivityOptions::Corrector::kStaggered
-          : SensitivityOptions::Corrector::kSimultaneous;
-  o.difference_quotient =
-      node.Choice("difference_quotient", {"centered", "forward"}, "centered") == "forward"
-          ? SensitivityOptions::DifferenceQuotient::kForward
-          : SensitivityOptions::DifferenceQuotient::kCentered;
+  const bool staggered = o.corrector == SensitivityOptions::Corrector::kStaggered;
+  o.corrector = node.Choice("corrector", {"simultaneous", "staggered"},
+                            staggered ? "staggered" : "simultaneous") == "staggered"
+                    ? SensitivityOptions::Corrector::kStaggered
+                    : SensitivityOptions::Corrector::kSimultaneous;
+  const bool forward = o.difference_quotient == SensitivityOptions::DifferenceQuotient::kForward;
+  o.difference_quotient = node.Choice("difference_quotient", {"centered", "forward"},
+                                      forward ? "forward" : "centered") == "forward"
+                              ? SensitivityOptions::DifferenceQuotient::kForward
+                              : SensitivityOptions::DifferenceQuotient::kCentered;
   o.relative_tolerance = node.PositiveDouble("relative_tolerance", o.relative_tolerance);
   o.absolute_tolerance = node.PositiveDouble("absolute_tolerance", o.absolute_tolerance);
   o.error_control = node.Bool("error_control", o.error_control);

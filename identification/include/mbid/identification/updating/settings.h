@@ -51,7 +51,7 @@ namespace mbid::updating {
 //       interpolate_outputs: true
 //     sensitivity:                         # CVODES forward sensitivities (docs/toolchain.md)
 //       corrector: simultaneous            # simultaneous | staggered
-//       difference_quotient: centered      # centered | forward
+//       difference_quotient: forward       # forward | centered (twice the work)
 //       relative_tolerance: 1.0e-6         # looser than the state's on purpose
 //       absolute_tolerance: 1.0e-8         # divided by each parameter's magnitude
 //       error_control: true
