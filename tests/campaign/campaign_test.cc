@@ -10,6 +10,7 @@
 #include <fstream>
 #include <random>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include "mbid/app/campaign_case.h"
@@ -257,6 +258,120 @@ damper_sizing:
   for (Eigen::Index i = 0; i < d.size(); ++i) {
     // d up to 20 < 2 sqrt(cJ) = 40: underdamped, zeta = d / 40 to eigenvalue round-off.
     EXPECT_NEAR(zeta[i], d[i] / 40.0, 1e-12) << "d = " << d[i];
+  }
+}
+
+TEST_F(CampaignTest, LawsStudyRecoversTheLawTheCasesWereBuiltWith) {
+  Write("oscillator.yaml", kOscillator);
+  // The cases' stiffness follows c = 100 + 20 J - 2 J^2 over the inertia J = 1..5 (a list
+  // sweep): the degree-2 law of truth.c_angle must give back (100, 20, -2) to round-off
+  // (1e-9 relative to c ~ 100), with R^2 = 1. Modes only: no simulation needed.
+  const Campaign campaign = LoadCampaign(Write("laws.yaml", R"(name: laws
+base: oscillator.yaml
+steps: [modes]
+sweep:
+  - list:
+      model.inertia_kgm2: [1, 2, 3, 4, 5]
+      model.joints.angle.stiffness_Nm_per_rad: [118, 132, 142, 148, 150]
+study: laws
+laws:
+  variables: [model.inertia_kgm2]
+  quantities: [truth.c_angle, exact.mode1.frequency_hz]
+  degree: 2
+)"));
+  CampaignRunOptions options;
+  options.quiet = true;
+  const std::string out = (dir_ / "out").string();
+  RunCampaign(campaign, out, options);
+  const H5Reader file(out + "/campaign.h5");
+  const Eigen::VectorXd c = file.ReadVector("/laws/truth.c_angle", "coefficients");
+  ASSERT_EQ(c.size(), 3);
+  EXPECT_NEAR(c[0], 100, 1e-7);
+  EXPECT_NEAR(c[1], 20, 1e-7);
+  EXPECT_NEAR(c[2], -2, 1e-8);
+  EXPECT_NEAR(file.ReadScalar("/laws/truth.c_angle", "r_squared"), 1.0, 1e-12);
+  EXPECT_EQ(file.ReadStrings("/laws/truth.c_angle", "terms"),
+            (std::vector<std::string>{"1", "inertia_kgm2", "inertia_kgm2^2"}));
+  EXPECT_EQ(file.ReadScalar("/laws/exact.mode1.frequency_hz", "samples"), 5.0);
+  const std::string report = [&] {
+    std::ifstream in(out + "/report.md");
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }();
+  EXPECT_NE(report.find("### truth.c_angle (N*m/rad)"), std::string::npos) << report;
+}
+
+TEST_F(CampaignTest, IdentificationSettingsAreReadStrictly) {
+  Write("oscillator.yaml", kOscillator);
+  // The scenario's identification: section reaches the identifier (prony-svd with p = 6 on the
+  // 41-sample record: at least 2p + 1 samples needed); a value out of range fails
+  // the case at its identify step, naming the field (the scenario reader leaves the section to
+  // the step, so the campaign itself loads).
+  const Campaign campaign = LoadCampaign(Write("ident.yaml", R"(name: ident
+base: oscillator.yaml
+steps: [identify]
+sweep:
+  - list:
+      identification: [{method: prony-svd, prony: {order: 6}}, {max_modes: 0}, {max_mode: 2}]
+)"));
+  CampaignRunOptions options;
+  options.quiet = true;
+  const std::string out = (dir_ / "out").string();
+  RunCampaign(campaign, out, options);
+  const H5Reader file(out + "/campaign.h5");
+  EXPECT_EQ(file.ReadStringAttribute("/cases/case_0000", "status"), "ok")
+      << file.ReadStringAttribute("/cases/case_0000", "reason");
+  EXPECT_EQ(file.ReadStringAttribute("/cases/case_0000/identification", "method"), "prony-svd");
+  EXPECT_EQ(file.ReadStringAttribute("/cases/case_0001", "status"), "invalid_input");
+  EXPECT_NE(file.ReadStringAttribute("/cases/case_0001", "reason")
+                .find("ident.yaml#case_0001:identification.max_modes:"),
+            std::string::npos)
+      << file.ReadStringAttribute("/cases/case_0001", "reason");
+  EXPECT_NE(file.ReadStringAttribute("/cases/case_0002", "reason").find("did you mean 'max_modes'"),
+            std::string::npos)
+      << file.ReadStringAttribute("/cases/case_0002", "reason");
+}
+
+TEST_F(CampaignTest, UpdateStepTunesTheOscillatorOrSaysItIsNotAvailable) {
+  Write("oscillator.yaml", kOscillator);
+  // Two noisy decays (seeded) of the oscillator with c = 100, d = 1; the update starts 30 % and
+  // 50 % off. With model updating in the build, each case converges and the tuned values lie
+  // within 4 standard deviations of the truth (the chance of a larger miss is 6e-5 per value).
+  const Campaign campaign = LoadCampaign(Write("update.yaml", R"(name: update
+base: oscillator.yaml
+steps: [all]
+set:
+  sensors.noise_std_rad: 1.0e-4
+  updating:
+    parameters: [c_angle, d_angle]
+    start: {c_angle: 70, d_angle: 1.5}
+    algebraic_start: false
+sweep:
+  - repeat: 2
+)"));
+  CampaignRunOptions options;
+  options.quiet = true;
+  const std::string out = (dir_ / "out").string();
+  RunCampaign(campaign, out, options);
+  const H5Reader file(out + "/campaign.h5");
+  for (const std::string id : {"case_0000", "case_0001"}) {
+    const std::string status = file.ReadStringAttribute("/cases/" + id, "status");
+#ifdef MBID_HAVE_UPDATING
+    ASSERT_EQ(status, "ok") << file.ReadStringAttribute("/cases/" + id, "reason");
+    const std::string group = "/cases/" + id + "/updating/parameters/";
+    const double c = file.ReadScalar(group + "c_angle", "value");
+    const double c_std = file.ReadScalar(group + "c_angle", "std");
+    const double d = file.ReadScalar(group + "d_angle", "value");
+    const double d_std = file.ReadScalar(group + "d_angle", "std");
+    EXPECT_LT(std::abs(c - 100.0), 4 * c_std) << c << " +- " << c_std;
+    EXPECT_LT(std::abs(d - 1.0), 4 * d_std) << d << " +- " << d_std;
+#else
+    EXPECT_EQ(status, "not_available");
+    EXPECT_EQ(file.ReadStringAttribute("/cases/" + id, "step"), "update");
+    // The steps before it ran: the record and its modes are there.
+    EXPECT_TRUE(file.Exists("/cases/" + id + "/identification"));
+#endif
   }
 }
 

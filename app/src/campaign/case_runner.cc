@@ -104,10 +104,10 @@ CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case) 
         row["settling_time_s"] = Number(outcome.settling_time_s);
       }
 
-      const internal::StepInput input{&scenario, model, test};
+      internal::StepInput input{&scenario, model, test, nullptr};
       if (campaign.steps.identify) {
         step = "identify";
-        internal::RunIdentifyStep(input, outcome);
+        input.identified = internal::RunIdentifyStep(input, outcome);
       }
       if (campaign.steps.update) {
         step = "update";

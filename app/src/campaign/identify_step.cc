@@ -18,7 +18,8 @@ nlohmann::ordered_json Number(double value) {
 
 }  // namespace
 
-void RunIdentifyStep(const StepInput& input, CaseOutcome& outcome) {
+std::shared_ptr<const identification::ModalResult> RunIdentifyStep(const StepInput& input,
+                                                                   CaseOutcome& outcome) {
   identification::IdentificationOptions options;
   if (input.scenario->root.Has("identification")) {
     options = ReadIdentificationSettings(input.scenario->root.Child("identification"));
@@ -51,6 +52,7 @@ void RunIdentifyStep(const StepInput& input, CaseOutcome& outcome) {
   }
   outcome.groups.push_back(
       [result](H5Writer& file) { identification::WriteModalResult(file, *result); });
+  return result;
 }
 
 }  // namespace mbid::app::internal

@@ -340,6 +340,7 @@ std::string LawsReport(const LawsSpec& spec, const std::vector<PolynomialLaw>& l
                                internal::ShortName(x_key), spec.degree);
     figure.x_label = fmt::format("{}, {}", x_key, internal::UnitOfColumn(x_key));
     figure.y_label = fmt::format("{}, {}", law.quantity, unit);
+    figure.pad_x = true;
     figure.series.push_back(
         {"cases", ToVector(data_x), ToVector(data_y), "points pt 7 ps 0.8 lc rgb '#1f77b4'"});
     const double low = *std::min_element(data_x.begin(), data_x.end());

@@ -8,6 +8,7 @@
 
 #include "mbid/app/campaign_case.h"
 #include "mbid/app/scenario.h"
+#include "mbid/identification/modal_result.h"
 #include "mbid/model/mechanical_model.h"
 #include "mbid/simulation/simulate.h"
 
@@ -18,6 +19,8 @@ struct StepInput {
   const Scenario* scenario = nullptr;
   std::shared_ptr<const model::MechanicalModel> model;
   std::shared_ptr<const simulation::SimulationResult> test;
+  // The identify step's result, if it ran (the update step starts from its poles).
+  std::shared_ptr<const identification::ModalResult> identified;
 };
 
 // Thrown by a step this build does not have; the case records status "not_available".
@@ -28,10 +31,14 @@ class StepNotAvailable : public std::runtime_error {
 
 // Identifies the modes of the case's record with the scenario's identification settings; adds
 // identified.* columns to the row and the /identification group. Throws on failure.
-void RunIdentifyStep(const StepInput& input, CaseOutcome& outcome);
+std::shared_ptr<const identification::ModalResult> RunIdentifyStep(const StepInput& input,
+                                                                   CaseOutcome& outcome);
 
-// Tunes the scenario's updating parameters to the case's record; adds updated.* columns and
-// the /updating group. Throws on failure.
+// Tunes the scenario's updating parameters to the case's record (mbid/identification/updating):
+// the scenario's updating: settings; Route 1 (eq. 7) from the identified poles as the start
+// when it gives an admissible set and the settings ask for it; the identification's residual
+// noise as weights where the settings give none. Adds updated.* columns and the /updating
+// group; a fit that does not converge throws NumericalError after recording what it found.
 void RunUpdateStep(const StepInput& input, CaseOutcome& outcome);
 
 }  // namespace mbid::app::internal

@@ -1,10 +1,123 @@
 #include "steps.h"
 
-namespace mbid::app::internal {
+#ifdef MBID_HAVE_UPDATING
 
-// Model updating (issue 5) has not been committed yet: the step says so for each case.
-void RunUpdateStep(const StepInput& /*input*/, CaseOutcome& /*outcome*/) {
-  throw StepNotAvailable("update: not available in this build (the updating library is missing)");
+#include <fmt/format.h>
+
+#include <cmath>
+#include <complex>
+#include <memory>
+#include <optional>
+
+#include "mbid/common/error.h"
+#include "mbid/identification/updating/characteristic.h"
+#include "mbid/identification/updating/output_error.h"
+#include "mbid/identification/updating/result_io.h"
+#include "mbid/identification/updating/settings.h"
+
+namespace mbid::app::internal {
+namespace {
+
+nlohmann::ordered_json Number(double value) {
+  if (!std::isfinite(value)) return nullptr;
+  return value;
+}
+
+// Route 1 (method.md, eqs. 6-8) from the identified poles, when they are as many as the model
+// has coordinates; nothing otherwise (the fit then starts from the scenario's values).
+std::shared_ptr<const updating::CharacteristicResult> SolveRouteOne(
+    const StepInput& input, const updating::UpdatingSettings& settings, std::string* note) {
+  if (!settings.algebraic_start) return nullptr;
+  const model::MechanicalModel& model = *input.model;
+  if (!input.identified ||
+      static_cast<int>(input.identified->modes.size()) != model.coordinate_count()) {
+    *note = input.identified ? fmt::format("{} identified modes for {} coordinates",
+                                           input.identified->modes.size(), model.coordinate_count())
+                             : "no identify step";
+    return nullptr;
+  }
+  std::vector<std::complex<double>> lambda;
+  for (const auto& mode : input.identified->modes) lambda.push_back(mode.lambda);
+  const updating::CharacteristicProblem problem = updating::MakeCharacteristicProblem(
+      model, lambda, input.test->measured, input.scenario->excitation);
+  return std::make_shared<const updating::CharacteristicResult>(
+      updating::SolveCharacteristicEquation(problem, settings.algebraic));
+}
+
+}  // namespace
+
+void RunUpdateStep(const StepInput& input, CaseOutcome& outcome) {
+  const Scenario& scenario = *input.scenario;
+  const model::MechanicalModel& model = *input.model;
+  updating::UpdatingSettings settings =
+      scenario.root.Has("updating")
+          ? updating::ReadUpdatingSettings(scenario.root.Child("updating"), model,
+                                           scenario.simulation.integrator)
+          : updating::MakeDefaultUpdatingSettings(model, scenario.simulation.integrator);
+  settings.options.quiet = true;  // the campaign reports progress, not each fit
+
+  std::string start = "scenario";
+  std::string note;
+  const auto algebraic = SolveRouteOne(input, settings, &note);
+  if (algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)) {
+    start = "route1";
+  }
+  updating::TestRecord test =
+      updating::MakeTestRecord(outcome.id, input.test->measured, scenario.excitation, settings);
+  // The identification's residual noise weighs the channels the settings leave open.
+  if (input.identified) {
+    for (size_t c = 0; c < input.identified->channels.size(); ++c) {
+      const double noise = input.identified->noise_std[static_cast<Eigen::Index>(c)];
+      if (noise > 0) test.noise_std.emplace(input.identified->channels[c], noise);
+    }
+  }
+  auto result = std::make_shared<updating::UpdateResult>(
+      updating::UpdateModel(model, {test}, settings.options));
+  if (algebraic) updating::MarkAlgebraicAmbiguity(*algebraic, *result);
+
+  nlohmann::ordered_json& row = outcome.row;
+  row["updated.termination"] = result->termination_name();
+  row["updated.start"] = start;
+  if (!note.empty()) row["updated.start_note"] = note;
+  row["updated.iterations"] = result->iterations;
+  row["updated.cost_initial"] = Number(result->initial_cost);
+  row["updated.cost_final"] = Number(result->final_cost);
+  row["updated.rank"] = result->rank;
+  for (const updating::ParameterEstimate& parameter : result->parameters) {
+    const std::string name = "updated." + parameter.name;
+    row[name] = Number(parameter.value);
+    row[name + ".std"] = Number(parameter.std);
+    row[name + ".determined"] = parameter.determined;
+  }
+  if (!result->tests.empty()) {
+    const updating::TestFit& fit = result->tests.front();
+    for (size_t c = 0; c < fit.channels.size(); ++c) {
+      row["updated.correlation." + fit.channels[c]] =
+          Number(fit.correlation[static_cast<Eigen::Index>(c)]);
+    }
+  }
+  outcome.groups.push_back([result, algebraic](H5Writer& file) {
+    updating::WriteUpdatingGroup(file, *result, algebraic.get());
+  });
+  if (result->termination != updating::UpdateResult::Termination::kConverged) {
+    throw NumericalError("updating", result->termination_name() + ": " + result->message);
+  }
 }
 
 }  // namespace mbid::app::internal
+
+#else
+
+namespace mbid::app::internal {
+
+// This build has no model updating (identification/updating.cmake is not part of it): the step
+// says so for each case.
+void RunUpdateStep(const StepInput& /*input*/, CaseOutcome& /*outcome*/) {
+  throw StepNotAvailable(
+      "update: not available in this build (the updating library, "
+      "identification/updating.cmake, is not part of it)");
+}
+
+}  // namespace mbid::app::internal
+
+#endif
