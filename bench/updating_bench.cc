@@ -4,7 +4,9 @@
 // 8 s at 100 Hz, sensor noise 1e-5 rad with seed 1), the noise level given to the fit.
 // Argument: worker threads (sensitivity groups, or columns of the numeric Jacobian).
 // Counters: Ceres iterations, right-hand-side evaluations of every kind, simulations, and the
-// largest relative error of the eight estimates against the truth.
+// largest relative error of the eight estimates against the truth. Anchors in the same run: one
+// plain simulation of the record and one sensitivity run of all eight parameters, the units the
+// fit's cost is made of.
 
 #include <benchmark/benchmark.h>
 
@@ -15,6 +17,7 @@
 #include "mbid/identification/updating/output_error.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/simulation/scenario_sections.h"
+#include "mbid/simulation/sensitivity.h"
 #include "mbid/simulation/simulate.h"
 
 namespace {
@@ -77,6 +80,51 @@ void RunUpdate(benchmark::State& state, UpdateOptions::Jacobian jacobian,
       result.termination == mbid::updating::UpdateResult::Termination::kConverged;
 }
 
+mbid::simulation::SimulationOptions FitSimulation(const Setup& setup) {
+  mbid::simulation::SimulationOptions options;
+  options.duration_s = (setup.test.record.samples() - 1) * setup.test.record.sample_interval_s;
+  options.integrator = setup.integrator;
+  options.integrator.interpolate_outputs = true;
+  return options;
+}
+
+mbid::simulation::SensorOptions FitSensors(const Setup& setup) {
+  mbid::simulation::SensorOptions sensors;
+  sensors.sample_rate_hz = 1.0 / setup.test.record.sample_interval_s;
+  sensors.channels = setup.test.record.channels;
+  return sensors;
+}
+
+void BM_AnchorPlainSimulation(benchmark::State& state) {
+  const Setup& setup = Reference();
+  mbid::simulation::SimulationResult result;
+  for (auto _ : state) {
+    result = mbid::simulation::Simulate(*setup.model, setup.test.excitation, FitSimulation(setup),
+                                        FitSensors(setup));
+  }
+  state.counters["rhs_evaluations"] = static_cast<double>(
+      result.statistics.rhs_evaluations + result.statistics.rhs_evaluations_for_jacobian);
+}
+
+void BM_AnchorSensitivityRun(benchmark::State& state) {
+  const Setup& setup = Reference();
+  std::vector<std::string> names;
+  for (const mbid::model::Parameter& p : setup.model->parameters()) names.push_back(p.name);
+  mbid::simulation::SensitivityOptions sensitivity;
+  sensitivity.difference_quotient =
+      state.range(0) == 0 ? mbid::simulation::SensitivityOptions::DifferenceQuotient::kCentered
+                          : mbid::simulation::SensitivityOptions::DifferenceQuotient::kForward;
+  mbid::simulation::SensitivityResult result;
+  for (auto _ : state) {
+    result = mbid::simulation::SimulateWithSensitivities(*setup.model, setup.test.excitation,
+                                                         FitSimulation(setup), FitSensors(setup),
+                                                         names, {}, sensitivity);
+  }
+  const auto& s = result.statistics;
+  state.counters["rhs_evaluations"] = static_cast<double>(
+      s.rhs_evaluations + s.rhs_evaluations_for_jacobian + s.rhs_evaluations_for_sensitivities);
+}
+
 void BM_UpdateSensitivitiesCentered(benchmark::State& state) {
   RunUpdate(state, UpdateOptions::Jacobian::kSensitivities,
             mbid::simulation::SensitivityOptions::DifferenceQuotient::kCentered);
@@ -90,6 +138,9 @@ void BM_UpdateNumeric(benchmark::State& state) {
             mbid::simulation::SensitivityOptions::DifferenceQuotient::kCentered);
 }
 
+BENCHMARK(BM_AnchorPlainSimulation)->Unit(benchmark::kMillisecond);
+// 0: centered quotients, 1: forward.
+BENCHMARK(BM_AnchorSensitivityRun)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // One fit takes seconds: one iteration each, wall time (the threads work in parallel).
 BENCHMARK(BM_UpdateSensitivitiesCentered)
     ->Arg(1)
