@@ -79,12 +79,6 @@ IdentificationOptions OptionsFor(Estimator estimator) {
   IdentificationOptions options;
   options.compute_spectrum = false;
   options.compute_stabilization = false;
-  if (const char* columns = std::getenv("MBID_BENCH_COLUMNS")) {
-    options.hankel.max_columns = std::atoi(columns);
-  }
-  if (const char* factor = std::getenv("MBID_BENCH_FACTOR")) {
-    options.hankel.noise_floor_factor = std::atof(factor);
-  }
   // The bound's model has no offset; "offset fitted" shows what estimating one costs.
   options.offset =
       estimator == Estimator::kDefaultWithOffset ? OffsetRemoval::kFit : OffsetRemoval::kNone;
@@ -206,17 +200,26 @@ void BM_MatrixPencilAnchor(benchmark::State& state) {
 BENCHMARK(BM_MatrixPencilAnchor)->Arg(1000)->Unit(benchmark::kMillisecond);
 
 // 10 s of the paper's signal at 100 * (samples / 1000) Hz, decimated back to 100 Hz; defaults
-// otherwise (offset fitted, spectrum and stabilization data computed on the full record).
-void BM_Scaling(benchmark::State& state) {
+// otherwise (offset fitted; with `extras` the spectrum, zero-padded 4x, and the stabilization
+// data, both on the full-rate record).
+void BM_Scaling(benchmark::State& state, bool extras) {
   const int samples = static_cast<int>(state.range(0));
   const Record record = MakeRecord(samples);
   IdentificationOptions options;
   options.decimation = samples / 1000;
+  options.compute_spectrum = extras;
+  options.compute_stabilization = extras;
   size_t modes = 0;
   for (auto _ : state) modes = Identify(record.measurement, options).modes.size();
   state.counters["modes"] = static_cast<double>(modes);
 }
-BENCHMARK(BM_Scaling)
+BENCHMARK_CAPTURE(BM_Scaling, defaults, true)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Scaling, without_spectrum_and_stabilization, false)
     ->Arg(1000)
     ->Arg(10000)
     ->Arg(100000)

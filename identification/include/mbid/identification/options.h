@@ -95,10 +95,10 @@ struct IdentificationOptions {
   double window_end_s = std::numeric_limits<double>::infinity();
   std::vector<std::string> channels;  // empty: all, in the record's order
   OffsetRemoval offset = OffsetRemoval::kFit;
-  // Poles are estimated on the record low-pass filtered (zero-phase FIR, cutoff 0.8 of the new
-  // Nyquist frequency) and downsampled by this factor; amplitudes, phases and the
-  // reconstruction always use the full-rate record. The filter loses the first and last
-  // 10 * decimation samples for the pole estimate.
+  // Poles are estimated on the record low-pass filtered (zero-phase FIR, cutoff 0.9 of the new
+  // Nyquist frequency, flat to 0.76 of it) and downsampled by this factor; amplitudes, phases
+  // and the reconstruction always use the full-rate record. The filter loses the first and last
+  // 20 * decimation samples for the pole estimate.
   int decimation = 1;
 
   // Step 5 of method.md: poles outside these limits are dropped. Modes are oscillatory:
