@@ -354,6 +354,16 @@ sweep:
   options.quiet = true;
   const std::string out = (dir_ / "out").string();
   RunCampaign(campaign, out, options);
+  // The fit's file is the same bit for bit with 2 workers (no wall times recorded).
+  options.workers = 2;
+  RunCampaign(campaign, (dir_ / "two").string(), options);
+  const auto bytes = [](const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
+  EXPECT_TRUE(bytes(out + "/campaign.h5") == bytes(dir_ / "two" / "campaign.h5"));
   const H5Reader file(out + "/campaign.h5");
   for (const std::string id : {"case_0000", "case_0001"}) {
     const std::string status = file.ReadStringAttribute("/cases/" + id, "status");

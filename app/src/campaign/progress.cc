@@ -48,7 +48,7 @@ std::string CampaignProgress::Line(int done, int failed) const {
 }
 
 void CampaignProgress::Update(int done, int failed) {
-  if (quiet_ || done == last_done_) return;
+  if (quiet_ || done == 0 || done == last_done_) return;
   const double elapsed = Elapsed();
   // A terminal line is cheap to rewrite; a log gets a line every 5 s.
   if (elapsed - last_print_s_ < (terminal_ ? 0.25 : 5.0)) return;

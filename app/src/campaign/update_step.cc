@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -74,6 +75,9 @@ void RunUpdateStep(const StepInput& input, CaseOutcome& outcome) {
   auto result = std::make_shared<updating::UpdateResult>(
       updating::UpdateModel(model, {test}, settings.options));
   if (algebraic) updating::MarkAlgebraicAmbiguity(*algebraic, *result);
+  // The only number of the fit that depends on the machine and its load: a campaign's file must
+  // be the same bit for bit whoever ran the case, so it is not recorded (NaN).
+  result->wall_time_s = std::numeric_limits<double>::quiet_NaN();
 
   nlohmann::ordered_json& row = outcome.row;
   row["updated.termination"] = result->termination_name();
