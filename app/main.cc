@@ -89,6 +89,15 @@ int Main(int argc, char** argv) {
   identify->add_option("--max-modes", identify_options.max_modes, "At most this many modes")
       ->capture_default_str();
 
+  std::vector<std::string> update_data;
+  CLI::App* update = app.add_subcommand(
+      "update", "Tune the joints' stiffness and damping to measurements (Route 1, then Ceres)");
+  update->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
+  update->add_option("DATA", update_data, "Measurement files (.h5 or .csv), one per test")
+      ->required();
+  update->add_option("-o,--output", output_path, "Write /measurement, /scenario, /updating (.h5)");
+  update->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -111,6 +120,9 @@ int Main(int argc, char** argv) {
                                   ? mbid::identification::OffsetRemoval::kMean
                                   : mbid::identification::OffsetRemoval::kFit;
     return mbid::app::RunIdentifyCommand(data_path, identify_options, output_path, common);
+  }
+  if (update->parsed()) {
+    return mbid::app::RunUpdateCommand(scenario_path, update_data, output_path, common);
   }
   if (modes->parsed()) return mbid::app::RunModesCommand(scenario_path, common);
   if (simulate->parsed()) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "mbid/identification/options.h"
 
@@ -30,5 +31,11 @@ int RunCampaignCommand(const std::string& campaign_path, const std::string& outp
 int RunIdentifyCommand(const std::string& data_path,
                        const identification::IdentificationOptions& options,
                        const std::string& output_path, const CommonOptions& common);
+
+// `mbid update SCENARIO DATA [DATA...] [-o FILE.h5] [--json FILE]`: tunes the scenario's joint
+// parameters to the records (Route 1 start, Route 2 fit); the exit code follows the fit's
+// termination (3 unless converged).
+int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::string>& data_paths,
+                     const std::string& output_path, const CommonOptions& common);
 
 }  // namespace mbid::app

@@ -1,0 +1,244 @@
+// `mbid update`: Route 1 (eqs. 6-8) on the first record's poles, then Route 2 (Ceres output
+// error) on every record, as the campaign's update step does (campaign/update_step.cc).
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbid/app/commands.h"
+#include "mbid/common/error.h"
+
+#ifdef MBID_HAVE_UPDATING
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+#include "mbid/app/identification_settings.h"
+#include "mbid/app/scenario.h"
+#include "mbid/common/hdf5_io.h"
+#include "mbid/common/json_io.h"
+#include "mbid/identification/identify.h"
+#include "mbid/identification/updating/characteristic.h"
+#include "mbid/identification/updating/output_error.h"
+#include "mbid/identification/updating/result_io.h"
+#include "mbid/identification/updating/settings.h"
+
+namespace mbid::app {
+namespace {
+
+bool IsHdf5(const std::string& path) {
+  const auto ends_with = [&](const std::string& tail) {
+    return path.size() >= tail.size() &&
+           path.compare(path.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  return ends_with(".h5") || ends_with(".hdf5");
+}
+
+// One DATA file: its record, the excitation that produced it and what identification found.
+struct LoadedTest {
+  std::string path;
+  Measurement record;
+  simulation::Excitation excitation;
+  std::string excitation_source;  // "scenario" or the file whose /scenario gave it
+  identification::ModalResult identified;
+};
+
+LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
+                    const model::MechanicalModel& model,
+                    const identification::IdentificationOptions& identification_options) {
+  LoadedTest test;
+  test.path = path;
+  test.record = ReadMeasurement(path);
+  // Checked here rather than left to the fit: identification would run first on any channels.
+  for (const std::string& channel : test.record.channels) {
+    const auto& outputs = model.output_names();
+    if (std::find(outputs.begin(), outputs.end(), channel) == outputs.end()) {
+      throw InputError(
+          path, "channels", fmt::format("channel '{}' is not an output of the model", channel),
+          fmt::format("channels among the model's outputs ({})", fmt::join(outputs, ", ")));
+    }
+  }
+  // A simulated test carries its own scenario: its excitation is the one of this record (a load
+  // drop and an initial deflection can then be fitted together).
+  const std::string yaml = IsHdf5(path) ? ReadScenarioYaml(path) : std::string();
+  const Scenario* source = &scenario;
+  std::unique_ptr<Scenario> own;
+  if (!yaml.empty()) {
+    own = std::make_unique<Scenario>(LoadScenarioFromText(yaml, path + ":/scenario"));
+    if (own->has_excitation) source = own.get();
+  }
+  test.excitation = source->RequireExcitation();
+  test.excitation_source = source == &scenario ? "scenario" : path;
+
+  identification::IdentificationOptions options = identification_options;
+  // Only the free decay is identified: the record before a forcing's end is not one.
+  const double forcing_end = test.excitation.CalcForcingEndTime();
+  if (forcing_end > 0 && !std::isfinite(options.window_start_s)) {
+    options.window_start_s = forcing_end;
+  }
+  test.identified = identification::Identify(test.record, options, path);
+  return test;
+}
+
+// Route 1 from the first record's poles when they are as many as the model has coordinates.
+std::shared_ptr<const updating::CharacteristicResult> SolveRouteOne(
+    const model::MechanicalModel& model, const LoadedTest& test,
+    const updating::UpdatingSettings& settings, std::string* note) {
+  if (!settings.algebraic_start) {
+    *note = "algebraic_start is off";
+    return nullptr;
+  }
+  if (static_cast<int>(test.identified.modes.size()) != model.coordinate_count()) {
+    *note = fmt::format("{} identified modes for {} coordinates", test.identified.modes.size(),
+                        model.coordinate_count());
+    return nullptr;
+  }
+  std::vector<std::complex<double>> lambda;
+  for (const auto& mode : test.identified.modes) lambda.push_back(mode.lambda);
+  const updating::CharacteristicProblem problem =
+      updating::MakeCharacteristicProblem(model, lambda, test.record, test.excitation);
+  return std::make_shared<const updating::CharacteristicResult>(
+      updating::SolveCharacteristicEquation(problem, settings.algebraic));
+}
+
+std::string FormatNumber(double value) {
+  return std::isfinite(value) ? fmt::format("{:.6g}", value) : std::string("-");
+}
+
+void PrintSummary(const updating::UpdateResult& result,
+                  const updating::CharacteristicResult* algebraic, const std::string& start) {
+  if (algebraic) {
+    int admissible = 0;
+    for (const auto& set : algebraic->solutions) admissible += set.admissible ? 1 : 0;
+    std::cout << fmt::format("route 1: {} ({} admissible sets{})\n", algebraic->status_name(),
+                             admissible, algebraic->ambiguous ? ", ambiguous choice" : "");
+  }
+  std::cout << fmt::format("route 2: {} after {} iterations (start: {}), cost {:.6g} -> {:.6g}\n",
+                           result.termination_name(), result.iterations, start, result.initial_cost,
+                           result.final_cost);
+  std::cout << fmt::format("{:<12} {:>13} {:>13} {:>11} {:>9} {:>10}\n", "parameter", "value",
+                           "initial", "std", "rel_std", "units");
+  for (const updating::ParameterEstimate& p : result.parameters) {
+    const std::string name = p.test.empty() ? p.name : p.test + ":" + p.name;
+    std::cout << fmt::format(
+        "{:<12} {:>13} {:>13} {:>11} {:>9} {:>10}{}{}\n", name, FormatNumber(p.value),
+        FormatNumber(p.initial), FormatNumber(p.std), FormatNumber(p.relative_std), p.units,
+        p.determined ? "" : "  (undetermined)", p.at_bound ? "  (at bound)" : "");
+  }
+  if (!result.undetermined.empty()) {
+    std::cout << fmt::format("undetermined by the records: {}\n",
+                             fmt::join(result.undetermined, ", "));
+  }
+  for (const updating::TestFit& fit : result.tests) {
+    for (size_t c = 0; c < fit.channels.size(); ++c) {
+      std::cout << fmt::format("correlation K({}, {}) = {:.4f}\n", fit.name, fit.channels[c],
+                               fit.correlation[static_cast<Eigen::Index>(c)]);
+    }
+  }
+}
+
+}  // namespace
+
+int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::string>& data_paths,
+                     const std::string& output_path, const CommonOptions& common) {
+  const Scenario scenario = LoadScenario(scenario_path);
+  const auto model = scenario.MakeModel();
+  updating::UpdatingSettings settings =
+      scenario.root.Has("updating")
+          ? updating::ReadUpdatingSettings(scenario.root.Child("updating"), *model,
+                                           scenario.simulation.integrator)
+          : updating::MakeDefaultUpdatingSettings(*model, scenario.simulation.integrator);
+  settings.options.quiet = common.quiet;
+  const identification::IdentificationOptions identification_options =
+      scenario.root.Has("identification")
+          ? ReadIdentificationSettings(scenario.root.Child("identification"))
+          : identification::IdentificationOptions();
+
+  // Every record is read and checked before any long work starts.
+  std::vector<LoadedTest> tests;
+  for (const std::string& path : data_paths) {
+    tests.push_back(LoadTest(path, scenario, *model, identification_options));
+    if (!common.quiet) {
+      const LoadedTest& test = tests.back();
+      std::cerr << fmt::format("mbid: {}: {} samples x {} channels, {} ({}), {} modes identified\n",
+                               path, test.record.samples(), test.record.channel_count(),
+                               test.excitation.type_name(), test.excitation_source,
+                               test.identified.modes.size());
+    }
+  }
+
+  std::string start = "scenario";
+  std::string note;
+  const auto algebraic = SolveRouteOne(*model, tests.front(), settings, &note);
+  // Route 1 only informs the start: its failure is reported, the fit starts from the scenario.
+  if (algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)) {
+    start = "route1";
+  }
+  if (!common.quiet) {
+    std::cerr << fmt::format("mbid: route 1: {}; route 2 starts from {}{}\n",
+                             algebraic ? algebraic->status_name() : "not run", start,
+                             note.empty() ? "" : " (" + note + ")");
+  }
+
+  std::vector<updating::TestRecord> records;
+  for (const LoadedTest& test : tests) {
+    updating::TestRecord record =
+        updating::MakeTestRecord(test.path, test.record, test.excitation, settings);
+    // The identification's residual noise weighs the channels the settings leave open.
+    for (size_t c = 0; c < test.identified.channels.size(); ++c) {
+      const double noise = test.identified.noise_std[static_cast<Eigen::Index>(c)];
+      if (noise > 0) record.noise_std.emplace(test.identified.channels[c], noise);
+    }
+    records.push_back(std::move(record));
+  }
+  updating::UpdateResult result = updating::UpdateModel(*model, records, settings.options);
+  if (algebraic) updating::MarkAlgebraicAmbiguity(*algebraic, result);
+
+  const bool converged = result.termination == updating::UpdateResult::Termination::kConverged;
+  nlohmann::json summary = updating::UpdateResultToJson(result, algebraic.get());
+  summary["start"] = start;
+  if (!note.empty()) summary["start_note"] = note;
+  // A failed fit leaves no output file (interfaces.md); standard output still gets its JSON.
+  if (common.json_path == "-" || (converged && !common.json_path.empty())) {
+    WriteJson(summary, common.json_path);
+  }
+  if (converged && !output_path.empty()) {
+    H5Writer file(output_path);
+    file.WriteMeasurement(tests.front().record);
+    file.WriteScenarioYaml(scenario.yaml_text);
+    updating::WriteUpdatingGroup(file, result, algebraic.get());
+    file.Commit();
+  }
+  for (const std::string& warning : result.warnings) {
+    if (!common.quiet) std::cerr << "mbid: warning: " << warning << "\n";
+  }
+  if (common.json_path != "-") PrintSummary(result, algebraic.get(), start);
+  if (!converged) {
+    std::cerr << fmt::format("mbid: numerical failure: updating: {}: {}\n",
+                             result.termination_name(), result.message);
+  }
+  return static_cast<int>(result.exit_code());
+}
+
+}  // namespace mbid::app
+
+#else
+
+namespace mbid::app {
+
+// This build has no model updating (identification/updating.cmake is not part of it).
+int RunUpdateCommand(const std::string& /*scenario_path*/,
+                     const std::vector<std::string>& /*data_paths*/,
+                     const std::string& /*output_path*/, const CommonOptions& /*common*/) {
+  std::cerr << "mbid: failure: update: not available in this build (the updating library, "
+               "identification/updating.cmake, is not part of it)\n";
+  return static_cast<int>(ExitCode::kOther);
+}
+
+}  // namespace mbid::app
+
+#endif
