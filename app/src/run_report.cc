@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include "mbid/app/gnuplot.h"
@@ -184,6 +185,98 @@ std::string ModalTableMarkdown(const identification::ModalResult& result,
   }
   out << fmt::format(". Method `{}`, model order {}, effective rank {}.\n", result.method,
                      result.model_order, result.effective_rank);
+  return out.str();
+}
+
+std::string DrawResimulationFigure(const std::string& folder, const Measurement& measured,
+                                   const updating::TestFit& fit, int channel) {
+  Figure figure;
+  const std::string& name = fit.channels[channel];
+  const int column = measured.FindChannel(name);
+  figure.title = fmt::format("{}: record and re-simulation with the tuned parameters (K = {:.4f})",
+                             name, fit.correlation[channel]);
+  figure.x_label = "time, s";
+  figure.y_label = fmt::format("{}, {}", name, fit.simulated.units[channel]);
+  figure.series.push_back(
+      {"record", measured.CalcTime(), measured.values.col(column), kRecordStyle});
+  figure.series.push_back({"re-simulation (tuned model)", fit.simulated.CalcTime(),
+                           fit.simulated.values.col(channel), "lines lw 1.5 lc rgb '#2ca02c'"});
+  const std::string file = fmt::format("resimulation_{}.png", name);
+  DrawFigure(figure, Path(folder, file));
+  return file;
+}
+
+std::string DrawConvergenceFigure(const std::string& folder, const updating::UpdateResult& result) {
+  Figure figure;
+  figure.title = "Model updating (Route 2): cost per Ceres iteration";
+  figure.x_label = "iteration (all stages in order)";
+  figure.y_label = "cost, 1/2 sum of squared weighted residuals";
+  figure.log_y = true;
+  Eigen::VectorXd x(static_cast<Eigen::Index>(result.history.size()));
+  Eigen::VectorXd y(x.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    x[i] = static_cast<double>(i);
+    y[i] = std::max(result.history[static_cast<size_t>(i)].cost, 1e-300);
+  }
+  figure.series.push_back({"cost", x, y, "linespoints pt 7 ps 0.6 lc rgb '#1f77b4'"});
+  DrawFigure(figure, Path(folder, "convergence.png"));
+  return "convergence.png";
+}
+
+std::string TunedParametersMarkdown(const updating::UpdateResult& result,
+                                    const model::MechanicalModel& truth) {
+  std::ostringstream out;
+  out << fmt::format(
+      "Termination `{}` after {} iterations; cost {:.4g} -> {:.4g}; Jacobian "
+      "from {}.\n\n",
+      result.termination_name(), result.iterations, result.initial_cost, result.final_cost,
+      result.jacobian);
+  out << "| parameter | tuned | std | start | model (truth of a simulated test) | difference |\n";
+  out << "|---|---|---|---|---|---|\n";
+  for (const updating::ParameterEstimate& p : result.parameters) {
+    double true_value = std::numeric_limits<double>::quiet_NaN();
+    for (const model::Parameter& q : truth.parameters()) {
+      if (q.name == p.name) true_value = q.value;
+    }
+    out << fmt::format(
+        "| {} ({}) | {:.4g} | {} | {:.4g} | {:.4g} | {} |\n", p.name, p.units, p.value,
+        std::isfinite(p.std) ? fmt::format("{:.2g} ({:.2g}%)", p.std, 100 * p.relative_std)
+                             : "undetermined",
+        p.initial, true_value,
+        std::isfinite(true_value)
+            ? fmt::format("{:+.3g}%", 100 * (p.value - true_value) / true_value)
+            : "");
+  }
+  if (!result.undetermined.empty()) {
+    out << "\n**The record leaves these parameters undetermined:** "
+        << fmt::format("{}", fmt::join(result.undetermined, ", "))
+        << " (their values above are not results).\n";
+  }
+  for (const std::string& warning : result.warnings) out << "\n> " << warning << "\n";
+  return out.str();
+}
+
+std::string AlgebraicSetsMarkdown(const updating::CharacteristicResult& result) {
+  std::ostringstream out;
+  out << fmt::format("Route 1 (eq. 7) from the identified poles: `{}`, {} of {} starts converged",
+                     result.status_name(), result.converged_starts, result.starts);
+  if (result.ambiguous) out << "; **ambiguous** (rival sets fit the initial state about as well)";
+  out << ".\n\n| set | admissible | mismatch of the initial state |";
+  for (const std::string& q : result.coordinates) out << " c_" << q << " |";
+  for (const std::string& q : result.coordinates) out << " d_" << q << " |";
+  out << "\n|---|---|---|";
+  for (size_t i = 0; i < 2 * result.coordinates.size(); ++i) out << "---|";
+  out << "\n";
+  for (size_t k = 0; k < result.solutions.size(); ++k) {
+    const updating::CharacteristicSolution& set = result.solutions[k];
+    out << fmt::format("| {}{} | {} | {} |", k + 1,
+                       static_cast<int>(k) == result.chosen ? " (chosen)" : "",
+                       set.admissible ? "yes" : set.reason,
+                       set.admissible ? fmt::format("{:.3g}", set.mismatch) : "");
+    for (Eigen::Index i = 0; i < set.c.size(); ++i) out << fmt::format(" {:.3g} |", set.c[i]);
+    for (Eigen::Index i = 0; i < set.d.size(); ++i) out << fmt::format(" {:.3g} |", set.d[i]);
+    out << "\n";
+  }
   return out.str();
 }
 

@@ -28,10 +28,11 @@ Scenario LoadScenario(const std::string& path) {
 }
 
 Scenario LoadScenarioFromText(const std::string& text, const std::string& source) {
-  Scenario scenario{source, "", text, YamlReader::FromString(text, source), false, {}, {}, {}};
+  Scenario scenario{source, "", text, YamlReader::FromString(text, source), false, {},
+                    {},     {}, 0.95};
   if (!scenario.root.IsMap()) scenario.root.Fail("not a mapping", "a YAML mapping of sections");
-  scenario.root.ExpectMap(
-      {"name", "model", "excitation", "simulation", "sensors", "identification", "updating"});
+  scenario.root.ExpectMap({"name", "model", "excitation", "simulation", "sensors", "identification",
+                           "updating", "validation"});
   scenario.name = scenario.root.String("name");
   if (scenario.name.empty() || scenario.name.find('/') != std::string::npos) {
     scenario.root.FailAt("name", "'" + scenario.name + "'",
@@ -45,6 +46,14 @@ Scenario LoadScenarioFromText(const std::string& text, const std::string& source
   }
   if (scenario.root.Has("simulation")) {
     scenario.simulation = simulation::ReadSimulationOptions(scenario.root.Child("simulation"));
+  }
+  if (scenario.root.Has("validation")) {
+    const YamlReader validation = scenario.root.Child("validation");
+    validation.ExpectMap({"min_correlation"});
+    scenario.validation_min_correlation = validation.Double("min_correlation", 0.95);
+    if (!(scenario.validation_min_correlation > -1 && scenario.validation_min_correlation <= 1)) {
+      validation.FailAt("min_correlation", "out of range", "a correlation in (-1, 1]");
+    }
   }
   if (scenario.root.Has("sensors")) {
     scenario.sensors = simulation::ReadSensorOptions(scenario.root.Child("sensors"), *model);

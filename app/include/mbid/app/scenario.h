@@ -21,6 +21,9 @@ struct Scenario {
   simulation::Excitation excitation;
   simulation::SimulationOptions simulation;  // defaults where the section is absent
   simulation::SensorOptions sensors;         // defaults where the section is absent
+  // `validation: {min_correlation: K}`: the run passes when the re-simulation with the tuned
+  // parameters correlates with the record at least this well on every channel.
+  double validation_min_correlation = 0.95;
 
   // A fresh model instance (one per worker).
   std::unique_ptr<model::MechanicalModel> MakeModel() const;
