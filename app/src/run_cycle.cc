@@ -14,6 +14,7 @@
 #include "mbid/app/result_writers.h"
 #include "mbid/app/run_report.h"
 #include "mbid/app/scenario.h"
+#include "mbid/app/updating_glue.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
@@ -124,32 +125,19 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
                                            scenario.simulation.integrator)
           : updating::MakeDefaultUpdatingSettings(*model, scenario.simulation.integrator);
   settings.options.quiet = common.quiet;
-  std::unique_ptr<updating::CharacteristicResult> algebraic;
   std::string start_note = "the scenario's values";
-  if (settings.algebraic_start &&
-      static_cast<int>(identified.modes.size()) == model->coordinate_count()) {
-    std::vector<std::complex<double>> poles;
-    for (const auto& mode : identified.modes) poles.push_back(mode.lambda);
-    algebraic =
-        std::make_unique<updating::CharacteristicResult>(updating::SolveCharacteristicEquation(
-            updating::MakeCharacteristicProblem(*model, poles, test.measured, excitation),
-            settings.algebraic));
-    std::string note;
-    if (updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)) {
-      start_note = "Route 1 (eq. 7)";
-    }
-    progress.Say(fmt::format("Route 1 (eq. 7): {}{}", algebraic->status_name(),
-                             note.empty() ? "" : "; " + note));
-  } else {
-    progress.Say(fmt::format("Route 1 (eq. 7) skipped: {} identified modes for {} coordinates",
-                             identified.modes.size(), model->coordinate_count()));
+  std::string note;
+  const auto algebraic =
+      SolveAlgebraicRoute(*model, identified, test.measured, excitation, settings, &note);
+  if (algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)) {
+    start_note = "Route 1 (eq. 7)";
   }
+  progress.Say(fmt::format("Route 1 (eq. 7): {}{}",
+                           algebraic ? algebraic->status_name() : "skipped",
+                           note.empty() ? "" : "; " + note));
   updating::TestRecord record =
       updating::MakeTestRecord(scenario.name, test.measured, excitation, settings);
-  for (size_t c = 0; c < identified.channels.size(); ++c) {
-    const double noise = identified.noise_std[static_cast<Eigen::Index>(c)];
-    if (noise > 0) record.noise_std.emplace(identified.channels[c], noise);
-  }
+  WeighByIdentifiedNoise(identified, record);
   progress.Say(fmt::format("Route 2 (Ceres, output error) from {}", start_note));
   updating::UpdateResult tuned = updating::UpdateModel(*model, {record}, settings.options);
   if (algebraic) updating::MarkAlgebraicAmbiguity(*algebraic, tuned);

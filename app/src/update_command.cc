@@ -3,22 +3,19 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
+#include <cmath>
+#include <complex>
 #include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "mbid/app/commands.h"
-#include "mbid/common/error.h"
-
-#ifdef MBID_HAVE_UPDATING
-
-#include <algorithm>
-#include <cmath>
-#include <complex>
-
 #include "mbid/app/identification_settings.h"
 #include "mbid/app/scenario.h"
+#include "mbid/app/updating_glue.h"
+#include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
 #include "mbid/identification/identify.h"
@@ -82,27 +79,6 @@ LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
   }
   test.identified = identification::Identify(test.record, options, path);
   return test;
-}
-
-// Route 1 from the first record's poles when they are as many as the model has coordinates.
-std::shared_ptr<const updating::CharacteristicResult> SolveRouteOne(
-    const model::MechanicalModel& model, const LoadedTest& test,
-    const updating::UpdatingSettings& settings, std::string* note) {
-  if (!settings.algebraic_start) {
-    *note = "algebraic_start is off";
-    return nullptr;
-  }
-  if (static_cast<int>(test.identified.modes.size()) != model.coordinate_count()) {
-    *note = fmt::format("{} identified modes for {} coordinates", test.identified.modes.size(),
-                        model.coordinate_count());
-    return nullptr;
-  }
-  std::vector<std::complex<double>> lambda;
-  for (const auto& mode : test.identified.modes) lambda.push_back(mode.lambda);
-  const updating::CharacteristicProblem problem =
-      updating::MakeCharacteristicProblem(model, lambda, test.record, test.excitation);
-  return std::make_shared<const updating::CharacteristicResult>(
-      updating::SolveCharacteristicEquation(problem, settings.algebraic));
 }
 
 std::string FormatNumber(double value) {
@@ -173,7 +149,8 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
 
   std::string start = "scenario";
   std::string note;
-  const auto algebraic = SolveRouteOne(*model, tests.front(), settings, &note);
+  const auto algebraic = SolveAlgebraicRoute(*model, tests.front().identified, tests.front().record,
+                                             tests.front().excitation, settings, &note);
   // Route 1 only informs the start: its failure is reported, the fit starts from the scenario.
   if (algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)) {
     start = "route1";
@@ -188,11 +165,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   for (const LoadedTest& test : tests) {
     updating::TestRecord record =
         updating::MakeTestRecord(test.path, test.record, test.excitation, settings);
-    // The identification's residual noise weighs the channels the settings leave open.
-    for (size_t c = 0; c < test.identified.channels.size(); ++c) {
-      const double noise = test.identified.noise_std[static_cast<Eigen::Index>(c)];
-      if (noise > 0) record.noise_std.emplace(test.identified.channels[c], noise);
-    }
+    WeighByIdentifiedNoise(test.identified, record);
     records.push_back(std::move(record));
   }
   updating::UpdateResult result = updating::UpdateModel(*model, records, settings.options);
@@ -225,20 +198,3 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
 }
 
 }  // namespace mbid::app
-
-#else
-
-namespace mbid::app {
-
-// This build has no model updating (identification/updating.cmake is not part of it).
-int RunUpdateCommand(const std::string& /*scenario_path*/,
-                     const std::vector<std::string>& /*data_paths*/,
-                     const std::string& /*output_path*/, const CommonOptions& /*common*/) {
-  std::cerr << "mbid: failure: update: not available in this build (the updating library, "
-               "identification/updating.cmake, is not part of it)\n";
-  return static_cast<int>(ExitCode::kOther);
-}
-
-}  // namespace mbid::app
-
-#endif

@@ -1,7 +1,3 @@
-#include "steps.h"
-
-#ifdef MBID_HAVE_UPDATING
-
 #include <fmt/format.h>
 
 #include <cmath>
@@ -10,11 +6,13 @@
 #include <memory>
 #include <optional>
 
+#include "mbid/app/updating_glue.h"
 #include "mbid/common/error.h"
 #include "mbid/identification/updating/characteristic.h"
 #include "mbid/identification/updating/output_error.h"
 #include "mbid/identification/updating/result_io.h"
 #include "mbid/identification/updating/settings.h"
+#include "steps.h"
 
 namespace mbid::app::internal {
 namespace {
@@ -22,27 +20,6 @@ namespace {
 nlohmann::ordered_json Number(double value) {
   if (!std::isfinite(value)) return nullptr;
   return value;
-}
-
-// Route 1 (method.md, eqs. 6-8) from the identified poles, when they are as many as the model
-// has coordinates; nothing otherwise (the fit then starts from the scenario's values).
-std::shared_ptr<const updating::CharacteristicResult> SolveRouteOne(
-    const StepInput& input, const updating::UpdatingSettings& settings, std::string* note) {
-  if (!settings.algebraic_start) return nullptr;
-  const model::MechanicalModel& model = *input.model;
-  if (!input.identified ||
-      static_cast<int>(input.identified->modes.size()) != model.coordinate_count()) {
-    *note = input.identified ? fmt::format("{} identified modes for {} coordinates",
-                                           input.identified->modes.size(), model.coordinate_count())
-                             : "no identify step";
-    return nullptr;
-  }
-  std::vector<std::complex<double>> lambda;
-  for (const auto& mode : input.identified->modes) lambda.push_back(mode.lambda);
-  const updating::CharacteristicProblem problem = updating::MakeCharacteristicProblem(
-      model, lambda, input.test->measured, input.scenario->excitation);
-  return std::make_shared<const updating::CharacteristicResult>(
-      updating::SolveCharacteristicEquation(problem, settings.algebraic));
 }
 
 }  // namespace
@@ -59,19 +36,17 @@ void RunUpdateStep(const StepInput& input, CaseOutcome& outcome) {
 
   std::string start = "scenario";
   std::string note;
-  const auto algebraic = SolveRouteOne(input, settings, &note);
+  const auto algebraic = input.identified
+                             ? SolveAlgebraicRoute(model, *input.identified, input.test->measured,
+                                                   scenario.excitation, settings, &note)
+                             : nullptr;
+  if (!input.identified) note = "no identify step";
   if (algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)) {
     start = "route1";
   }
   updating::TestRecord test =
       updating::MakeTestRecord(outcome.id, input.test->measured, scenario.excitation, settings);
-  // The identification's residual noise weighs the channels the settings leave open.
-  if (input.identified) {
-    for (size_t c = 0; c < input.identified->channels.size(); ++c) {
-      const double noise = input.identified->noise_std[static_cast<Eigen::Index>(c)];
-      if (noise > 0) test.noise_std.emplace(input.identified->channels[c], noise);
-    }
-  }
+  if (input.identified) WeighByIdentifiedNoise(*input.identified, test);
   auto result = std::make_shared<updating::UpdateResult>(
       updating::UpdateModel(model, {test}, settings.options));
   if (algebraic) updating::MarkAlgebraicAmbiguity(*algebraic, *result);
@@ -109,19 +84,3 @@ void RunUpdateStep(const StepInput& input, CaseOutcome& outcome) {
 }
 
 }  // namespace mbid::app::internal
-
-#else
-
-namespace mbid::app::internal {
-
-// This build has no model updating (identification/updating.cmake is not part of it): the step
-// says so for each case.
-void RunUpdateStep(const StepInput& /*input*/, CaseOutcome& /*outcome*/) {
-  throw StepNotAvailable(
-      "update: not available in this build (the updating library, "
-      "identification/updating.cmake, is not part of it)");
-}
-
-}  // namespace mbid::app::internal
-
-#endif
