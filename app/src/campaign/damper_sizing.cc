@@ -57,8 +57,12 @@ class Evaluator {
     // The damping ratio alone needs no simulation.
     if (!campaign.damper_sizing.has_settling_target()) campaign_.steps = {false, false, false};
   }
+  // Targets bisect over the same brackets ("all" repeats another target's): each damping is
+  // evaluated once.
   Point operator()(double damping, int* evaluations, std::string* failure) const {
     ++*evaluations;
+    const auto cached = cache_.find(damping);
+    if (cached != cache_.end()) return cached->second;
     const CampaignCase one_case = MakeAdHocCase(
         campaign_, {{key_, NumberNode(damping), "damper_sizing.range_Nms_per_rad"}}, "sizing");
     const CaseOutcome outcome = ComputeCase(campaign_, one_case);
@@ -70,12 +74,14 @@ class Evaluator {
     point.min_damping_ratio =
         *std::min_element(outcome.exact_damping_ratios.begin(), outcome.exact_damping_ratios.end());
     point.settling_time_s = outcome.settling_time_s;
+    cache_.emplace(damping, point);
     return point;
   }
 
  private:
   Campaign campaign_;
   std::string key_;
+  mutable std::map<double, Point> cache_;
 };
 
 Eigen::VectorXd ToVector(const std::vector<double>& values) {
@@ -283,9 +289,8 @@ DamperSizingResult SizeDampers(const Campaign& campaign,
       }
       result.refinement_evaluations += evaluations;
       sizing.smallest_Nms_per_rad.push_back(high);
-      std::string note =
-          fmt::format("bisection between {:.6g} and {:.6g} N*m*s/rad ({} evaluations)",
-                      damping[first - 1], damping[first], evaluations);
+      std::string note = fmt::format("bisection between {:.6g} and {:.6g} N*m*s/rad ({} steps)",
+                                     damping[first - 1], damping[first], evaluations);
       if (!failure.empty()) note += "; some evaluations failed: " + failure;
       sizing.notes.push_back(note);
     }
