@@ -118,8 +118,6 @@ CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case) 
     Fail(outcome, "invalid_input", step, error.what());
   } catch (const NumericalError& error) {
     Fail(outcome, "numerical_failure", step, error.what());
-  } catch (const internal::StepNotAvailable& error) {
-    Fail(outcome, "not_available", step, error.what());
   } catch (const std::exception& error) {
     Fail(outcome, "error", step, error.what());
   }

@@ -137,6 +137,11 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
     try {
       if (folder.Prepare(campaign, options.resume) == internal::ResultsFolder::State::kComplete) {
         decision = kAlreadyComplete;
+        // A kill between the final rename and the clean-up leaves the case files behind.
+        folder.RemoveCases();
+        std::error_code ignored;
+        fs::remove(folder.Path(".campaign-info.h5"), ignored);
+        fs::remove(folder.Path(".study.h5"), ignored);
       } else {
         const std::vector<bool> committed = folder.ScanCommitted(campaign);
         for (size_t i = 0; i < committed.size(); ++i) {

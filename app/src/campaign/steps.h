@@ -1,8 +1,7 @@
 #pragma once
 
-// The identify and update steps of a campaign case. They live apart from the case runner so
-// that a build without the identification or updating library still runs the other steps and
-// says which step it lacks.
+// The identify and update steps of a campaign case: what each takes from the case and adds to
+// its results.
 
 #include <memory>
 
@@ -21,12 +20,6 @@ struct StepInput {
   std::shared_ptr<const simulation::SimulationResult> test;
   // The identify step's result, if it ran (the update step starts from its poles).
   std::shared_ptr<const identification::ModalResult> identified;
-};
-
-// Thrown by a step this build does not have; the case records status "not_available".
-class StepNotAvailable : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
 };
 
 // Identifies the modes of the case's record with the scenario's identification settings; adds
