@@ -8,9 +8,14 @@
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
 #include "mbid/simulation/cvodes_integrator.h"
+#include "simulation_setup.h"
 
 namespace mbid::simulation {
 namespace {
+
+using internal::ChannelSource;
+using internal::MakeForcedModel;
+using internal::ResolveChannels;
 
 // Relative step of the central differences of the initial coordinates: the static equilibrium
 // is solved to roundoff and is smooth in the parameters, so the O(h^2) error is ~1e-8.
@@ -18,59 +23,6 @@ constexpr double kInitialStateStep = 1e-4;
 // Step (rad) of dy/dq: outputs are angles smooth on the scale of 1 rad, so the truncation error
 // h^2 ~ 1e-12 and the roundoff 1e-16 / h ~ 1e-10 stay far below the sensitivities' tolerance.
 constexpr double kOutputStep_rad = 1e-6;
-
-// Channel c reads output `index` (is_output) or coordinate `index`.
-struct ChannelSource {
-  bool is_output = true;
-  int index = 0;
-  std::string units;
-};
-
-std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
-                                           const std::vector<std::string>& channels) {
-  std::vector<ChannelSource> sources;
-  for (const std::string& channel : channels) {
-    const auto& outputs = model.output_names();
-    const auto& coordinates = model.coordinate_names();
-    const auto output = std::find(outputs.begin(), outputs.end(), channel);
-    const auto coordinate = std::find(coordinates.begin(), coordinates.end(), channel);
-    if (output != outputs.end()) {
-      const int i = static_cast<int>(output - outputs.begin());
-      sources.push_back({true, i, model.output_units()[i]});
-    } else if (coordinate != coordinates.end()) {
-      sources.push_back({false, static_cast<int>(coordinate - coordinates.begin()), "rad"});
-    } else {
-      throw InputError("sensors", "channels", "unknown channel '" + channel + "'",
-                       "an output or a coordinate of the model");
-    }
-  }
-  return sources;
-}
-
-// The model carrying the excitation's time-dependent load (as Simulate builds it), or null for
-// a free decay.
-std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalModel& model,
-                                                        const Excitation& excitation) {
-  if (!(excitation.CalcForcingEndTime() > 0)) return nullptr;
-  std::unique_ptr<model::MechanicalModel> forced = model.Clone();
-  const int n = model.coordinate_count();
-  int torque_index = -1;
-  for (int i = 0; i < n; ++i) {
-    if (model.coordinate_names()[i] == excitation.coordinate) torque_index = i;
-  }
-  forced->SetExternalLoad([excitation, n, torque_index](double t,
-                                                        std::vector<model::PointLoad>& loads,
-                                                        Eigen::VectorXd& generalized_forces) {
-    const double factor = excitation.CalcForcingFactor(t);
-    if (factor == 0.0) return;
-    if (!excitation.point.empty()) loads.push_back({excitation.point, factor * excitation.force_N});
-    if (torque_index >= 0) {
-      generalized_forces = Eigen::VectorXd::Zero(n);
-      generalized_forces[torque_index] = factor * excitation.torque_Nm;
-    }
-  });
-  return forced;
-}
 
 // dq(0)/dp for each model parameter, by central differences on a clone.
 Eigen::MatrixXd CalcInitialStateSensitivity(const model::MechanicalModel& model,

@@ -5,41 +5,10 @@
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
 #include "mbid/simulation/cvodes_integrator.h"
+#include "simulation_setup.h"
 
 namespace mbid::simulation {
 namespace {
-
-// Where channel c comes from: an output (index into y) or a coordinate (index into q).
-struct ChannelSource {
-  bool is_output = true;
-  int index = 0;
-  std::string units;
-};
-
-std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
-                                           const std::vector<std::string>& channels) {
-  std::vector<ChannelSource> sources;
-  for (const std::string& channel : channels) {
-    bool found = false;
-    for (int i = 0; i < model.output_count() && !found; ++i) {
-      if (model.output_names()[i] == channel) {
-        sources.push_back({true, i, model.output_units()[i]});
-        found = true;
-      }
-    }
-    for (int i = 0; i < model.coordinate_count() && !found; ++i) {
-      if (model.coordinate_names()[i] == channel) {
-        sources.push_back({false, i, "rad"});
-        found = true;
-      }
-    }
-    if (!found) {
-      throw InputError("sensors", "channels", "unknown channel '" + channel + "'",
-                       "an output or a coordinate of the model");
-    }
-  }
-  return sources;
-}
 
 // Counters of two integration stretches (the forced one and the free decay).
 IntegratorStatistics AddStatistics(IntegratorStatistics total, const IntegratorStatistics& more) {
@@ -61,7 +30,8 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   if (!(options.duration_s > 0) || !(sensors.sample_rate_hz > 0)) {
     throw std::invalid_argument("Simulate: duration and sample rate must be positive");
   }
-  const std::vector<ChannelSource> sources = ResolveChannels(model, sensors.channels);
+  const std::vector<internal::ChannelSource> sources =
+      internal::ResolveChannels(model, sensors.channels);
   const double tau = sensors.sample_interval_s();
   // j = 0..s with s tau <= duration; the tolerance keeps 8 s at 100 Hz at 801 samples.
   const int samples = static_cast<int>(std::floor(options.duration_s / tau + 1e-9)) + 1;
@@ -70,30 +40,10 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   result.initial_q = CalcInitialCoordinates(model, excitation);
   result.forcing_end_s = excitation.CalcForcingEndTime();
 
-  // A forced test gets its own model instance carrying the excitation's load function: the
-  // caller's model stays unchanged.
-  std::unique_ptr<model::MechanicalModel> forced_model;
-  const bool forced = result.forcing_end_s > 0;
-  if (forced) {
-    forced_model = model.Clone();
-    const int n = model.coordinate_count();
-    int torque_index = -1;
-    for (int i = 0; i < n; ++i) {
-      if (model.coordinate_names()[i] == excitation.coordinate) torque_index = i;
-    }
-    forced_model->SetExternalLoad(
-        [excitation, n, torque_index](double t, std::vector<model::PointLoad>& loads,
-                                      Eigen::VectorXd& generalized_forces) {
-          const double factor = excitation.CalcForcingFactor(t);
-          if (factor == 0.0) return;
-          if (!excitation.point.empty())
-            loads.push_back({excitation.point, factor * excitation.force_N});
-          if (torque_index >= 0) {
-            generalized_forces = Eigen::VectorXd::Zero(n);
-            generalized_forces[torque_index] = factor * excitation.torque_Nm;
-          }
-        });
-  }
+  // A forced test gets its own model instance carrying the excitation's load function.
+  const std::unique_ptr<model::MechanicalModel> forced_model =
+      internal::MakeForcedModel(model, excitation);
+  const bool forced = forced_model != nullptr;
   const model::MechanicalModel& simulated = forced ? *forced_model : model;
   // While forced, stop at every sample and at the forcing's end: no step may straddle the kink
   // where the load switches off. The free decay may use dense output.
@@ -105,7 +55,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
 
   Measurement exact;
   exact.channels = sensors.channels;
-  for (const ChannelSource& source : sources) exact.units.push_back(source.units);
+  for (const internal::ChannelSource& source : sources) exact.units.push_back(source.units);
   exact.sample_interval_s = tau;
   exact.source = "simulation";
   exact.values.resize(samples, static_cast<Eigen::Index>(sources.size()));

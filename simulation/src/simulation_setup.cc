@@ -1,0 +1,53 @@
+#include "simulation_setup.h"
+
+#include <algorithm>
+
+#include "mbid/common/error.h"
+
+namespace mbid::simulation::internal {
+
+std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
+                                           const std::vector<std::string>& channels) {
+  std::vector<ChannelSource> sources;
+  for (const std::string& channel : channels) {
+    const auto& outputs = model.output_names();
+    const auto& coordinates = model.coordinate_names();
+    const auto output = std::find(outputs.begin(), outputs.end(), channel);
+    const auto coordinate = std::find(coordinates.begin(), coordinates.end(), channel);
+    if (output != outputs.end()) {
+      const int i = static_cast<int>(output - outputs.begin());
+      sources.push_back({true, i, model.output_units()[i]});
+    } else if (coordinate != coordinates.end()) {
+      sources.push_back({false, static_cast<int>(coordinate - coordinates.begin()), "rad"});
+    } else {
+      throw InputError("sensors", "channels", "unknown channel '" + channel + "'",
+                       "an output or a coordinate of the model");
+    }
+  }
+  return sources;
+}
+
+std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalModel& model,
+                                                        const Excitation& excitation) {
+  if (!(excitation.CalcForcingEndTime() > 0)) return nullptr;
+  std::unique_ptr<model::MechanicalModel> forced = model.Clone();
+  const int n = model.coordinate_count();
+  int torque_index = -1;
+  for (int i = 0; i < n; ++i) {
+    if (model.coordinate_names()[i] == excitation.coordinate) torque_index = i;
+  }
+  forced->SetExternalLoad([excitation, n, torque_index](double t,
+                                                        std::vector<model::PointLoad>& loads,
+                                                        Eigen::VectorXd& generalized_forces) {
+    const double factor = excitation.CalcForcingFactor(t);
+    if (factor == 0.0) return;
+    if (!excitation.point.empty()) loads.push_back({excitation.point, factor * excitation.force_N});
+    if (torque_index >= 0) {
+      generalized_forces = Eigen::VectorXd::Zero(n);
+      generalized_forces[torque_index] = factor * excitation.torque_Nm;
+    }
+  });
+  return forced;
+}
+
+}  // namespace mbid::simulation::internal

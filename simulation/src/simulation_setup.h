@@ -1,0 +1,30 @@
+#pragma once
+
+// What Simulate and SimulateWithSensitivities both need to set up a test (private to
+// simulation/).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/excitation.h"
+
+namespace mbid::simulation::internal {
+
+// Channel c reads output `index` (is_output) or coordinate `index`.
+struct ChannelSource {
+  bool is_output = true;
+  int index = 0;
+  std::string units;
+};
+
+// Throws InputError for a channel that is neither an output nor a coordinate of `model`.
+std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
+                                           const std::vector<std::string>& channels);
+
+// A clone of `model` carrying the excitation's time-dependent load, or null for a free decay:
+// the caller's model stays unchanged.
+std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalModel& model,
+                                                        const Excitation& excitation);
+
+}  // namespace mbid::simulation::internal
