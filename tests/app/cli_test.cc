@@ -10,61 +10,21 @@
 #include <sstream>
 #include <string>
 
+#include "command_test.h"
+
 namespace {
 
+using mbid::testing::CommandResult;
+using mbid::testing::ReadText;
 namespace fs = std::filesystem;
 
-const std::string kMbid = std::string(MBID_BINARY_DIR) + "/app/mbid";
 const std::string kReference = std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-struct CommandResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-class CliTest : public ::testing::Test {
+class CliTest : public mbid::testing::CommandTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("mbid_cli_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  CommandResult Run(const std::string& arguments) const {
-    const fs::path out = dir_ / "stdout.txt";
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string command =
-        kMbid + " " + arguments + " > " + out.string() + " 2> " + err.string();
-    const int status = std::system(command.c_str());
-    CommandResult result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = ReadText(out);
-    result.err = ReadText(err);
-    fs::remove(out);
-    fs::remove(err);
-    return result;
-  }
-
   // The reference scenario with `from` replaced by `to` (which must occur).
   fs::path WriteVariant(const std::string& from, const std::string& to) const {
-    std::string text = ReadText(kReference);
-    const size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    const fs::path path = dir_ / "scenario.yaml";
-    std::ofstream(path) << text;
-    return path;
+    return CommandTest::WriteVariant(kReference, "scenario.yaml", from, to);
   }
 
   // Nothing but what the test itself wrote.
@@ -73,8 +33,6 @@ class CliTest : public ::testing::Test {
       EXPECT_EQ(entry.path(), scenario) << "left behind: " << entry.path();
     }
   }
-
-  fs::path dir_;
 };
 
 struct BadScenario {

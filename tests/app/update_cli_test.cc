@@ -12,13 +12,13 @@
 #include <sstream>
 #include <string>
 
+#include "command_test.h"
 #include "mbid/common/hdf5_io.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kMbid = std::string(MBID_BINARY_DIR) + "/app/mbid";
 const std::string kScenarios = std::string(MBID_SOURCE_DIR) + "/scenarios/";
 
 // The reference crane's joints (scenarios/reference-crane.yaml, the simulation's truth).
@@ -26,57 +26,15 @@ const std::map<std::string, double> kTruth = {
     {"c_alpha", 4.9e7}, {"c_gamma", 1.1e6},  {"c_eta", 5.5e6}, {"c_theta", 9.4e6},
     {"d_alpha", 5.2e5}, {"d_gamma", 1.78e5}, {"d_eta", 4.4e4}, {"d_theta", 1.16e5}};
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using mbid::testing::CommandResult;
+using mbid::testing::ReadText;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-class UpdateCliTest : public ::testing::Test {
+class UpdateCliTest : public mbid::testing::CommandTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("mbid_update_cli_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  CommandResult Run(const std::string& arguments) const {
-    const fs::path out = dir_ / "stdout.txt";
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string command =
-        kMbid + " " + arguments + " > " + out.string() + " 2> " + err.string();
-    const int status = std::system(command.c_str());
-    CommandResult result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = ReadText(out);
-    result.err = ReadText(err);
-    fs::remove(out);
-    fs::remove(err);
-    return result;
-  }
-
   // scenarios/<name> with `from` replaced by `to` (when given), written as <stem>.yaml.
   fs::path WriteScenario(const std::string& name, const std::string& stem,
                          const std::string& from = "", const std::string& to = "") const {
-    std::string text = ReadText(kScenarios + name);
-    if (!from.empty()) {
-      const size_t at = text.find(from);
-      EXPECT_NE(at, std::string::npos) << from;
-      if (at != std::string::npos) text.replace(at, from.size(), to);
-    }
-    const fs::path path = dir_ / (stem + ".yaml");
-    std::ofstream(path) << text;
-    return path;
+    return WriteVariant(kScenarios + name, stem + ".yaml", from, to);
   }
 
   // The record of `scenario` by `mbid simulate`, next to it.
@@ -86,8 +44,6 @@ class UpdateCliTest : public ::testing::Test {
     EXPECT_EQ(result.exit_code, 0) << result.err;
     return record;
   }
-
-  fs::path dir_;
 };
 
 // The reference test shortened to 4 s (CI time): the first second and a half hold the fast
