@@ -13,6 +13,7 @@ class SingleProcess final : public Cluster {
  public:
   int rank() const override { return 0; }
   int size() const override { return 1; }
+  bool distributed() const override { return false; }
   int Broadcast(int value) override { return value; }
   // Queues every pending case at once: the workers never wait for the main thread.
   bool Pump(const std::function<int()>& next, WorkQueue& local, const Tally& /*tally*/,

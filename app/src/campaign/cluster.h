@@ -17,7 +17,8 @@ struct Tally {
 
 // The processes that share a campaign: one process alone, or the ranks of an MPI job
 // (`mpirun -n K mbid campaign ...`). Rank 0 owns the list of pending cases and hands them out
-// one at a time on request, so that fast ranks take more cases; every rank writes its cases'
+// one at a time on request, so that fast ranks take more cases (each rank keeps one case per
+// worker queued ahead, which hides the answer's delay); every rank writes its cases'
 // files itself, and rank 0 merges them at the end. Only the main thread of a rank calls MPI
 // (MPI_THREAD_FUNNELED); worker threads never do.
 class Cluster {
@@ -26,6 +27,8 @@ class Cluster {
   virtual int rank() const = 0;
   virtual int size() const = 0;
   bool is_root() const { return rank() == 0; }
+  // Started by mpirun (even with one rank): the job's launcher placed the processes on cores.
+  virtual bool distributed() const = 0;
 
   // Rank 0's `value`, on every rank.
   virtual int Broadcast(int value) = 0;

@@ -37,6 +37,7 @@ class MpiCluster final : public Cluster {
 
   int rank() const override { return rank_; }
   int size() const override { return size_; }
+  bool distributed() const override { return true; }
 
   int Broadcast(int value) override {
     MPI_Bcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD);
@@ -51,7 +52,9 @@ class MpiCluster final : public Cluster {
 
   int remote_done() const override { return remote_done_; }
   int remote_failed() const override { return remote_failed_; }
-  std::chrono::milliseconds poll_interval() const override { return std::chrono::milliseconds(1); }
+  // Cases are fetched one per worker ahead, so an answer may take a poll interval without a
+  // worker waiting for it; rare polls leave the workers' cores alone.
+  std::chrono::milliseconds poll_interval() const override { return std::chrono::milliseconds(10); }
   [[noreturn]] void Abort(int exit_code) override {
     MPI_Abort(MPI_COMM_WORLD, exit_code);
     std::abort();
@@ -74,7 +77,7 @@ class MpiCluster final : public Cluster {
         ++finished_ranks_;
       }
     }
-    for (int hungry = local.Hungry(); hungry > 0; --hungry) {
+    for (int wanted = local.Wanted(); wanted > 0; --wanted) {
       const int index = next();
       if (index < 0) {
         local.Close();
@@ -98,7 +101,7 @@ class MpiCluster final : public Cluster {
         local.Push(assigned_);
       }
     }
-    if (local.Hungry() > 0) {
+    if (local.Wanted() > 0) {
       int counts[2];
       TakeCounts(tally, counts);
       MPI_Send(counts, 2, MPI_INT, 0, kTagRequest, MPI_COMM_WORLD);

@@ -125,8 +125,8 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
   summary.workers =
       options.workers > 0
           ? options.workers
-          : (cluster.size() > 1
-                 ? 1
+          : (cluster.distributed()
+                 ? 1  // mpirun placed one rank per core
                  : std::max(1, static_cast<int>(std::thread::hardware_concurrency())));
 
   const internal::ResultsFolder folder(output_dir);
@@ -178,7 +178,7 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
 
   std::condition_variable wakeup;
   std::mutex wakeup_mutex;
-  internal::WorkQueue queue(wakeup);
+  internal::WorkQueue queue(wakeup, summary.workers);
   internal::Tally tally;
   std::atomic<int> running{summary.workers};
   std::mutex error_mutex;

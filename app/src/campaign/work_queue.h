@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -8,12 +9,15 @@
 namespace mbid::app::internal {
 
 // The case indices waiting for this process's worker threads. The main thread pushes (all at
-// once, or on demand when cases come from another MPI rank) and closes; workers pop, blocking
-// until a case comes or the queue is closed and empty. Every change wakes the main thread
-// through `main_wakeup`, so that it can fetch more work or report progress at once.
+// once, or on demand when cases come from MPI rank 0) and closes; workers pop, blocking until a
+// case comes or the queue is closed and empty. A worker that starts waiting wakes the main
+// thread through `main_wakeup`, so that it can fetch more work at once.
 class WorkQueue {
  public:
-  explicit WorkQueue(std::condition_variable& main_wakeup) : main_wakeup_(main_wakeup) {}
+  // `prefetch`: how many cases to keep queued ahead of the workers when fetching on demand
+  // (one per worker hides the time a case takes to arrive from rank 0).
+  WorkQueue(std::condition_variable& main_wakeup, int prefetch)
+      : main_wakeup_(main_wakeup), prefetch_(prefetch) {}
 
   void Push(int index) {
     {
@@ -41,10 +45,10 @@ class WorkQueue {
     queue_.pop_front();
     return index;
   }
-  // Workers waiting beyond the cases already queued: how many more cases to fetch now.
-  int Hungry() const {
+  // How many more cases to fetch now: up to `prefetch` queued ahead of the workers.
+  int Wanted() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return closed_ ? 0 : waiting_ - static_cast<int>(queue_.size());
+    return closed_ ? 0 : std::max(0, prefetch_ - static_cast<int>(queue_.size()));
   }
   bool closed() const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -55,6 +59,7 @@ class WorkQueue {
   mutable std::mutex mutex_;
   std::condition_variable workers_;
   std::condition_variable& main_wakeup_;
+  const int prefetch_;
   std::deque<int> queue_;
   int waiting_ = 0;
   bool closed_ = false;
