@@ -63,4 +63,19 @@ bool SensitivityOptions::IsValid(std::string* why) const {
   return true;
 }
 
+IntegratorStatistics& IntegratorStatistics::operator+=(const IntegratorStatistics& later) {
+  steps += later.steps;
+  rhs_evaluations += later.rhs_evaluations;
+  linear_solver_setups += later.linear_solver_setups;
+  error_test_failures += later.error_test_failures;
+  nonlinear_iterations += later.nonlinear_iterations;
+  nonlinear_convergence_failures += later.nonlinear_convergence_failures;
+  jacobian_evaluations += later.jacobian_evaluations;
+  rhs_evaluations_for_jacobian += later.rhs_evaluations_for_jacobian;
+  rhs_evaluations_for_sensitivities += later.rhs_evaluations_for_sensitivities;
+  last_step_s = later.last_step_s;
+  last_order = later.last_order;
+  return *this;
+}
+
 }  // namespace mbid::simulation

@@ -49,20 +49,6 @@ Eigen::MatrixXd CalcInitialStateSensitivity(const model::MechanicalModel& model,
   return dq0;
 }
 
-void Accumulate(IntegratorStatistics& total, const IntegratorStatistics& part) {
-  total.steps += part.steps;
-  total.rhs_evaluations += part.rhs_evaluations;
-  total.linear_solver_setups += part.linear_solver_setups;
-  total.error_test_failures += part.error_test_failures;
-  total.nonlinear_iterations += part.nonlinear_iterations;
-  total.nonlinear_convergence_failures += part.nonlinear_convergence_failures;
-  total.jacobian_evaluations += part.jacobian_evaluations;
-  total.rhs_evaluations_for_jacobian += part.rhs_evaluations_for_jacobian;
-  total.rhs_evaluations_for_sensitivities += part.rhs_evaluations_for_sensitivities;
-  total.last_step_s = part.last_step_s;
-  total.last_order = part.last_order;
-}
-
 }  // namespace
 
 SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
@@ -157,7 +143,7 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
     if (!forcing_done && t >= forcing_end_s) {
       // Restart the multistep history at the kink of the load, sensitivities carried over.
       integrator.AdvanceTo(forcing_end_s);
-      Accumulate(result.statistics, integrator.statistics());
+      result.statistics += integrator.statistics();
       const Eigen::MatrixXd carried = integrator.sensitivities();
       integrator.Initialize(SimTK::State(integrator.state()));
       integrator.InitializeSensitivities(p, scale, carried, sensitivity);
@@ -189,7 +175,7 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
       }
     }
   }
-  Accumulate(result.statistics, integrator.statistics());
+  result.statistics += integrator.statistics();
   return result;
 }
 

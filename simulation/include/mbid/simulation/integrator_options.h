@@ -72,6 +72,10 @@ struct IntegratorStatistics {
   long rhs_evaluations_for_sensitivities = 0;
   double last_step_s = 0.0;
   int last_order = 0;
+
+  // Adds the counters of a later stretch of integration (after a restart); the last step and
+  // order become the later stretch's.
+  IntegratorStatistics& operator+=(const IntegratorStatistics& later);
 };
 
 }  // namespace mbid::simulation
