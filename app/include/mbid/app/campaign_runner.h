@@ -25,7 +25,7 @@ struct CampaignRunSummary {
   int failed = 0;             // cases of the campaign with a status other than ok
   bool was_complete = false;  // --resume of a finished campaign: nothing to do
   int ranks = 1;
-  int workers = 1;  // per rank
+  int workers = 1;          // per rank
   double wall_s = 0;        // the whole run on rank 0, merge and report included
   double cases_wall_s = 0;  // from the first case handed out to the last one committed
   // Non-zero on ranks other than 0 when rank 0 stopped the campaign before it ran (rank 0
