@@ -89,7 +89,7 @@ BENCHMARK(BM_CvodesAdams)->Unit(benchmark::kMillisecond);
 
 // Simbody's integrators through the same model, outputs at the same sample times.
 template <class Integrator>
-void RunSimbody(benchmark::State& state) {
+void RunSimbody(benchmark::State& state, double accuracy = kTolerance) {
   Reference();
   const mbid::model::TruckCrane& crane = Crane();
   const Eigen::VectorXd q0 = crane.SolveStaticEquilibrium(crane.CalcPayloadLoads(650.0));
@@ -98,7 +98,7 @@ void RunSimbody(benchmark::State& state) {
   double rhs = 0;
   for (auto _ : state) {
     Integrator integrator(crane.system());
-    integrator.setAccuracy(kTolerance);
+    integrator.setAccuracy(accuracy);
     integrator.initialize(crane.MakeState(q0, Eigen::VectorXd::Zero(4)));
     y.row(0) = crane.CalcOutputs(integrator.getState()).transpose();
     for (int j = 1; j < samples; ++j) {
@@ -115,6 +115,13 @@ void BM_SimbodyRungeKuttaMerson(benchmark::State& state) {
   RunSimbody<SimTK::RungeKuttaMersonIntegrator>(state);
 }
 BENCHMARK(BM_SimbodyRungeKuttaMerson)->Unit(benchmark::kMillisecond);
+
+// RK-Merson tightened until its error matches CVODES BDF's at 1e-8 (~7e-9 rad): the
+// equal-error comparison.
+void BM_SimbodyRungeKuttaMersonEqualError(benchmark::State& state) {
+  RunSimbody<SimTK::RungeKuttaMersonIntegrator>(state, 1e-10);
+}
+BENCHMARK(BM_SimbodyRungeKuttaMersonEqualError)->Unit(benchmark::kMillisecond);
 
 void BM_SimbodyCPodes(benchmark::State& state) { RunSimbody<SimTK::CPodesIntegrator>(state); }
 BENCHMARK(BM_SimbodyCPodes)->Unit(benchmark::kMillisecond);
