@@ -59,9 +59,11 @@ sweep:
 class CampaignCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
+    // Parametrized tests are named "Test/Param": one folder, not two.
+    std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::replace(name.begin(), name.end(), '/', '_');
     dir_ = fs::temp_directory_path() /
-           ("mbid_campaign_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+           ("mbid_campaign_cli_" + std::to_string(::getpid()) + "_" + name);
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
