@@ -98,25 +98,29 @@ Excitation ReadExcitation(const YamlReader& node, const model::MechanicalModel& 
   return excitation;
 }
 
+IntegratorOptions ReadIntegratorOptions(const YamlReader& node, IntegratorOptions o) {
+  node.ExpectMap({"method", "relative_tolerance", "absolute_tolerance", "max_steps", "max_step_s",
+                  "interpolate_outputs"});
+  const bool adams = o.method == IntegratorOptions::Method::kAdams;
+  o.method = node.Choice("method", {"bdf", "adams"}, adams ? "adams" : "bdf") == "adams"
+                 ? IntegratorOptions::Method::kAdams
+                 : IntegratorOptions::Method::kBdf;
+  o.relative_tolerance = node.PositiveDouble("relative_tolerance", o.relative_tolerance);
+  o.absolute_tolerance = node.PositiveDouble("absolute_tolerance", o.absolute_tolerance);
+  o.max_steps = node.Int("max_steps", o.max_steps);
+  o.max_step_s = node.Double("max_step_s", o.max_step_s);
+  o.interpolate_outputs = node.Bool("interpolate_outputs", o.interpolate_outputs);
+  std::string why;
+  if (!o.IsValid(&why)) node.Fail(why, "valid integrator options (docs/scenarios.md)");
+  return o;
+}
+
 SimulationOptions ReadSimulationOptions(const YamlReader& node) {
   SimulationOptions options;
   node.ExpectMap({"duration_s", "integrator"});
   options.duration_s = node.PositiveDouble("duration_s", options.duration_s);
   if (node.Has("integrator")) {
-    const YamlReader integrator = node.Child("integrator");
-    integrator.ExpectMap({"method", "relative_tolerance", "absolute_tolerance", "max_steps",
-                          "max_step_s", "interpolate_outputs"});
-    IntegratorOptions& o = options.integrator;
-    o.method = integrator.Choice("method", {"bdf", "adams"}, "bdf") == "adams"
-                   ? IntegratorOptions::Method::kAdams
-                   : IntegratorOptions::Method::kBdf;
-    o.relative_tolerance = integrator.PositiveDouble("relative_tolerance", o.relative_tolerance);
-    o.absolute_tolerance = integrator.PositiveDouble("absolute_tolerance", o.absolute_tolerance);
-    o.max_steps = integrator.Int("max_steps", o.max_steps);
-    o.max_step_s = integrator.Double("max_step_s", o.max_step_s);
-    o.interpolate_outputs = integrator.Bool("interpolate_outputs", o.interpolate_outputs);
-    std::string why;
-    if (!o.IsValid(&why)) integrator.Fail(why, "valid integrator options (docs/scenarios.md)");
+    options.integrator = ReadIntegratorOptions(node.Child("integrator"), options.integrator);
   }
   return options;
 }

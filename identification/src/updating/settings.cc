@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "mbid/simulation/scenario_sections.h"
+
 namespace mbid::updating {
 namespace {
 
@@ -30,25 +32,6 @@ void CheckParameterKeys(const YamlReader& node, const UpdateOptions& options) {
                   "one of updating.parameters; did you mean '" + ClosestMatch(key, tuned) + "'?");
     }
   }
-}
-
-simulation::IntegratorOptions ReadIntegrator(const YamlReader& node,
-                                             simulation::IntegratorOptions o) {
-  node.ExpectMap({"method", "relative_tolerance", "absolute_tolerance", "max_steps", "max_step_s",
-                  "interpolate_outputs"});
-  const std::string method =
-      node.Choice("method", {"bdf", "adams"},
-                  o.method == simulation::IntegratorOptions::Method::kAdams ? "adams" : "bdf");
-  o.method = method == "adams" ? simulation::IntegratorOptions::Method::kAdams
-                               : simulation::IntegratorOptions::Method::kBdf;
-  o.relative_tolerance = node.PositiveDouble("relative_tolerance", o.relative_tolerance);
-  o.absolute_tolerance = node.PositiveDouble("absolute_tolerance", o.absolute_tolerance);
-  o.max_steps = node.Int("max_steps", o.max_steps);
-  o.max_step_s = node.Double("max_step_s", o.max_step_s);
-  o.interpolate_outputs = node.Bool("interpolate_outputs", o.interpolate_outputs);
-  std::string why;
-  if (!o.IsValid(&why)) node.Fail(why, "valid integrator options (docs/scenarios.md)");
-  return o;
 }
 
 simulation::SensitivityOptions ReadSensitivity(const YamlReader& node,
@@ -240,7 +223,8 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
     }
   }
   if (node.Has("integrator")) {
-    options.integrator = ReadIntegrator(node.Child("integrator"), options.integrator);
+    options.integrator =
+        simulation::ReadIntegratorOptions(node.Child("integrator"), options.integrator);
   }
   if (node.Has("sensitivity")) {
     options.sensitivity = ReadSensitivity(node.Child("sensitivity"), options.sensitivity);

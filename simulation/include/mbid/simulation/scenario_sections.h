@@ -12,6 +12,8 @@ namespace mbid::simulation {
 // coordinates, load points and channels are checked against `model`.
 Excitation ReadExcitation(const YamlReader& excitation, const model::MechanicalModel& model);
 SimulationOptions ReadSimulationOptions(const YamlReader& simulation);
+// An `integrator:` block; keys it leaves out keep their values in `defaults`.
+IntegratorOptions ReadIntegratorOptions(const YamlReader& integrator, IntegratorOptions defaults);
 SensorOptions ReadSensorOptions(const YamlReader& sensors, const model::MechanicalModel& model);
 
 }  // namespace mbid::simulation
