@@ -4,6 +4,7 @@
 #include <random>
 
 #include "mbid/common/error.h"
+#include "mbid/simulation/scenario_sections.h"
 
 namespace mbid::simulation {
 namespace {
@@ -11,21 +12,6 @@ namespace {
 double Lookup(const std::map<std::string, double>& values, const std::string& key) {
   const auto found = values.find(key);
   return found == values.end() ? 0.0 : found->second;
-}
-
-std::map<std::string, double> ReadChannelMap(const YamlReader& node, const std::string& key,
-                                             const std::vector<std::string>& channels) {
-  std::map<std::string, double> values;
-  if (!node.Has(key)) return values;
-  const YamlReader map = node.Child(key);
-  if (!map.IsMap()) {
-    const double value = node.Double(key);
-    for (const std::string& channel : channels) values[channel] = value;
-    return values;
-  }
-  map.ExpectMap(channels);
-  for (const std::string& channel : map.Keys()) values[channel] = map.Double(channel);
-  return values;
 }
 
 }  // namespace
@@ -71,10 +57,7 @@ ModalRecordSpec ReadModalRecordSpec(const YamlReader& node) {
   if (spec.channels.empty()) node.FailAt("channels", "no channel", "at least one channel name");
   spec.sample_rate_hz = node.PositiveDouble("sample_rate_hz", spec.sample_rate_hz);
   spec.duration_s = node.PositiveDouble("duration_s", spec.duration_s);
-  spec.noise_std = ReadChannelMap(node, "noise_std_rad", spec.channels);
-  for (const auto& [channel, value] : spec.noise_std) {
-    if (value < 0) node.FailAt("noise_std_rad", "negative noise for " + channel, "a value >= 0");
-  }
+  spec.noise_std = ReadChannelValues(node, "noise_std_rad", spec.channels, true);
   const int seed = node.Int("seed", 1);
   if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
   spec.seed = static_cast<std::uint64_t>(seed);
@@ -93,11 +76,11 @@ ModalRecordSpec ReadModalRecordSpec(const YamlReader& node) {
       mode.FailAt("frequency_hz", "at or above the Nyquist frequency",
                   "a frequency below sample_rate_hz / 2");
     }
-    component.amplitude = ReadChannelMap(mode, "amplitude_rad", spec.channels);
+    component.amplitude = ReadChannelValues(mode, "amplitude_rad", spec.channels, false);
     if (component.amplitude.empty()) {
       mode.FailAt("amplitude_rad", "missing", "the amplitude per channel, rad");
     }
-    component.phase_rad = ReadChannelMap(mode, "phase_rad", spec.channels);
+    component.phase_rad = ReadChannelValues(mode, "phase_rad", spec.channels, false);
     spec.modes.push_back(component);
   }
   return spec;

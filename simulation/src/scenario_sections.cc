@@ -13,28 +13,6 @@ bool Contains(const std::vector<std::string>& names, const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
 }
 
-// A scalar for every channel, or a map channel -> value; values must be >= 0.
-std::map<std::string, double> ReadPerChannel(const YamlReader& sensors, const std::string& key,
-                                             const std::vector<std::string>& channels,
-                                             bool non_negative) {
-  std::map<std::string, double> values;
-  if (!sensors.Has(key)) return values;
-  const YamlReader node = sensors.Child(key);
-  if (node.IsMap()) {
-    node.ExpectMap(channels);
-    for (const std::string& channel : node.Keys()) values[channel] = node.Double(channel);
-  } else {
-    const double value = sensors.Double(key);
-    for (const std::string& channel : channels) values[channel] = value;
-  }
-  for (const auto& [channel, value] : values) {
-    if (non_negative && value < 0) {
-      sensors.FailAt(key, "negative value for " + channel, "a value >= 0 in the channel's unit");
-    }
-  }
-  return values;
-}
-
 // The target of an impulse or burst: `point` + `force_N` or `coordinate` + `torque_Nm`.
 void ReadForceTarget(const YamlReader& node, const model::MechanicalModel& model,
                      Excitation& excitation) {
@@ -57,6 +35,27 @@ void ReadForceTarget(const YamlReader& node, const model::MechanicalModel& model
 }
 
 }  // namespace
+
+std::map<std::string, double> ReadChannelValues(const YamlReader& sensors, const std::string& key,
+                                                const std::vector<std::string>& channels,
+                                                bool non_negative) {
+  std::map<std::string, double> values;
+  if (!sensors.Has(key)) return values;
+  const YamlReader node = sensors.Child(key);
+  if (node.IsMap()) {
+    node.ExpectMap(channels);
+    for (const std::string& channel : node.Keys()) values[channel] = node.Double(channel);
+  } else {
+    const double value = sensors.Double(key);
+    for (const std::string& channel : channels) values[channel] = value;
+  }
+  for (const auto& [channel, value] : values) {
+    if (non_negative && value < 0) {
+      sensors.FailAt(key, "negative value for " + channel, "a value >= 0 in the channel's unit");
+    }
+  }
+  return values;
+}
 
 Excitation ReadExcitation(const YamlReader& node, const model::MechanicalModel& model) {
   Excitation excitation;
@@ -146,9 +145,10 @@ SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalM
     }
   }
   // Every channel of the crane is an angle, so the sensor keys carry rad.
-  options.noise_std = ReadPerChannel(node, "noise_std_rad", options.channels, true);
-  options.bias = ReadPerChannel(node, "bias_rad", options.channels, false);
-  options.quantization_step = ReadPerChannel(node, "quantization_step_rad", options.channels, true);
+  options.noise_std = ReadChannelValues(node, "noise_std_rad", options.channels, true);
+  options.bias = ReadChannelValues(node, "bias_rad", options.channels, false);
+  options.quantization_step =
+      ReadChannelValues(node, "quantization_step_rad", options.channels, true);
   const int seed = node.Int("seed", 1);
   if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
   options.seed = static_cast<std::uint64_t>(seed);
