@@ -1,5 +1,6 @@
 #include "mbid/app/identification_settings.h"
 
+#include <cmath>
 #include <limits>
 
 #include "mbid/common/error.h"
@@ -55,6 +56,15 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
                        why.substr(colon + 2, expected - colon - 2), why.substr(expected + 11));
     }
     section.Fail(why, "identification options in range");
+  }
+  return options;
+}
+
+identification::IdentificationOptions FreeDecayOptions(
+    identification::IdentificationOptions options, const simulation::Excitation& excitation) {
+  const double forcing_end = excitation.CalcForcingEndTime();
+  if (forcing_end > 0 && !std::isfinite(options.window_start_s)) {
+    options.window_start_s = forcing_end;
   }
   return options;
 }

@@ -11,18 +11,18 @@
 #include "mbid/app/gnuplot.h"
 #include "mbid/app/identification_settings.h"
 #include "mbid/app/json_summaries.h"
+#include "mbid/app/record_source.h"
 #include "mbid/app/result_writers.h"
 #include "mbid/app/run_report.h"
 #include "mbid/app/scenario.h"
-#include "mbid/app/updating_glue.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
 #include "mbid/identification/identify.h"
-#include "mbid/identification/updating/characteristic.h"
-#include "mbid/identification/updating/output_error.h"
 #include "mbid/identification/updating/result_io.h"
 #include "mbid/identification/updating/settings.h"
+#include "run_document.h"
+#include "run_test.h"
 
 namespace mbid::app {
 namespace {
@@ -77,6 +77,93 @@ class StagingFolder {
   bool committed_ = false;
 };
 
+// The tests of the run: the scenario's records, or one test simulated from the model.
+std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::MechanicalModel& model,
+                                  const simulation::Excitation& excitation,
+                                  const Progress& progress) {
+  std::vector<RunTest> tests;
+  if (scenario.records.empty()) {
+    RunTest test;
+    test.name = scenario.name;
+    test.origin = "simulation";
+    test.simulation =
+        simulation::Simulate(model, excitation, scenario.simulation, scenario.sensors);
+    test.measured = test.simulation->measured;
+    test.exact = test.simulation->exact;
+    progress.Say(fmt::format("simulated the test: {} ({} samples x {} channels, {} CVODES steps)",
+                             excitation.type_name(), test.measured.samples(),
+                             test.measured.channel_count(), test.simulation->statistics.steps));
+    tests.push_back(std::move(test));
+    return tests;
+  }
+  for (const RecordSource& source : scenario.records) {
+    LoadedRecord loaded = LoadRecord(source, model);
+    RunTest test;
+    test.name = source.name;
+    test.origin = loaded.origin;
+    test.measured = std::move(loaded.measured);
+    test.exact = std::move(loaded.exact);
+    progress.Say(fmt::format("test {}: {} ({} samples x {} channels)", test.name, test.origin,
+                             test.measured.samples(), test.measured.channel_count()));
+    tests.push_back(std::move(test));
+  }
+  return tests;
+}
+
+nlohmann::json ChannelValues(const std::vector<std::string>& channels, const Eigen::VectorXd& v) {
+  nlohmann::json object = nlohmann::json::object();
+  for (size_t c = 0; c < channels.size(); ++c)
+    object[channels[c]] = v[static_cast<Eigen::Index>(c)];
+  return object;
+}
+
+// One test's results in run.h5 under `root` ("" for the top-level groups of the contract).
+void WriteTestGroups(H5Writer& run, const RunTest& test, const std::string& root,
+                     double threshold) {
+  run.WriteMeasurement(test.measured, root + "/measurement");
+  identification::WriteModalResult(run, test.identified, root + "/identification");
+  updating::WriteUpdatingGroup(run, test.tuned, test.algebraic.get(), root + "/updating");
+  const updating::TestFit& fit = test.tuned.tests.front();
+  const std::string validation = root + "/validation";
+  run.WriteStringAttribute(validation, "passed", test.passed ? "true" : "false");
+  run.WriteScalar(validation, "threshold", threshold, "1");
+  for (size_t c = 0; c < fit.channels.size(); ++c) {
+    const auto column = static_cast<Eigen::Index>(c);
+    run.WriteScalar(validation + "/correlation", fit.channels[c], fit.correlation[column], "1");
+    run.WriteVector(validation + "/resimulation", fit.channels[c], fit.simulated.values.col(column),
+                    fit.simulated.units[c]);
+  }
+  if (!root.empty()) {
+    run.WriteStringAttribute(root, "origin", test.origin);
+    if (test.exact) {
+      for (int c = 0; c < test.exact->channel_count(); ++c) {
+        run.WriteVector(root + "/exact", test.exact->channels[c], test.exact->values.col(c),
+                        test.exact->units[c]);
+      }
+    }
+  }
+}
+
+nlohmann::json TestValidationJson(const RunTest& test, double threshold) {
+  const updating::TestFit& fit = test.tuned.tests.front();
+  return {{"correlation", ChannelValues(fit.channels, fit.correlation)},
+          {"threshold", threshold},
+          {"passed", test.passed}};
+}
+
+std::string VerdictLine(const std::vector<RunTest>& tests, double threshold, bool passed) {
+  std::vector<std::string> parts;
+  for (const RunTest& test : tests) {
+    const updating::TestFit& fit = test.tuned.tests.front();
+    for (size_t c = 0; c < fit.channels.size(); ++c) {
+      parts.push_back(fmt::format("K({}{}) = {:.4f}", tests.size() > 1 ? test.name + ", " : "",
+                                  fit.channels[c], fit.correlation[static_cast<Eigen::Index>(c)]));
+    }
+  }
+  return fmt::format("re-simulation vs record: {}; threshold {} -> {}", fmt::join(parts, ", "),
+                     threshold, passed ? "PASSED" : "FAILED");
+}
+
 }  // namespace
 
 int RunValidationCycle(const std::string& scenario_path, const std::string& output_dir,
@@ -93,159 +180,97 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   const std::vector<model::Mode> exact_modes = model::CalcModes(linear);
   progress.Say(fmt::format("model {}: {} coordinates, {} exact modes", model->type(),
                            model->coordinate_count(), exact_modes.size()));
-
   const simulation::Excitation& excitation = scenario.RequireExcitation();
-  const simulation::SimulationResult test =
-      simulation::Simulate(*model, excitation, scenario.simulation, scenario.sensors);
-  progress.Say(fmt::format("simulated the test: {} ({} samples x {} channels, {} CVODES steps)",
-                           excitation.type_name(), test.measured.samples(),
-                           test.measured.channel_count(), test.statistics.steps));
 
-  H5Writer run(folder / "run.h5");
-  run.WriteMeasurement(test.measured);
-  run.WriteScenarioYaml(scenario.yaml_text);
-  WriteTruth(run, *model, test);
-  WriteSimulationInfo(run, excitation, scenario.simulation, test);
-
-  const identification::IdentificationOptions identify_options =
-      scenario.root.Has("identification")
-          ? ReadIdentificationSettings(scenario.root.Child("identification"))
-          : identification::IdentificationOptions();
-  const identification::ModalResult identified =
-      identification::Identify(test.measured, identify_options, scenario_path);
-  identification::WriteModalResult(run, identified);
-  progress.Say(fmt::format("identified {} modes ({}), K = {:.3f}", identified.modes.size(),
-                           identified.method, identified.correlation.minCoeff()));
-
-  // Route 1 (eqs. 6-8) from the identified poles when there is one per coordinate; Route 2 (Ceres,
-  // time domain) from its chosen set, else from the scenario's values; then the re-simulation.
-  updating::UpdatingSettings settings =
+  RunSettings settings;
+  if (scenario.root.Has("identification")) {
+    settings.identification = ReadIdentificationSettings(scenario.root.Child("identification"));
+  }
+  settings.updating =
       scenario.root.Has("updating")
           ? updating::ReadUpdatingSettings(scenario.root.Child("updating"), *model,
                                            scenario.simulation.integrator)
           : updating::MakeDefaultUpdatingSettings(*model, scenario.simulation.integrator);
-  settings.options.quiet = common.quiet;
-  std::string start_note = "the scenario's values";
-  std::string note;
-  const auto algebraic =
-      SolveAlgebraicRoute(*model, identified, test.measured, excitation, settings, &note);
-  if (algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)) {
-    start_note = "Route 1 (eq. 7)";
-  }
-  progress.Say(fmt::format("Route 1 (eq. 7): {}{}",
-                           algebraic ? algebraic->status_name() : "skipped",
-                           note.empty() ? "" : "; " + note));
-  updating::TestRecord record =
-      updating::MakeTestRecord(scenario.name, test.measured, excitation, settings);
-  WeighByIdentifiedNoise(identified, record);
-  progress.Say(fmt::format("Route 2 (Ceres, output error) from {}", start_note));
-  updating::UpdateResult tuned = updating::UpdateModel(*model, {record}, settings.options);
-  if (algebraic) updating::MarkAlgebraicAmbiguity(*algebraic, tuned);
-  updating::WriteUpdatingGroup(run, tuned, algebraic.get());
-  progress.Say(fmt::format("updating: {} after {} iterations, cost {:.3g} -> {:.3g}",
-                           tuned.termination_name(), tuned.iterations, tuned.initial_cost,
-                           tuned.final_cost));
-  if (tuned.termination != updating::UpdateResult::Termination::kConverged) {
-    throw NumericalError("updating", tuned.termination_name() + ": " + tuned.message);
-  }
+  settings.updating.options.quiet = common.quiet;
+  settings.min_correlation = scenario.validation_min_correlation;
 
-  // The verdict: the re-simulation with the tuned values against the record.
-  const updating::TestFit& fit = tuned.tests.front();
-  const double threshold = scenario.validation_min_correlation;
-  nlohmann::json validation_correlation;
+  std::vector<RunTest> tests = AcquireTests(scenario, *model, excitation, progress);
+  const bool several = tests.size() > 1;
+  for (RunTest& test : tests) {
+    const std::string prefix = several ? "test " + test.name + ": " : "";
+    AnalyseTest(test, *model, excitation, settings,
+                [&](const std::string& message) { progress.Say(prefix + message); });
+  }
   bool passed = true;
-  for (size_t c = 0; c < fit.channels.size(); ++c) {
-    const double k = fit.correlation[static_cast<Eigen::Index>(c)];
-    validation_correlation[fit.channels[c]] = k;
-    passed = passed && k >= threshold;
-  }
-  run.WriteStringAttribute("/validation", "passed", passed ? "true" : "false");
-  run.WriteScalar("/validation", "threshold", threshold, "1");
-  for (size_t c = 0; c < fit.channels.size(); ++c) {
-    run.WriteScalar("/validation/correlation", fit.channels[c],
-                    fit.correlation[static_cast<Eigen::Index>(c)], "1");
-    run.WriteVector("/validation/resimulation", fit.channels[c],
-                    fit.simulated.values.col(static_cast<Eigen::Index>(c)), fit.simulated.units[c]);
-  }
-  const std::string verdict = fmt::format(
-      "re-simulation vs record: {}; threshold {} -> {}",
-      fmt::join(
-          [&] {
-            std::vector<std::string> parts;
-            for (size_t c = 0; c < fit.channels.size(); ++c) {
-              parts.push_back(fmt::format("K({}) = {:.4f}", fit.channels[c],
-                                          fit.correlation[static_cast<Eigen::Index>(c)]));
-            }
-            return parts;
-          }(),
-          ", "),
-      threshold, passed ? "PASSED" : "FAILED");
+  for (const RunTest& test : tests) passed = passed && test.passed;
+  const double threshold = settings.min_correlation;
+  const std::string verdict = VerdictLine(tests, threshold, passed);
   progress.Say(verdict);
-  nlohmann::json summary{
-      {"scenario", scenario.name},
-      {"simulation",
-       {{"excitation", excitation.type_name()},
-        {"samples", test.measured.samples()},
-        {"sample_interval_s", test.measured.sample_interval_s},
-        {"channels", test.measured.channels},
-        {"integrator", IntegratorStatisticsToJson(test.statistics)}}},
-      {"model", LinearModelToJson(linear, exact_modes)},
-      {"identification", identification::ModalResultToJson(identified)},
-      {"updating", updating::UpdateResultToJson(tuned, algebraic.get())},
-      {"validation",
-       {{"correlation", validation_correlation}, {"threshold", threshold}, {"passed", passed}}}};
 
-  std::vector<std::string> record_figures, identification_figures, updating_figures;
-  if (GnuplotAvailable()) {
-    const std::string dir = (folder / "").string();
-    for (int c = 0; c < test.measured.channel_count(); ++c) {
-      record_figures.push_back(DrawRecordFigure(dir, test.measured, &test.exact, c));
-    }
-    identification_figures.push_back(DrawSpectrumFigure(dir, identified));
-    for (int c = 0; c < static_cast<int>(identified.channels.size()); ++c) {
-      identification_figures.push_back(DrawReconstructionFigure(dir, test.measured, identified, c));
-    }
-    const std::string stabilization = DrawStabilizationFigure(dir, identified);
-    if (!stabilization.empty()) identification_figures.push_back(stabilization);
-    for (int c = 0; c < static_cast<int>(fit.channels.size()); ++c) {
-      updating_figures.push_back(DrawResimulationFigure(dir, test.measured, fit, c));
-    }
-    updating_figures.push_back(DrawConvergenceFigure(dir, tuned));
-    progress.Say(fmt::format(
-        "drew {} figures",
-        record_figures.size() + identification_figures.size() + updating_figures.size()));
-  } else {
-    progress.Say("gnuplot with pngcairo not found: the report has no figures");
+  H5Writer run(folder / "run.h5");
+  run.WriteScenarioYaml(scenario.yaml_text);
+  const RunTest& first = tests.front();
+  WriteTestGroups(run, first, "", threshold);
+  run.WriteStringAttribute("/validation", "passed", passed ? "true" : "false");
+  if (first.simulation) {
+    WriteTruth(run, *model, *first.simulation);
+    WriteSimulationInfo(run, excitation, scenario.simulation, *first.simulation);
   }
-  const size_t figure_count =
-      record_figures.size() + identification_figures.size() + updating_figures.size();
+  if (!scenario.records.empty()) {
+    for (const RunTest& test : tests) WriteTestGroups(run, test, "/tests/" + test.name, threshold);
+  }
 
-  {
-    std::ofstream report(folder / "report.md");
-    report << "# mbid run: " << scenario.name << "\n\n";
-    report << fmt::format(
-        "Scenario `{}`; model `{}`; excitation `{}`; {} samples at {} Hz on "
-        "channels {}.\n\n",
-        scenario_path, model->type(), excitation.type_name(), test.measured.samples(),
-        1.0 / test.measured.sample_interval_s, fmt::join(test.measured.channels, ", "));
-    report << "## The test record\n\n";
-    for (const std::string& figure : record_figures) {
-      report << "![" << figure << "](" << figure << ")\n\n";
-    }
-    report << "## Identified modes (the paper's Table 1), with the model's exact modes\n\n";
-    report << ModalTableMarkdown(identified, &exact_modes) << "\n";
-    for (const std::string& warning : identified.warnings) report << "> " << warning << "\n\n";
-    for (const std::string& figure : identification_figures) {
-      report << "![" << figure << "](" << figure << ")\n\n";
-    }
-    report << "## Tuned joint parameters (the paper's Table 2)\n\n";
-    report << "Start: " << start_note << ". " << TunedParametersMarkdown(tuned, *model) << "\n";
-    if (algebraic) report << AlgebraicSetsMarkdown(*algebraic) << "\n";
-    for (const std::string& figure : updating_figures) {
-      report << "![" << figure << "](" << figure << ")\n\n";
-    }
-    report << "## Verdict\n\n**" << verdict << "**\n";
+  // The top level holds the first test (interfaces.md); with several tests the verdict is the
+  // worst correlation per channel and passes only if every test does.
+  nlohmann::json validation = TestValidationJson(first, threshold);
+  validation["passed"] = passed;
+  nlohmann::json summary{{"scenario", scenario.name}};
+  if (first.simulation) {
+    summary["simulation"] = {
+        {"excitation", excitation.type_name()},
+        {"samples", first.measured.samples()},
+        {"sample_interval_s", first.measured.sample_interval_s},
+        {"channels", first.measured.channels},
+        {"integrator", IntegratorStatisticsToJson(first.simulation->statistics)}};
   }
+  summary["model"] = LinearModelToJson(linear, exact_modes);
+  summary["identification"] = identification::ModalResultToJson(first.identified);
+  summary["updating"] = updating::UpdateResultToJson(first.tuned, first.algebraic.get());
+  if (!scenario.records.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const RunTest& test : tests) {
+      list.push_back({{"name", test.name},
+                      {"origin", test.origin},
+                      {"samples", test.measured.samples()},
+                      {"sample_interval_s", test.measured.sample_interval_s},
+                      {"channels", test.measured.channels},
+                      {"identification", identification::ModalResultToJson(test.identified)},
+                      {"updating", updating::UpdateResultToJson(test.tuned, test.algebraic.get())},
+                      {"validation", TestValidationJson(test, threshold)}});
+      const updating::TestFit& fit = test.tuned.tests.front();
+      for (size_t c = 0; c < fit.channels.size(); ++c) {
+        const double k = fit.correlation[static_cast<Eigen::Index>(c)];
+        auto& worst = validation["correlation"][fit.channels[c]];
+        if (k < worst.get<double>()) worst = k;
+      }
+    }
+    summary["tests"] = list;
+  }
+  if (several) {
+    std::vector<const updating::UpdateResult*> results;
+    for (const RunTest& test : tests) results.push_back(&test.tuned);
+    nlohmann::json spread = nlohmann::json::object();
+    for (const auto& [name, value] : CalcRelativeSpread(results)) {
+      spread[name] = value;
+      run.WriteScalar("/validation/spread", name, value, "1");
+    }
+    summary["spread"] = spread;
+  }
+  summary["validation"] = validation;
+
+  const int figure_count =
+      WriteRunReport((folder / "").string(), scenario, *model, exact_modes, tests, verdict,
+                     [&](const std::string& m) { progress.Say(m); });
   WriteJson(summary, (folder / "summary.json").string());
   run.Commit();
   folder.Commit();

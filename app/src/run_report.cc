@@ -145,15 +145,34 @@ std::string DrawStabilizationFigure(const std::string& folder,
 }
 
 std::string ModalTableMarkdown(const identification::ModalResult& result,
-                               const std::vector<model::Mode>* exact) {
+                               const std::vector<ReferenceMode>* reference,
+                               const std::string& reference_label) {
   std::ostringstream out;
+  // The paper's mean amplitude: the envelope A e^{-beta t} averaged over the analysed record.
+  const double record_s = (result.samples - 1) * result.sample_interval_s;
+  const auto mean_amplitude = [record_s](double amplitude, double decay) {
+    const double x = decay * record_s;
+    return std::abs(x) < 1e-12 ? amplitude : amplitude * -std::expm1(-x) / x;
+  };
   out << "| k | frequency, Hz | beta, 1/s | half-life ln2/beta, s | damping ratio |";
   for (const std::string& channel : result.channels) out << " A_" << channel << ", rad |";
-  out << " mean A, rad |";
-  if (exact != nullptr) out << " exact: frequency, Hz | exact: beta, 1/s |";
+  for (const std::string& channel : result.channels) out << " mean A_" << channel << ", rad |";
+  if (reference != nullptr) {
+    out << fmt::format(" {0}: frequency, Hz | {0}: beta, 1/s |", reference_label);
+    if (!reference->empty() && !reference->front().amplitude.empty()) {
+      for (const std::string& channel : result.channels) {
+        out << fmt::format(" {}: A_{}, rad |", reference_label, channel);
+      }
+    }
+  }
   out << "\n|---|---|---|---|---|";
-  for (size_t c = 0; c <= result.channels.size(); ++c) out << "---|";
-  if (exact != nullptr) out << "---|---|";
+  for (size_t c = 0; c < 2 * result.channels.size(); ++c) out << "---|";
+  if (reference != nullptr) {
+    out << "---|---|";
+    if (!reference->empty() && !reference->front().amplitude.empty()) {
+      for (size_t c = 0; c < result.channels.size(); ++c) out << "---|";
+    }
+  }
   out << "\n";
   for (size_t k = 0; k < result.modes.size(); ++k) {
     const auto& mode = result.modes[k];
@@ -163,18 +182,26 @@ std::string ModalTableMarkdown(const identification::ModalResult& result,
     for (Eigen::Index c = 0; c < mode.amplitude.size(); ++c) {
       out << fmt::format(" {:.2e} |", mode.amplitude[c]);
     }
-    out << fmt::format(" {:.2e} |", mode.amplitude.mean());
-    if (exact != nullptr) {
-      // The exact mode nearest in frequency.
-      const model::Mode* nearest = nullptr;
-      for (const model::Mode& candidate : *exact) {
-        if (nearest == nullptr || std::abs(candidate.frequency_hz() - mode.frequency_hz) <
-                                      std::abs(nearest->frequency_hz() - mode.frequency_hz)) {
+    for (Eigen::Index c = 0; c < mode.amplitude.size(); ++c) {
+      out << fmt::format(" {:.2e} |", mean_amplitude(mode.amplitude[c], mode.decay_rate_per_s));
+    }
+    if (reference != nullptr && !reference->empty()) {
+      // The reference mode nearest in frequency.
+      const ReferenceMode* nearest = nullptr;
+      for (const ReferenceMode& candidate : *reference) {
+        if (nearest == nullptr || std::abs(candidate.frequency_hz - mode.frequency_hz) <
+                                      std::abs(nearest->frequency_hz - mode.frequency_hz)) {
           nearest = &candidate;
         }
       }
-      out << fmt::format(" {:.4f} | {:.3f} |", nearest->frequency_hz(),
-                         -nearest->decay_rate_per_s());
+      out << fmt::format(" {:.4f} | {:.3f} |", nearest->frequency_hz, -nearest->decay_rate_per_s);
+      if (!nearest->amplitude.empty()) {
+        for (const std::string& channel : result.channels) {
+          const auto found = nearest->amplitude.find(channel);
+          out << (found == nearest->amplitude.end() ? std::string(" - |")
+                                                    : fmt::format(" {:.2e} |", found->second));
+        }
+      }
     }
     out << "\n";
   }
@@ -183,8 +210,10 @@ std::string ModalTableMarkdown(const identification::ModalResult& result,
     out << fmt::format(" K({}) = {:.3f}", result.channels[c],
                        result.correlation[static_cast<Eigen::Index>(c)]);
   }
-  out << fmt::format(". Method `{}`, model order {}, effective rank {}.\n", result.method,
-                     result.model_order, result.effective_rank);
+  out << fmt::format(
+      ". Method `{}`, model order {}, effective rank {}; mean amplitudes over the "
+      "{:.2f} s analysed.\n",
+      result.method, result.model_order, result.effective_rank, record_s);
   return out.str();
 }
 
@@ -224,18 +253,19 @@ std::string DrawConvergenceFigure(const std::string& folder, const updating::Upd
 }
 
 std::string TunedParametersMarkdown(const updating::UpdateResult& result,
-                                    const model::MechanicalModel& truth) {
+                                    const model::MechanicalModel& model,
+                                    const std::string& model_label) {
   std::ostringstream out;
   out << fmt::format(
       "Termination `{}` after {} iterations; cost {:.4g} -> {:.4g}; Jacobian "
       "from {}.\n\n",
       result.termination_name(), result.iterations, result.initial_cost, result.final_cost,
       result.jacobian);
-  out << "| parameter | tuned | std | start | model (truth of a simulated test) | difference |\n";
+  out << fmt::format("| parameter | tuned | std | start | {} | difference |\n", model_label);
   out << "|---|---|---|---|---|---|\n";
   for (const updating::ParameterEstimate& p : result.parameters) {
     double true_value = std::numeric_limits<double>::quiet_NaN();
-    for (const model::Parameter& q : truth.parameters()) {
+    for (const model::Parameter& q : model.parameters()) {
       if (q.name == p.name) true_value = q.value;
     }
     out << fmt::format(
@@ -253,6 +283,52 @@ std::string TunedParametersMarkdown(const updating::UpdateResult& result,
         << " (their values above are not results).\n";
   }
   for (const std::string& warning : result.warnings) out << "\n> " << warning << "\n";
+  return out.str();
+}
+
+std::vector<std::pair<std::string, double>> CalcRelativeSpread(
+    const std::vector<const updating::UpdateResult*>& results) {
+  std::vector<std::pair<std::string, double>> spread;
+  if (results.empty()) return spread;
+  for (const updating::ParameterEstimate& p : results.front()->parameters) {
+    if (!p.test.empty()) continue;  // a nuisance parameter of one test
+    double lowest = p.value, highest = p.value;
+    for (const updating::UpdateResult* result : results) {
+      for (const updating::ParameterEstimate& q : result->parameters) {
+        if (q.name == p.name && q.test.empty()) {
+          lowest = std::min(lowest, q.value);
+          highest = std::max(highest, q.value);
+        }
+      }
+    }
+    spread.emplace_back(p.name, (highest - lowest) / highest);
+  }
+  return spread;
+}
+
+std::string TestsTableMarkdown(const std::vector<std::string>& test_names,
+                               const std::vector<const updating::UpdateResult*>& results) {
+  const auto spread = CalcRelativeSpread(results);
+  std::ostringstream out;
+  out << "| test |";
+  for (const auto& [name, value] : spread) out << " " << name << " |";
+  out << "\n|---|";
+  for (size_t i = 0; i < spread.size(); ++i) out << "---|";
+  out << "\n";
+  for (size_t t = 0; t < results.size(); ++t) {
+    out << "| " << test_names[t] << " |";
+    for (const auto& [name, value] : spread) {
+      for (const updating::ParameterEstimate& q : results[t]->parameters) {
+        if (q.name == name && q.test.empty()) {
+          out << fmt::format(" {:.3g}{} |", q.value, q.determined ? "" : " (undetermined)");
+        }
+      }
+    }
+    out << "\n";
+  }
+  out << "| relative spread, % |";
+  for (const auto& [name, value] : spread) out << fmt::format(" {:.0f} |", 100 * value);
+  out << "\n";
   return out.str();
 }
 

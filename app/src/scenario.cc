@@ -28,11 +28,11 @@ Scenario LoadScenario(const std::string& path) {
 }
 
 Scenario LoadScenarioFromText(const std::string& text, const std::string& source) {
-  Scenario scenario{source, "", text, YamlReader::FromString(text, source), false, {},
+  Scenario scenario{source, "", text, YamlReader::FromString(text, source), false, {}, {},
                     {},     {}, 0.95};
   if (!scenario.root.IsMap()) scenario.root.Fail("not a mapping", "a YAML mapping of sections");
-  scenario.root.ExpectMap({"name", "model", "excitation", "simulation", "sensors", "identification",
-                           "updating", "validation"});
+  scenario.root.ExpectMap({"name", "model", "excitation", "simulation", "sensors", "record",
+                           "identification", "updating", "validation"});
   scenario.name = scenario.root.String("name");
   if (scenario.name.empty() || scenario.name.find('/') != std::string::npos) {
     scenario.root.FailAt("name", "'" + scenario.name + "'",
@@ -57,6 +57,11 @@ Scenario LoadScenarioFromText(const std::string& text, const std::string& source
   }
   if (scenario.root.Has("sensors")) {
     scenario.sensors = simulation::ReadSensorOptions(scenario.root.Child("sensors"), *model);
+  }
+  if (scenario.root.Has("record")) {
+    const std::filesystem::path folder = std::filesystem::path(source).parent_path();
+    scenario.records = ReadRecordSources(scenario.root.Child("record"),
+                                         folder.empty() ? "." : folder.string(), *model);
   }
   return scenario;
 }

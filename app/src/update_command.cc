@@ -71,13 +71,8 @@ LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
   test.excitation = source->RequireExcitation();
   test.excitation_source = source == &scenario ? "scenario" : path;
 
-  identification::IdentificationOptions options = identification_options;
-  // Only the free decay is identified: the record before a forcing's end is not one.
-  const double forcing_end = test.excitation.CalcForcingEndTime();
-  if (forcing_end > 0 && !std::isfinite(options.window_start_s)) {
-    options.window_start_s = forcing_end;
-  }
-  test.identified = identification::Identify(test.record, options, path);
+  test.identified = identification::Identify(
+      test.record, FreeDecayOptions(identification_options, test.excitation), path);
   return test;
 }
 

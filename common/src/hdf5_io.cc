@@ -343,19 +343,19 @@ H5Writer::~H5Writer() {
   impl_.reset();
 }
 
-void H5Writer::WriteMeasurement(const Measurement& measurement) {
+void H5Writer::WriteMeasurement(const Measurement& measurement, const std::string& path) {
   measurement.Validate(impl_->atomic.path());
-  impl_->Run("/measurement", [&measurement](H5::H5File& file) {
-    RemoveIfExists(file, "/measurement");
-    const H5::Group group = EnsureGroup(file, "/measurement");
+  impl_->Run(path, [&measurement, &path](H5::H5File& file) {
+    RemoveIfExists(file, path);
+    const H5::Group group = EnsureGroup(file, path);
     WriteStringArrayAttr(group, "channels", measurement.channels);
     WriteDoubleAttr(group, "sample_interval_s", measurement.sample_interval_s);
     WriteStringAttr(group, "source", measurement.source);
     const std::vector<hsize_t> dims = {static_cast<hsize_t>(measurement.samples())};
     const Eigen::VectorXd time = measurement.CalcTime();
-    WriteDoubleDataset(file, "/measurement", "time", dims, time.data(), "s");
+    WriteDoubleDataset(file, path, "time", dims, time.data(), "s");
     for (int c = 0; c < measurement.channel_count(); ++c) {
-      WriteDoubleDataset(file, "/measurement", measurement.channels[c], dims,
+      WriteDoubleDataset(file, path, measurement.channels[c], dims,
                          measurement.values.col(c).data(), measurement.units[c]);
     }
   });

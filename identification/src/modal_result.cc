@@ -5,8 +5,6 @@
 namespace mbid::identification {
 namespace {
 
-constexpr char kGroup[] = "/identification";
-
 // JSON has no NaN or infinity; the contract writes null for "not available".
 nlohmann::json Number(double value) {
   return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
@@ -19,8 +17,6 @@ nlohmann::json PerChannel(const std::vector<std::string>& channels, const Eigen:
   }
   return object;
 }
-
-std::string Sub(const std::string& name) { return std::string(kGroup) + "/" + name; }
 
 template <typename Get>
 Eigen::VectorXd ModeVector(const ModalResult& result, Get&& get) {
@@ -124,20 +120,21 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
   return json;
 }
 
-void WriteModalResult(H5Writer& writer, const ModalResult& result) {
-  writer.WriteStringAttribute(kGroup, "method", result.method);
-  writer.WriteStrings(kGroup, "channels", result.channels);
-  writer.WriteScalar(kGroup, "sample_interval_s", result.sample_interval_s, "s");
-  writer.WriteScalar(kGroup, "samples", result.samples, "1");
-  writer.WriteScalar(kGroup, "model_order", result.model_order, "1");
-  writer.WriteScalar(kGroup, "effective_rank", result.effective_rank, "1");
-  writer.WriteScalar(kGroup, "start_time_s", result.start_time_s, "s");
-  writer.WriteScalar(kGroup, "decimation", result.decimation, "1");
-  writer.WriteScalar(kGroup, "significance_threshold", result.significance_threshold, "1");
-  writer.WriteScalar(kGroup, "iterations", result.iterations, "1");
-  writer.WriteStringAttribute(kGroup, "termination", result.termination);
+void WriteModalResult(H5Writer& writer, const ModalResult& result, const std::string& group) {
+  const auto sub = [&group](const std::string& name) { return group + "/" + name; };
+  writer.WriteStringAttribute(group, "method", result.method);
+  writer.WriteStrings(group, "channels", result.channels);
+  writer.WriteScalar(group, "sample_interval_s", result.sample_interval_s, "s");
+  writer.WriteScalar(group, "samples", result.samples, "1");
+  writer.WriteScalar(group, "model_order", result.model_order, "1");
+  writer.WriteScalar(group, "effective_rank", result.effective_rank, "1");
+  writer.WriteScalar(group, "start_time_s", result.start_time_s, "s");
+  writer.WriteScalar(group, "decimation", result.decimation, "1");
+  writer.WriteScalar(group, "significance_threshold", result.significance_threshold, "1");
+  writer.WriteScalar(group, "iterations", result.iterations, "1");
+  writer.WriteStringAttribute(group, "termination", result.termination);
 
-  const std::string modes = Sub("modes");
+  const std::string modes = sub("modes");
   const auto write_mode_vector = [&](const char* name, const char* units, auto get) {
     writer.WriteVector(modes, name, ModeVector(result, get), units);
   };
@@ -164,20 +161,20 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result) {
     writer.WriteVector(modes + "/phase_rad", channel,
                        ModeVector(result, [c](const IdentifiedMode& m) { return m.phase_rad(c); }),
                        "rad");
-    writer.WriteScalar(Sub("correlation"), channel, result.correlation(c), "1");
-    writer.WriteScalar(Sub("offset"), channel, result.offset(c), UnitOf(result, c));
-    writer.WriteScalar(Sub("noise_std"), channel, result.noise_std(c), UnitOf(result, c));
-    writer.WriteVector(Sub("reconstruction"), channel, result.reconstruction.col(c),
+    writer.WriteScalar(sub("correlation"), channel, result.correlation(c), "1");
+    writer.WriteScalar(sub("offset"), channel, result.offset(c), UnitOf(result, c));
+    writer.WriteScalar(sub("noise_std"), channel, result.noise_std(c), UnitOf(result, c));
+    writer.WriteVector(sub("reconstruction"), channel, result.reconstruction.col(c),
                        UnitOf(result, c));
   }
-  writer.WriteVector(Sub("reconstruction"), "time",
+  writer.WriteVector(sub("reconstruction"), "time",
                      Eigen::VectorXd::LinSpaced(result.samples, 0.0, 1.0) * (result.samples - 1) *
                              result.sample_interval_s +
                          Eigen::VectorXd::Constant(result.samples, result.start_time_s),
                      "s");
 
   if (result.has_spectrum) {
-    const std::string spectrum = Sub("spectrum");
+    const std::string spectrum = sub("spectrum");
     writer.WriteVector(spectrum, "frequency_hz", result.spectrum.frequency_hz, "Hz");
     for (size_t c = 0; c < result.channels.size(); ++c) {
       writer.WriteVector(spectrum, result.channels[c], result.spectrum.amplitude.col(c),
@@ -214,7 +211,7 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result) {
     const auto as_vector = [](const std::vector<double>& v) {
       return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
     };
-    const std::string stabilization = Sub("stabilization");
+    const std::string stabilization = sub("stabilization");
     writer.WriteVector(stabilization, "order", as_vector(order), "1");
     writer.WriteVector(stabilization, "frequency_hz", as_vector(frequency), "Hz");
     writer.WriteVector(stabilization, "decay_rate_per_s", as_vector(decay), "1/s");
@@ -222,7 +219,7 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result) {
     writer.WriteVector(stabilization, "stable", as_vector(stable), "1");
   }
   if (result.eq2_coefficients.size() > 0) {
-    writer.WriteMatrix(kGroup, "eq2_coefficients", result.eq2_coefficients, "");
+    writer.WriteMatrix(group, "eq2_coefficients", result.eq2_coefficients, "");
   }
 }
 

@@ -16,7 +16,8 @@ double Lookup(const std::map<std::string, double>& values, const std::string& ke
 
 }  // namespace
 
-Measurement SynthesizeModalRecord(const ModalRecordSpec& spec, Measurement* exact) {
+Measurement SynthesizeModalRecord(const ModalRecordSpec& spec, Measurement* exact,
+                                  std::map<std::string, double>* noise_std) {
   const double tau = 1.0 / spec.sample_rate_hz;
   const int samples = static_cast<int>(std::floor(spec.duration_s / tau + 1e-9)) + 1;
   Measurement clean;
@@ -40,8 +41,17 @@ Measurement SynthesizeModalRecord(const ModalRecordSpec& spec, Measurement* exac
   Measurement noisy = clean;
   std::mt19937_64 generator(spec.seed);
   std::normal_distribution<double> unit_normal(0.0, 1.0);
+  if (noise_std != nullptr) noise_std->clear();
   for (size_t c = 0; c < spec.channels.size(); ++c) {
-    const double std_dev = Lookup(spec.noise_std, spec.channels[c]);
+    double std_dev = Lookup(spec.noise_std, spec.channels[c]);
+    const auto target = spec.target_correlation.find(spec.channels[c]);
+    if (target != spec.target_correlation.end()) {
+      const auto column = clean.values.col(static_cast<Eigen::Index>(c));
+      const double signal_std =
+          std::sqrt((column.array() - column.mean()).square().sum() / column.size());
+      std_dev = signal_std * std::sqrt(1.0 / (target->second * target->second) - 1.0);
+    }
+    if (noise_std != nullptr) (*noise_std)[spec.channels[c]] = std_dev;
     for (int j = 0; j < samples; ++j) {
       noisy.values(j, static_cast<Eigen::Index>(c)) += std_dev * unit_normal(generator);
     }
@@ -51,13 +61,25 @@ Measurement SynthesizeModalRecord(const ModalRecordSpec& spec, Measurement* exac
 }
 
 ModalRecordSpec ReadModalRecordSpec(const YamlReader& node) {
-  node.ExpectMap({"channels", "sample_rate_hz", "duration_s", "modes", "noise_std_rad", "seed"});
+  node.ExpectMap({"channels", "sample_rate_hz", "duration_s", "modes", "noise_std_rad",
+                  "target_correlation", "seed"});
   ModalRecordSpec spec;
   spec.channels = node.StringList("channels");
   if (spec.channels.empty()) node.FailAt("channels", "no channel", "at least one channel name");
   spec.sample_rate_hz = node.PositiveDouble("sample_rate_hz", spec.sample_rate_hz);
   spec.duration_s = node.PositiveDouble("duration_s", spec.duration_s);
   spec.noise_std = ReadChannelValues(node, "noise_std_rad", spec.channels, true);
+  spec.target_correlation = ReadChannelValues(node, "target_correlation", spec.channels, true);
+  if (!spec.noise_std.empty() && !spec.target_correlation.empty()) {
+    node.FailAt("target_correlation", "given together with noise_std_rad",
+                "one of noise_std_rad and target_correlation");
+  }
+  for (const auto& [channel, k] : spec.target_correlation) {
+    if (!(k > 0 && k <= 1)) {
+      node.FailAt("target_correlation", channel + " = " + std::to_string(k),
+                  "a correlation in (0, 1] per channel");
+    }
+  }
   const int seed = node.Int("seed", 1);
   if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
   spec.seed = static_cast<std::uint64_t>(seed);

@@ -40,6 +40,32 @@ TEST(ModalRecordTest, NoiseIsSeeded) {
   EXPECT_NEAR(std::sqrt(noise.squaredNorm() / noise.size()), 1e-4, 1e-5);
 }
 
+double Correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const Eigen::ArrayXd x = a.array() - a.mean();
+  const Eigen::ArrayXd y = b.array() - b.mean();
+  return (x * y).sum() / std::sqrt(x.square().sum() * y.square().sum());
+}
+
+TEST(ModalRecordTest, TargetCorrelationSetsTheNoiseLevel) {
+  ModalRecordSpec spec;
+  spec.channels = {"psi", "phi"};
+  spec.sample_rate_hz = 100;
+  spec.duration_s = 100;  // 10001 samples: the sample correlation scatters by ~0.002
+  spec.modes = {{1.155, 0.2, {{"psi", 0.0112}, {"phi", 0.0055}}, {}},
+                {3.179, 0.1, {{"psi", 0.0010}, {"phi", 0.0062}}, {}}};
+  spec.target_correlation = {{"psi", 0.883}, {"phi", 0.5}};
+  Measurement exact;
+  std::map<std::string, double> noise_std;
+  const Measurement noisy = SynthesizeModalRecord(spec, &exact, &noise_std);
+  // std = std(exact) sqrt(1/K^2 - 1): the formula, checked on the record it was applied to.
+  const Eigen::VectorXd psi = exact.values.col(0);
+  const double psi_std = std::sqrt((psi.array() - psi.mean()).square().mean());
+  EXPECT_NEAR(noise_std.at("psi"), psi_std * std::sqrt(1 / (0.883 * 0.883) - 1), 1e-15);
+  // The realized correlation is the target within 5 times its sampling scatter.
+  EXPECT_NEAR(Correlation(noisy.values.col(0), exact.values.col(0)), 0.883, 0.01);
+  EXPECT_NEAR(Correlation(noisy.values.col(1), exact.values.col(1)), 0.5, 0.02);
+}
+
 TEST(ModalRecordTest, ReadsTheScenarioSectionStrictly) {
   const YamlReader good = YamlReader::FromString(
       "channels: [psi, phi]\nsample_rate_hz: 100\nduration_s: 10\nnoise_std_rad: 1.0e-4\n"
@@ -61,6 +87,16 @@ TEST(ModalRecordTest, ReadsTheScenarioSectionStrictly) {
     EXPECT_NE(std::string(error.what()).find("modes[0].frequency_hz"), std::string::npos)
         << error.what();
   }
+  const YamlReader both_noise_forms = YamlReader::FromString(
+      "channels: [psi]\nnoise_std_rad: 1.0e-4\ntarget_correlation: 0.9\nmodes:\n"
+      "  - {frequency_hz: 1, decay_rate_per_s: 1, amplitude_rad: 0.01}\n",
+      "bad.yaml");
+  EXPECT_THROW(ReadModalRecordSpec(both_noise_forms), InputError);
+  const YamlReader correlation_above_one = YamlReader::FromString(
+      "channels: [psi]\ntarget_correlation: 1.2\nmodes:\n"
+      "  - {frequency_hz: 1, decay_rate_per_s: 1, amplitude_rad: 0.01}\n",
+      "bad.yaml");
+  EXPECT_THROW(ReadModalRecordSpec(correlation_above_one), InputError);
 }
 
 }  // namespace

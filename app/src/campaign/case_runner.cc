@@ -73,6 +73,9 @@ CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case) 
     const Scenario scenario =
         LoadScenarioFromText(outcome.scenario_text, campaign.CaseSource(one_case));
     row["seed"] = scenario.sensors.seed;
+    if (!scenario.records.empty()) {
+      scenario.root.FailAt("record", "a recorded test", "no record: campaign cases simulate");
+    }
 
     step = "modes";
     std::shared_ptr<const model::MechanicalModel> model = scenario.MakeModel();

@@ -24,12 +24,9 @@ std::shared_ptr<const identification::ModalResult> RunIdentifyStep(const StepInp
   if (input.scenario->root.Has("identification")) {
     options = ReadIdentificationSettings(input.scenario->root.Child("identification"));
   }
-  // Only the free decay is identified: the record before a forcing's end is not one.
-  if (input.test->forcing_end_s > 0 && !std::isfinite(options.window_start_s)) {
-    options.window_start_s = input.test->forcing_end_s;
-  }
-  const auto result = std::make_shared<const identification::ModalResult>(
-      identification::Identify(input.test->measured, options, input.scenario->path));
+  const auto result = std::make_shared<const identification::ModalResult>(identification::Identify(
+      input.test->measured, FreeDecayOptions(options, input.scenario->RequireExcitation()),
+      input.scenario->path));
 
   nlohmann::ordered_json& row = outcome.row;
   row["identified.modes"] = result->modes.size();

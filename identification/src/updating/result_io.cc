@@ -206,8 +206,7 @@ void WriteCharacteristicGroup(H5Writer& file, const CharacteristicResult& result
 }
 
 void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,
-                        const CharacteristicResult* algebraic) {
-  const std::string root = "/updating";
+                        const CharacteristicResult* algebraic, const std::string& root) {
   file.WriteStringAttribute(root, "termination", result.termination_name());
   file.WriteStringAttribute(root, "message", result.message);
   file.WriteStringAttribute(root, "jacobian", result.jacobian);

@@ -2,6 +2,7 @@
 
 #include "mbid/common/yaml_reader.h"
 #include "mbid/identification/options.h"
+#include "mbid/simulation/excitation.h"
 
 namespace mbid::app {
 
@@ -17,5 +18,10 @@ namespace mbid::app {
 // Errors name the file and field; options out of range are reported as IdentificationOptions::
 // IsValid says.
 identification::IdentificationOptions ReadIdentificationSettings(const YamlReader& section);
+
+// Only the free decay is identified: without an explicit window start, the window opens at the
+// excitation's forcing end (impulse, burst).
+identification::IdentificationOptions FreeDecayOptions(
+    identification::IdentificationOptions options, const simulation::Excitation& excitation);
 
 }  // namespace mbid::app

@@ -2,7 +2,9 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "mbid/app/record_source.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/mechanical_model.h"
 #include "mbid/simulation/excitation.h"
@@ -21,6 +23,9 @@ struct Scenario {
   simulation::Excitation excitation;
   simulation::SimulationOptions simulation;  // defaults where the section is absent
   simulation::SensorOptions sensors;         // defaults where the section is absent
+  // `record:`: the tests' records when they are measured (or made from modes) rather than
+  // simulated from the model; empty: `mbid run` simulates the test.
+  std::vector<RecordSource> records;
   // `validation: {min_correlation: K}`: the run passes when the re-simulation with the tuned
   // parameters correlates with the record at least this well on every channel.
   double validation_min_correlation = 0.95;

@@ -28,7 +28,8 @@ class H5Writer {
   H5Writer(const H5Writer&) = delete;
   H5Writer& operator=(const H5Writer&) = delete;
 
-  void WriteMeasurement(const Measurement& measurement);
+  // `group` other than /measurement: a further record in the same layout (a run's other tests).
+  void WriteMeasurement(const Measurement& measurement, const std::string& group = "/measurement");
   void WriteScenarioYaml(const std::string& yaml_text);
 
   // `group` is an absolute path ("/truth/modes"); missing groups are created.

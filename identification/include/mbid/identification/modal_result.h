@@ -91,6 +91,8 @@ nlohmann::json ModalResultToJson(const ModalResult& result);
 // reconstruction/time and reconstruction/<channel>; spectrum/frequency_hz,
 // spectrum/<channel>, spectrum/peaks_*; stabilization/order, frequency_hz, decay_rate_per_s,
 // damping_ratio, stable (one row per pole); eq2_coefficients.
-void WriteModalResult(H5Writer& writer, const ModalResult& result);
+// `group` other than /identification: a further test's result in the same layout.
+void WriteModalResult(H5Writer& writer, const ModalResult& result,
+                      const std::string& group = "/identification");
 
 }  // namespace mbid::identification

@@ -42,8 +42,10 @@ nlohmann::json CharacteristicResultToJson(const CharacteristicResult& result);
 //   residual_rms/<channel>}, work/{simulations, sensitivity_simulations, rhs_evaluations,
 //   wall_time_s}
 // and, when given, /updating/algebraic (WriteCharacteristicGroup). '/' in names becomes '_'.
+// `root` other than /updating: a further test's result in the same layout.
 void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,
-                        const CharacteristicResult* algebraic = nullptr);
+                        const CharacteristicResult* algebraic = nullptr,
+                        const std::string& root = "/updating");
 
 // Route 1 under `group`: attributes status, message; chosen, ambiguous (0/1), starts,
 // converged_starts;

@@ -1,0 +1,40 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mbid/common/measurement.h"
+#include "mbid/common/yaml_reader.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/modal_record.h"
+
+namespace mbid::app {
+
+// Where a test's record comes from when the scenario does not simulate it: the `record:`
+// section (docs/scenarios.md), one map or a list of maps, each naming a measurement file or the
+// modes of a synthetic record.
+struct RecordSource {
+  std::string name;   // the test's name in reports and result groups
+  std::string field;  // "record" or "record[1]", for messages
+  std::string file;   // a .csv/.h5 measurement file, resolved against the scenario's folder
+  std::optional<simulation::ModalRecordSpec> synthetic;
+};
+
+// Reads the section strictly; `scenario_dir` resolves relative file names. Channels of synthetic
+// records must be outputs of `model`; files are checked when read.
+std::vector<RecordSource> ReadRecordSources(const YamlReader& record,
+                                            const std::string& scenario_dir,
+                                            const model::MechanicalModel& model);
+
+// A test record ready for identification.
+struct LoadedRecord {
+  Measurement measured;
+  std::optional<Measurement> exact;  // the noise-free record of a synthetic one
+  std::string origin;                // the file, or "synthetic modes"
+};
+
+// Reads the file (every channel must be an output of `model`) or synthesizes the record.
+LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel& model);
+
+}  // namespace mbid::app

@@ -1,0 +1,112 @@
+#include "mbid/app/record_source.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+
+#include "mbid/common/error.h"
+#include "mbid/common/hdf5_io.h"
+
+namespace mbid::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool IsOutput(const model::MechanicalModel& model, const std::string& channel) {
+  const auto& outputs = model.output_names();
+  return std::find(outputs.begin(), outputs.end(), channel) != outputs.end();
+}
+
+std::string OutputList(const model::MechanicalModel& model) {
+  return fmt::format("channels among the model's outputs ({})",
+                     fmt::join(model.output_names(), ", "));
+}
+
+RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
+                     const std::string& scenario_dir, const model::MechanicalModel& model) {
+  if (!entry.IsMap()) entry.Fail("not a mapping", "{file: PATH} or {synthetic_modes: {...}}");
+  entry.ExpectMap({"name", "file", "synthetic_modes"});
+  RecordSource source;
+  source.field = entry.field();
+  source.name = entry.String("name", default_name);
+  if (source.name.empty() || source.name.find('/') != std::string::npos) {
+    entry.FailAt("name", "'" + source.name + "'", "a non-empty test name without '/'");
+  }
+  const bool has_file = entry.Has("file");
+  if (has_file == entry.Has("synthetic_modes")) {
+    entry.Fail(has_file ? "both file and synthetic_modes" : "neither file nor synthetic_modes",
+               "exactly one of file: PATH and synthetic_modes: {...}");
+  }
+  if (has_file) {
+    const fs::path file = entry.String("file");
+    source.file = (file.is_relative() ? fs::path(scenario_dir) / file : file).string();
+    const std::string extension = file.extension().string();
+    if (extension != ".csv" && extension != ".h5" && extension != ".hdf5") {
+      entry.FailAt("file", "'" + file.string() + "'", "a .csv, .h5 or .hdf5 measurement file");
+    }
+    if (!fs::is_regular_file(source.file)) {
+      entry.FailAt("file", "'" + source.file + "' does not exist", "a readable measurement file");
+    }
+  } else {
+    const YamlReader modes = entry.Child("synthetic_modes");
+    source.synthetic = simulation::ReadModalRecordSpec(modes);
+    for (const std::string& channel : source.synthetic->channels) {
+      if (!IsOutput(model, channel)) {
+        modes.FailAt("channels", "'" + channel + "' is not an output of the model",
+                     OutputList(model));
+      }
+    }
+  }
+  return source;
+}
+
+}  // namespace
+
+std::vector<RecordSource> ReadRecordSources(const YamlReader& record,
+                                            const std::string& scenario_dir,
+                                            const model::MechanicalModel& model) {
+  std::vector<RecordSource> sources;
+  if (record.node().IsSequence()) {
+    if (record.node().size() == 0) record.Fail("an empty list", "one or more records");
+    for (size_t k = 0; k < record.node().size(); ++k) {
+      const YamlReader entry(record.node()[k], record.source(),
+                             record.field() + "[" + std::to_string(k) + "]");
+      sources.push_back(ReadOne(entry, fmt::format("test-{}", k + 1), scenario_dir, model));
+    }
+  } else {
+    sources.push_back(ReadOne(record, "test-1", scenario_dir, model));
+  }
+  std::set<std::string> names;
+  for (const RecordSource& source : sources) {
+    if (!names.insert(source.name).second) {
+      record.Fail("two records named '" + source.name + "'", "a unique name per record");
+    }
+  }
+  return sources;
+}
+
+LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel& model) {
+  LoadedRecord loaded;
+  if (source.synthetic) {
+    Measurement exact;
+    loaded.measured = simulation::SynthesizeModalRecord(*source.synthetic, &exact);
+    loaded.exact = std::move(exact);
+    loaded.origin = "synthetic modes";
+    return loaded;
+  }
+  loaded.measured = ReadMeasurement(source.file);
+  loaded.origin = source.file;
+  for (const std::string& channel : loaded.measured.channels) {
+    if (!IsOutput(model, channel)) {
+      throw InputError(source.file, "channels",
+                       fmt::format("channel '{}' is not an output of the model", channel),
+                       OutputList(model));
+    }
+  }
+  return loaded;
+}
+
+}  // namespace mbid::app

@@ -1,0 +1,52 @@
+#include "run_test.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "mbid/app/identification_settings.h"
+#include "mbid/app/updating_glue.h"
+#include "mbid/common/error.h"
+#include "mbid/identification/identify.h"
+
+namespace mbid::app {
+
+void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
+                 const simulation::Excitation& excitation, const RunSettings& settings,
+                 const std::function<void(const std::string&)>& say) {
+  test.identified = identification::Identify(
+      test.measured, FreeDecayOptions(settings.identification, excitation), test.origin);
+  say(fmt::format("identified {} modes ({}), K = {:.3f}", test.identified.modes.size(),
+                  test.identified.method, test.identified.correlation.minCoeff()));
+
+  // Route 1 (eqs. 6-8) when there is one identified pole per coordinate; Route 2 starts from its
+  // chosen set, else from the scenario's values.
+  updating::UpdatingSettings updating = settings.updating;
+  test.start_note = "the scenario's values";
+  std::string note;
+  test.algebraic =
+      SolveAlgebraicRoute(model, test.identified, test.measured, excitation, updating, &note);
+  if (test.algebraic && updating::ApplyAlgebraicStart(*test.algebraic, updating.options, &note)) {
+    test.start_note = "Route 1 (eq. 7)";
+  }
+  say(fmt::format("Route 1 (eq. 7): {}{}",
+                  test.algebraic ? test.algebraic->status_name() : "skipped",
+                  note.empty() ? "" : "; " + note));
+  updating::TestRecord record =
+      updating::MakeTestRecord(test.name, test.measured, excitation, updating);
+  WeighByIdentifiedNoise(test.identified, record);
+  say(fmt::format("Route 2 (Ceres, output error) from {}", test.start_note));
+  test.tuned = updating::UpdateModel(model, {record}, updating.options);
+  if (test.algebraic) updating::MarkAlgebraicAmbiguity(*test.algebraic, test.tuned);
+  say(fmt::format("updating: {} after {} iterations, cost {:.3g} -> {:.3g}",
+                  test.tuned.termination_name(), test.tuned.iterations, test.tuned.initial_cost,
+                  test.tuned.final_cost));
+  if (test.tuned.termination != updating::UpdateResult::Termination::kConverged) {
+    throw NumericalError("updating of test " + test.name,
+                         test.tuned.termination_name() + ": " + test.tuned.message);
+  }
+  const Eigen::VectorXd& k = test.tuned.tests.front().correlation;
+  test.passed = k.size() > 0 && (k.array() >= settings.min_correlation).all();
+}
+
+}  // namespace mbid::app

@@ -1,0 +1,48 @@
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "mbid/common/measurement.h"
+#include "mbid/identification/modal_result.h"
+#include "mbid/identification/options.h"
+#include "mbid/identification/updating/characteristic.h"
+#include "mbid/identification/updating/output_error.h"
+#include "mbid/identification/updating/settings.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/excitation.h"
+#include "mbid/simulation/simulate.h"
+
+namespace mbid::app {
+
+// One test of `mbid run` and everything the cycle derives from it.
+struct RunTest {
+  std::string name;
+  std::string origin;  // "simulation", the record's file, or "synthetic modes"
+  Measurement measured;
+  std::optional<Measurement> exact;                        // the noise-free record, when known
+  std::optional<simulation::SimulationResult> simulation;  // a simulated test's integration
+  identification::ModalResult identified;
+  std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, if it ran
+  std::string start_note;                                           // where Route 2 started
+  updating::UpdateResult tuned;
+  bool passed = false;  // re-simulation correlates at least at the threshold on every channel
+};
+
+// What every test of a run shares.
+struct RunSettings {
+  identification::IdentificationOptions identification;
+  updating::UpdatingSettings updating;
+  double min_correlation = 0.95;
+};
+
+// The cycle after the record: identify the modes (the free decay after any forcing), Route 1
+// (eq. 7) on their poles, Route 2 (Ceres) from Route 1's set or the scenario's values, and the
+// verdict on the re-simulation. Throws NumericalError when Route 2 does not converge.
+void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
+                 const simulation::Excitation& excitation, const RunSettings& settings,
+                 const std::function<void(const std::string&)>& say);
+
+}  // namespace mbid::app
