@@ -103,6 +103,7 @@ class CvodesIntegrator::Impl {
   }
 
   void set_time_dependent_inputs(TimeDependentInputs hook) { hook_ = std::move(hook); }
+  void set_jacobian(Eigen::MatrixXd jacobian) { jacobian_ = std::move(jacobian); }
 
   void Initialize(const SimTK::State& initial) {
     // Copy first: `initial` may be our own working state.
@@ -135,6 +136,12 @@ class CvodesIntegrator::Impl {
           "CvodesIntegrator::Initialize: the state has no continuous variables; expected "
           "q, u or z");
     }
+    if (jacobian_.size() > 0 && (jacobian_.rows() != n || jacobian_.cols() != n)) {
+      std::ostringstream why;
+      why << "CvodesIntegrator::Initialize: the Jacobian is " << jacobian_.rows() << " x "
+          << jacobian_.cols() << "; expected " << n << " x " << n << " (NY) or none";
+      throw std::invalid_argument(why.str());
+    }
     // Positions and velocities do not depend on the inputs: realizing them needs no hook.
     system_->realize(state, SimTK::Stage::Velocity);
     initialized_ = false;
@@ -146,7 +153,7 @@ class CvodesIntegrator::Impl {
     initialized_ = true;
   }
 
-  const SimTK::State& AdvanceTo(double t) {
+  const SimTK::State& AdvanceTo(double t, Realization realization) {
     if (!initialized_) {
       throw std::logic_error(
           "CvodesIntegrator::AdvanceTo: not initialized; call Initialize() first (and again "
@@ -190,7 +197,8 @@ class CvodesIntegrator::Impl {
       }
     }
     SetTimeAndY(t, N_VGetArrayPointer(y_.get()));
-    system_->realize(state_, SimTK::Stage::Acceleration);
+    system_->realize(state_, realization == Realization::kPositions ? SimTK::Stage::Position
+                                                                    : SimTK::Stage::Acceleration);
     return state_;
   }
 
@@ -223,8 +231,8 @@ class CvodesIntegrator::Impl {
     if (!options.IsValid(&why)) {
       throw std::invalid_argument("CvodesIntegrator: invalid SensitivityOptions: " + why);
     }
-    if (options_.method == IntegratorOptions::Method::kAdams &&
-        options.corrector == SensitivityOptions::Corrector::kSimultaneous &&
+    const bool fixed_point = nonlinear_solver_ != nullptr;
+    if (fixed_point && options.corrector == SensitivityOptions::Corrector::kSimultaneous &&
         options.difference_quotient == SensitivityOptions::DifferenceQuotient::kForward) {
       // Found on the crane: SUNDIALS 6.4.1's simultaneous fixed-point corrector with forward
       // quotients evaluates the right-hand side at NaN states at once.
@@ -266,7 +274,7 @@ class CvodesIntegrator::Impl {
     Check(CVodeSetSensDQMethod(cv, centered ? CV_CENTERED : CV_FORWARD, 0.0),
           "CVodeSetSensDQMethod");
     Check(CVodeSetSensErrCon(cv, options.error_control ? SUNTRUE : SUNFALSE), "CVodeSetSensErrCon");
-    if (options_.method == IntegratorOptions::Method::kAdams) {
+    if (fixed_point) {
       // Without a linear solver the sensitivities need fixed-point iteration too; CVODES'
       // default would be Newton.
       sensitivity_nonlinear_solver_.reset(SUNNonlinSol_FixedPointSens(
@@ -344,7 +352,8 @@ class CvodesIntegrator::Impl {
     Check(CVodeSetMaxNumSteps(cv, options_.max_steps), "CVodeSetMaxNumSteps");
     if (options_.max_step_s > 0) Check(CVodeSetMaxStep(cv, options_.max_step_s), "CVodeSetMaxStep");
 
-    if (bdf) {
+    const bool given_jacobian = jacobian_.size() > 0;
+    if (bdf || given_jacobian) {
       matrix_.reset(SUNDenseMatrix(n, n, context));
       if (!matrix_) throw NumericalError("CVODES", "SUNDenseMatrix returned NULL");
       linear_solver_.reset(SUNLinSol_Dense(y_.get(), matrix_.get(), context));
@@ -354,9 +363,10 @@ class CvodesIntegrator::Impl {
         throw NumericalError("CVODES",
                              "CVodeSetLinearSolver failed: " + LinearSolverFlagName(flag));
       }
+      if (given_jacobian) Check(CVodeSetJacFn(cv, &Impl::Jacobian), "CVodeSetJacFn");
     } else {
-      // Adams is for non-stiff models, where fixed-point iteration converges without the n
-      // extra RHS calls per difference-quotient Jacobian that Newton would need.
+      // Without a given Jacobian, Adams (for non-stiff models) iterates to a fixed point instead
+      // of spending n extra RHS calls per difference-quotient Jacobian on Newton.
       nonlinear_solver_.reset(SUNNonlinSol_FixedPoint(y_.get(), 0, context));
       if (!nonlinear_solver_) {
         throw NumericalError("CVODES", "SUNNonlinSol_FixedPoint returned NULL");
@@ -419,6 +429,17 @@ class CvodesIntegrator::Impl {
     return self->rhs_failures_ > kMaxRhsFailuresPerCall ? -1 : 1;
   }
 
+  // The given constant Jacobian (dense, column-major).
+  static int Jacobian(realtype /*t*/, N_Vector /*y*/, N_Vector /*f*/, SUNMatrix jacobian,
+                      void* user_data, N_Vector, N_Vector, N_Vector) {
+    const Eigen::MatrixXd& given = static_cast<Impl*>(user_data)->jacobian_;
+    for (Eigen::Index j = 0; j < given.cols(); ++j) {
+      realtype* column = SM_COLUMN_D(jacobian, j);
+      for (Eigen::Index i = 0; i < given.rows(); ++i) column[i] = given(i, j);
+    }
+    return 0;
+  }
+
   void RecordRhsError(double t, const char* what) {
     ++rhs_failures_;
     rhs_error_time_ = t;
@@ -438,6 +459,7 @@ class CvodesIntegrator::Impl {
   const SimTK::System* system_;
   IntegratorOptions options_;
   TimeDependentInputs hook_;
+  Eigen::MatrixXd jacobian_;  // empty: difference quotients
   SimTK::State state_;
   bool has_state_ = false;
   bool initialized_ = false;  // CVODES is ready to advance state_.
@@ -472,8 +494,13 @@ CvodesIntegrator& CvodesIntegrator::operator=(CvodesIntegrator&&) noexcept = def
 void CvodesIntegrator::set_time_dependent_inputs(TimeDependentInputs hook) {
   impl_->set_time_dependent_inputs(std::move(hook));
 }
+void CvodesIntegrator::set_jacobian(Eigen::MatrixXd jacobian) {
+  impl_->set_jacobian(std::move(jacobian));
+}
 void CvodesIntegrator::Initialize(const SimTK::State& initial) { impl_->Initialize(initial); }
-const SimTK::State& CvodesIntegrator::AdvanceTo(double t) { return impl_->AdvanceTo(t); }
+const SimTK::State& CvodesIntegrator::AdvanceTo(double t, Realization realization) {
+  return impl_->AdvanceTo(t, realization);
+}
 void CvodesIntegrator::InitializeSensitivities(const std::vector<double>& p,
                                                const std::vector<double>& scale,
                                                const Eigen::MatrixXd& initial,

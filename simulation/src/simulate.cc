@@ -8,7 +8,11 @@
 #include "simulation_setup.h"
 
 namespace mbid::simulation {
-namespace {}  // namespace
+namespace {
+
+constexpr CvodesIntegrator::Realization kPositions = CvodesIntegrator::Realization::kPositions;
+
+}  // namespace
 
 SimulationResult Simulate(const model::MechanicalModel& model, const Excitation& excitation,
                           const SimulationOptions& options, const SensorOptions& sensors) {
@@ -35,8 +39,17 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   IntegratorOptions forced_options = options.integrator;
   forced_options.interpolate_outputs = false;
   CvodesIntegrator integrator(simulated.system(), forced ? forced_options : options.integrator);
-  integrator.Initialize(
-      simulated.MakeState(result.initial_q, Eigen::VectorXd::Zero(model.coordinate_count())));
+  const SimTK::State initial =
+      simulated.MakeState(result.initial_q, Eigen::VectorXd::Zero(model.coordinate_count()));
+  // The linearization's Jacobian costs a few dozen realizations once, against NY right-hand
+  // sides per difference-quotient Jacobian (22 of them in the crane's load drop), and lets Adams
+  // use Newton. Y = [q | u] for every MechanicalModel; anything else keeps difference quotients.
+  Eigen::MatrixXd jacobian;
+  if (initial.getNY() == 2 * model.coordinate_count()) {
+    jacobian = internal::CalcLinearizedJacobian(simulated);
+  }
+  integrator.set_jacobian(jacobian);
+  integrator.Initialize(initial);
 
   Measurement exact;
   exact.channels = sensors.channels;
@@ -52,13 +65,15 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
     if (!forcing_done && t >= result.forcing_end_s) {
       // Stop exactly where the forcing switches off (a kink in the load) and restart the
       // multistep history there.
-      const SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s);
+      const SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s, kPositions);
       before_restart = integrator.statistics();
       integrator = CvodesIntegrator(simulated.system(), options.integrator);
+      integrator.set_jacobian(jacobian);
       integrator.Initialize(at_end);
       forcing_done = true;
     }
-    const SimTK::State& state = j == 0 ? integrator.state() : integrator.AdvanceTo(t);
+    // Outputs need positions only: realizing accelerations would cost a right-hand side.
+    const SimTK::State& state = j == 0 ? integrator.state() : integrator.AdvanceTo(t, kPositions);
     const Eigen::VectorXd y = simulated.CalcOutputs(state);
     for (size_t c = 0; c < sources.size(); ++c) {
       exact.values(j, static_cast<Eigen::Index>(c)) =

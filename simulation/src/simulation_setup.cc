@@ -1,5 +1,6 @@
 #include "simulation_setup.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 
 #include "mbid/common/error.h"
@@ -48,6 +49,17 @@ std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalM
     }
   });
   return forced;
+}
+
+Eigen::MatrixXd CalcLinearizedJacobian(const model::MechanicalModel& model) {
+  const model::LinearModel linear = model.Linearize();
+  const Eigen::Index n = linear.M.rows();
+  const Eigen::LDLT<Eigen::MatrixXd> mass(linear.M);  // symmetric positive definite
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  jacobian.topRightCorner(n, n).setIdentity();
+  jacobian.bottomLeftCorner(n, n) = -mass.solve(linear.C);
+  jacobian.bottomRightCorner(n, n) = -mass.solve(linear.D);
+  return jacobian;
 }
 
 }  // namespace mbid::simulation::internal

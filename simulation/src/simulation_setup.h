@@ -27,4 +27,9 @@ std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
 std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalModel& model,
                                                         const Excitation& excitation);
 
+// The Newton iteration's Jacobian d[q' u']/d[q u] from the linearization M q'' + D q' + C q = 0:
+// [0 I; -M^-1 C  -M^-1 D] (2n x 2n), computed once per simulation. Near the equilibrium it is
+// the exact Jacobian; elsewhere an approximation that Newton tolerates.
+Eigen::MatrixXd CalcLinearizedJacobian(const model::MechanicalModel& model);
+
 }  // namespace mbid::simulation::internal

@@ -47,6 +47,15 @@ class CvodesIntegrator {
   // multistep history at the discontinuity.
   void set_time_dependent_inputs(TimeDependentInputs hook);
 
+  // A constant approximation of the Jacobian df/dY (NY x NY), e.g. the model's linearization,
+  // for the Newton iteration; empty (the default) forms it from difference quotients of f (NY
+  // right-hand sides each time CVODES refreshes it). Newton with an approximate Jacobian only
+  // converges more slowly; the error test, not the Jacobian, controls the accuracy. With a
+  // Jacobian, Adams also iterates with Newton instead of fixed-point iteration, which takes
+  // fewer and longer steps at the same tolerance. Takes effect at the next Initialize(), which
+  // throws std::invalid_argument if the size is not NY x NY.
+  void set_jacobian(Eigen::MatrixXd jacobian);
+
   // Starts (or restarts) the integration from a copy of `initial` at initial.getTime(); the
   // copy is realized to Stage::Velocity (the input hook is not called yet: AdvanceTo(time())
   // realizes it to Acceleration with the inputs). Throws std::invalid_argument if the state
@@ -54,8 +63,15 @@ class CvodesIntegrator {
   // be set up.
   void Initialize(const SimTK::State& initial);
 
+  // How far AdvanceTo() realizes the state it returns. A Simbody realization costs as much as a
+  // right-hand side: callers that only read q, u or outputs skip forces and accelerations.
+  enum class Realization {
+    kPositions,      // Stage::Position (outputs, kinematics); realize further as needed
+    kAccelerations,  // Stage::Acceleration
+  };
+
   // Integrates to exactly time `t` (s), t >= time(), and returns the working state at t
-  // realized to Stage::Acceleration (valid until the next call). Unless
+  // realized to `realization` (valid until the next call), with the inputs applied. Unless
   // options().interpolate_outputs, CVODES stops at t (a stop time, no interpolation), so
   // inputs changed between calls never act before their time.
   //
@@ -65,7 +81,7 @@ class CvodesIntegrator {
   // message, the time reached and the last exception; Initialize() must then be called again
   // and state() holds the last point CVODES reached. Throws std::logic_error before
   // Initialize() and std::invalid_argument for t < time().
-  const SimTK::State& AdvanceTo(double t);
+  const SimTK::State& AdvanceTo(double t, Realization realization = Realization::kAccelerations);
 
   // Forward sensitivities s_i = dY/dp_i of parameters p (CVodeSensInit1 with CVODES' own
   // difference quotients of the right-hand side). CVODES perturbs the values it reads through
@@ -82,7 +98,7 @@ class CvodesIntegrator {
   // s_i at time(), NY x Np (columns per parameter); empty without sensitivities.
   const Eigen::MatrixXd& sensitivities() const;
 
-  // The working state at time(): realized to Velocity after Initialize(), to Acceleration after
+  // The working state at time(): realized to Velocity after Initialize(), as asked after
   // AdvanceTo(). Throws std::logic_error before the first Initialize().
   const SimTK::State& state() const;
   double time() const;

@@ -9,7 +9,8 @@ namespace mbid::simulation {
 struct IntegratorOptions {
   enum class Method {
     kBdf,    // Backward differentiation formulas, Newton iteration with a dense Jacobian.
-    kAdams,  // Adams-Moulton, fixed-point (functional) iteration; for non-stiff models.
+    kAdams,  // Adams-Moulton, for non-stiff models: Newton with a given Jacobian
+             // (CvodesIntegrator::set_jacobian; Simulate gives one), else fixed-point iteration.
   };
 
   Method method = Method::kBdf;
