@@ -26,7 +26,11 @@ TestFigures DrawTestFigures(const std::string& folder, const std::string& prefix
   };
   const Measurement* exact = test.exact ? &*test.exact : nullptr;
   for (int c = 0; c < test.measured.channel_count(); ++c) {
-    add(figures.record, DrawRecordFigure(folder, test.measured, exact, c));
+    add(figures.record,
+        DrawRecordFigure(folder, test.measured, exact,
+                         test.simulation ? "exact model output (no sensor errors)"
+                                         : "noise-free record (before the noise was added)",
+                         c));
   }
   add(figures.identification, DrawSpectrumFigure(folder, test.identified));
   for (int c = 0; c < static_cast<int>(test.identified.channels.size()); ++c) {

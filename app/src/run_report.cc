@@ -22,7 +22,8 @@ const char* kRecordStyle = "points pt 7 ps 0.35 lc rgb '#1f77b4'";
 }  // namespace
 
 std::string DrawRecordFigure(const std::string& folder, const Measurement& measured,
-                             const Measurement* exact, int channel) {
+                             const Measurement* exact, const std::string& exact_label,
+                             int channel) {
   Figure figure;
   const std::string& name = measured.channels[channel];
   figure.title = fmt::format("Test record: {}", name);
@@ -31,8 +32,8 @@ std::string DrawRecordFigure(const std::string& folder, const Measurement& measu
   const Eigen::VectorXd t = measured.CalcTime();
   figure.series.push_back({"record", t, measured.values.col(channel), kRecordStyle});
   if (exact != nullptr) {
-    figure.series.push_back({"exact model output (no sensor errors)", t, exact->values.col(channel),
-                             "lines lw 1.5 lc rgb '#d62728'"});
+    figure.series.push_back(
+        {exact_label, t, exact->values.col(channel), "lines lw 1.5 lc rgb '#d62728'"});
   }
   const std::string file = fmt::format("record_{}.png", name);
   DrawFigure(figure, Path(folder, file));
@@ -269,10 +270,10 @@ std::string TunedParametersMarkdown(const updating::UpdateResult& result,
       if (q.name == p.name) true_value = q.value;
     }
     out << fmt::format(
-        "| {} ({}) | {:.4g} | {} | {:.4g} | {:.4g} | {} |\n", p.name, p.units, p.value,
+        "| {} ({}) | {:.4g} | {} | {:.4g} | {} | {} |\n", p.name, p.units, p.value,
         std::isfinite(p.std) ? fmt::format("{:.2g} ({:.2g}%)", p.std, 100 * p.relative_std)
                              : "undetermined",
-        p.initial, true_value,
+        p.initial, std::isfinite(true_value) ? fmt::format("{:.4g}", true_value) : "-",
         std::isfinite(true_value)
             ? fmt::format("{:+.3g}%", 100 * (p.value - true_value) / true_value)
             : "");

@@ -367,7 +367,7 @@ class ProgressCallback final : public ceres::IterationCallback {
     record.stage = stage_;
     history_.push_back(record);
     if (!quiet_) {
-      std::fprintf(stderr, "mbid update: %s iteration %3d  cost %.6e  step %.3e%s\n",
+      std::fprintf(stderr, "mbid: Route 2 (%s) iteration %3d  cost %.6e  step %.3e%s\n",
                    label_.c_str(), summary.iteration, summary.cost, summary.step_norm,
                    summary.iteration > 0 && !summary.step_is_successful ? " (rejected)" : "");
     }

@@ -16,7 +16,7 @@ namespace mbid::app {
 
 // The figures of a run (gnuplot PNGs), each returned as its file name in `folder`.
 std::string DrawRecordFigure(const std::string& folder, const Measurement& measured,
-                             const Measurement* exact, int channel);
+                             const Measurement* exact, const std::string& exact_label, int channel);
 std::string DrawSpectrumFigure(const std::string& folder,
                                const identification::ModalResult& result);
 std::string DrawReconstructionFigure(const std::string& folder, const Measurement& measured,
