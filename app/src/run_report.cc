@@ -270,7 +270,8 @@ std::string TunedParametersMarkdown(const updating::UpdateResult& result,
       if (q.name == p.name) true_value = q.value;
     }
     out << fmt::format(
-        "| {} ({}) | {:.4g} | {} | {:.4g} | {} | {} |\n", p.name, p.units, p.value,
+        "| {} ({}) | {:.4g}{} | {} | {:.4g} | {} | {} |\n", p.name, p.units, p.value,
+        p.at_bound ? " (at bound)" : "",
         std::isfinite(p.std) ? fmt::format("{:.2g} ({:.2g}%)", p.std, 100 * p.relative_std)
                              : "undetermined",
         p.initial, std::isfinite(true_value) ? fmt::format("{:.4g}", true_value) : "-",
