@@ -88,6 +88,11 @@ int Main(int argc, char** argv) {
       ->capture_default_str();
   identify->add_option("--max-modes", identify_options.max_modes, "At most this many modes")
       ->capture_default_str();
+  identify
+      ->add_option("--extra-orders", identify_options.hankel.extra_orders,
+                   "hankel-nls: also restart from this many orders above the signal order "
+                   "(low-SNR records)")
+      ->capture_default_str();
 
   std::vector<std::string> update_data;
   CLI::App* update = app.add_subcommand(

@@ -10,11 +10,26 @@ namespace mbid::app {
 identification::IdentificationOptions ReadIdentificationSettings(const YamlReader& section) {
   identification::IdentificationOptions options;
   if (section.node().IsNull()) return options;
-  section.ExpectMap({"method", "window_start_s", "window_end_s", "channels", "offset", "decimation",
-                     "min_frequency_hz", "max_frequency_hz", "min_damping_ratio",
-                     "max_damping_ratio", "max_decay_rate_per_s", "max_modes",
-                     "significance_false_alarm", "min_significance", "drop_insignificant",
-                     "compute_spectrum", "compute_stabilization", "compute_uncertainty", "prony"});
+  section.ExpectMap({"method",
+                     "window_start_s",
+                     "window_end_s",
+                     "channels",
+                     "offset",
+                     "decimation",
+                     "min_frequency_hz",
+                     "max_frequency_hz",
+                     "min_damping_ratio",
+                     "max_damping_ratio",
+                     "max_decay_rate_per_s",
+                     "max_modes",
+                     "significance_false_alarm",
+                     "min_significance",
+                     "drop_insignificant",
+                     "compute_spectrum",
+                     "compute_stabilization",
+                     "compute_uncertainty",
+                     "extra_orders",
+                     "prony"});
   const std::string method = section.Choice("method", {"hankel-nls", "prony-svd"}, "hankel-nls");
   identification::ParseMethod(method, &options.method);
   options.window_start_s = section.Double("window_start_s", options.window_start_s);
@@ -32,6 +47,7 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
   options.max_decay_rate_per_s =
       section.Double("max_decay_rate_per_s", options.max_decay_rate_per_s);
   options.max_modes = section.Int("max_modes", options.max_modes);
+  options.hankel.extra_orders = section.Int("extra_orders", options.hankel.extra_orders);
   options.significance_false_alarm =
       section.Double("significance_false_alarm", options.significance_false_alarm);
   options.min_significance = section.Double("min_significance", options.min_significance);

@@ -293,6 +293,49 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
   };
   refine(&estimate);
   SelectSignificant(record, options, &estimate, refine);
+  if (options.drop_insignificant && options.hankel.extra_orders > 0) {
+    int added = 0;
+    const int highest = std::min(order + 2 * options.hankel.extra_orders, columns - 2);
+    for (int higher = order + 2; higher <= highest; higher += 2) {
+      Estimate trial;
+      trial.warnings = estimate.warnings;
+      trial.model_order = estimate.model_order;
+      trial.effective_rank = estimate.effective_rank;
+      for (const auto& lambda : poles_at(higher)) {
+        if (lambda.imag() > 0 && PassesFilter(lambda, options, record.max_frequency_hz)) {
+          trial.lambda.push_back(lambda);
+        }
+      }
+      if (trial.lambda.size() <= estimate.lambda.size()) continue;
+      try {
+        refine(&trial);
+        SelectSignificant(record, options, &trial, refine);
+      } catch (const NumericalError&) {
+        continue;  // nothing significant from this start: the estimate stands
+      }
+      if (trial.lambda.size() <= estimate.lambda.size()) continue;
+      // On a noiseless record every mode is "significant": a mode must also carry more than
+      // round-off of the record's amplitude.
+      const double largest = trial.fit.coefficients.cwiseAbs().maxCoeff();
+      bool real_modes = true;
+      for (size_t k = 0; k < trial.lambda.size(); ++k) {
+        const double peak = trial.fit.coefficients.middleRows(2 * static_cast<Eigen::Index>(k), 2)
+                                .cwiseAbs()
+                                .maxCoeff();
+        real_modes = real_modes && peak > 1e-6 * largest;
+      }
+      if (!real_modes) continue;
+      added += static_cast<int>(trial.lambda.size() - estimate.lambda.size());
+      trial.iterations += estimate.iterations;
+      trial.stabilization = std::move(estimate.stabilization);
+      estimate = std::move(trial);
+    }
+    if (added > 0) {
+      estimate.warnings.push_back(fmt::format(
+          "{} more significant mode(s) found by restarting from orders above the signal order {}",
+          added, order));
+    }
+  }
   if (estimate.termination == "failure") {
     throw NumericalError("Ceres",
                          "the refinement of the poles failed: " + estimate.termination_message);

@@ -89,6 +89,7 @@ std::optional<OptionProblem> FindOptionProblem(const IdentificationOptions& o) {
   c.Require(o.hankel.min_relative_singular_value > 0 && o.hankel.min_relative_singular_value < 1,
             "hankel.min_relative_singular_value", o.hankel.min_relative_singular_value,
             "a fraction in (0, 1)");
+  c.Require(o.hankel.extra_orders >= 0, "extra_orders", o.hankel.extra_orders, "an integer >= 0");
   c.Require(o.hankel.stability_orders >= 0, "hankel.stability_orders", o.hankel.stability_orders,
             "an integer >= 0");
   c.Require(std::isfinite(o.hankel.stability_tolerance) && o.hankel.stability_tolerance > 0,
