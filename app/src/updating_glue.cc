@@ -1,11 +1,43 @@
 #include "mbid/app/updating_glue.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
+#include <cmath>
 #include <complex>
+#include <numeric>
 #include <vector>
 
 namespace mbid::app {
+
+std::vector<size_t> SelectMainModes(const identification::ModalResult& identified, size_t count) {
+  // Energy of mode k over the analysed record, sum over channels of
+  // A^2 (1 - e^{-2 decay T}) / (4 decay), each channel in units of its residual noise variance so
+  // that no channel dominates by its unit; noiseless channels count unweighted.
+  const double record_s = (identified.samples - 1) * identified.sample_interval_s;
+  std::vector<double> energy(identified.modes.size(), 0.0);
+  for (size_t k = 0; k < identified.modes.size(); ++k) {
+    const auto& mode = identified.modes[k];
+    const double decay = mode.decay_rate_per_s;
+    const double duration = std::abs(decay) * record_s < 1e-12
+                                ? record_s / 2
+                                : -std::expm1(-2 * decay * record_s) / (4 * decay);
+    for (Eigen::Index c = 0; c < mode.amplitude.size(); ++c) {
+      const double noise = c < identified.noise_std.size() && identified.noise_std[c] > 0
+                               ? identified.noise_std[c]
+                               : 1.0;
+      energy[k] += mode.amplitude[c] * mode.amplitude[c] * duration / (noise * noise);
+    }
+  }
+  std::vector<size_t> order(identified.modes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&energy](size_t a, size_t b) { return energy[a] > energy[b]; });
+  order.resize(std::min(count, order.size()));
+  std::sort(order.begin(), order.end());  // ascending frequency, as identified
+  return order;
+}
 
 std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
     const model::MechanicalModel& model, const identification::ModalResult& identified,
@@ -15,13 +47,24 @@ std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
     *note = "algebraic_start is off";
     return nullptr;
   }
-  if (static_cast<int>(identified.modes.size()) != model.coordinate_count()) {
-    *note = fmt::format("{} identified modes for {} coordinates", identified.modes.size(),
-                        model.coordinate_count());
+  const size_t n = static_cast<size_t>(model.coordinate_count());
+  if (identified.modes.size() < n) {
+    *note = fmt::format("{} identified modes for {} coordinates", identified.modes.size(), n);
     return nullptr;
   }
+  std::vector<size_t> main = SelectMainModes(identified, n);
+  if (identified.modes.size() > n) {
+    std::vector<std::string> left_out;
+    for (size_t k = 0; k < identified.modes.size(); ++k) {
+      if (std::find(main.begin(), main.end(), k) == main.end()) {
+        left_out.push_back(fmt::format("{:.3f} Hz", identified.modes[k].frequency_hz));
+      }
+    }
+    *note = fmt::format("eq. 7 on the {} main modes (largest energy in the record); left out: {}",
+                        n, fmt::join(left_out, ", "));
+  }
   std::vector<std::complex<double>> lambda;
-  for (const auto& mode : identified.modes) lambda.push_back(mode.lambda);
+  for (size_t k : main) lambda.push_back(identified.modes[k].lambda);
   return std::make_shared<const updating::CharacteristicResult>(
       updating::SolveCharacteristicEquation(
           updating::MakeCharacteristicProblem(model, lambda, record, excitation),

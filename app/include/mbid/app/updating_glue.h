@@ -2,6 +2,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "mbid/common/measurement.h"
 #include "mbid/identification/modal_result.h"
@@ -13,9 +14,14 @@
 
 namespace mbid::app {
 
+// The indices (ascending) of the `count` identified modes of largest energy in the record: the
+// paper's "main" modes, which it chose among all it found for eq. 7.
+std::vector<size_t> SelectMainModes(const identification::ModalResult& identified, size_t count);
+
 // Route 1 (method.md, eqs. 6-8) from the identified poles of `record`, when the settings ask for
-// it and there is one mode per coordinate; otherwise null with the reason in `note`. Shared by
-// `mbid run`, `mbid update` and the campaigns' update step.
+// it and there are at least as many modes as coordinates (more: the main ones, named in `note`);
+// otherwise null with the reason in `note`. Shared by `mbid run`, `mbid update` and the
+// campaigns' update step.
 std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
     const model::MechanicalModel& model, const identification::ModalResult& identified,
     const Measurement& record, const simulation::Excitation& excitation,
