@@ -18,24 +18,17 @@
 #include <thread>
 #include <vector>
 
+#include "../app/command_test.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kMbid = std::string(MBID_BINARY_DIR) + "/app/mbid";
 const std::string kScenarios = std::string(MBID_SOURCE_DIR) + "/scenarios";
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-struct CommandResult {
-  int exit_code = -1;
-  std::string err;
-};
+using mbid::testing::CommandResult;
+using mbid::testing::kMbid;
+using mbid::testing::ReadText;
 
 // A small campaign on the reference crane, cheap enough for CI: 2 s records at 50 Hz (a few
 // CVODES steps per sample), identification on, one value out of range (95 deg, a failing case).
@@ -56,38 +49,7 @@ sweep:
 )";
 }
 
-class CampaignCliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    // Parametrized tests are named "Test/Param": one folder, not two.
-    std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    std::replace(name.begin(), name.end(), '/', '_');
-    dir_ = fs::temp_directory_path() /
-           ("mbid_campaign_cli_" + std::to_string(::getpid()) + "_" + name);
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path Write(const std::string& name, const std::string& text) const {
-    std::ofstream(dir_ / name) << text;
-    return dir_ / name;
-  }
-
-  CommandResult Run(const std::string& arguments, const std::string& prefix = "") const {
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string command =
-        prefix + kMbid + " " + arguments + " > /dev/null 2> " + err.string();
-    const int status = std::system(command.c_str());
-    CommandResult result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.err = ReadFile(err);
-    fs::remove(err);
-    return result;
-  }
-
-  fs::path dir_;
-};
+class CampaignCliTest : public mbid::testing::CommandTest {};
 
 TEST_F(CampaignCliTest, OneAndTwoWorkersGiveTheSameFileBitForBit) {
   const fs::path campaign = Write("small.yaml", SmallCampaign());
@@ -98,16 +60,16 @@ TEST_F(CampaignCliTest, OneAndTwoWorkersGiveTheSameFileBitForBit) {
                                 " --workers 2 --quiet");
   ASSERT_EQ(two.exit_code, 0) << two.err;
   EXPECT_TRUE(two.err.empty()) << two.err;  // --quiet
-  const std::string h5 = ReadFile(dir_ / "one" / "campaign.h5");
+  const std::string h5 = ReadText(dir_ / "one" / "campaign.h5");
   ASSERT_GT(h5.size(), 10000u) << "6 cases with records and identification";
-  EXPECT_TRUE(h5 == ReadFile(dir_ / "two" / "campaign.h5")) << "campaign.h5 differs";
-  EXPECT_EQ(ReadFile(dir_ / "one" / "summary.csv"), ReadFile(dir_ / "two" / "summary.csv"));
+  EXPECT_TRUE(h5 == ReadText(dir_ / "two" / "campaign.h5")) << "campaign.h5 differs";
+  EXPECT_EQ(ReadText(dir_ / "one" / "summary.csv"), ReadText(dir_ / "two" / "summary.csv"));
   // Progress on standard error: cases and rate.
   EXPECT_NE(one.err.find("ran 6 cases"), std::string::npos) << one.err;
   EXPECT_NE(one.err.find("cases/s"), std::string::npos) << one.err;
   // The per-case files are merged and gone; the summary has one row per case (+ header).
   EXPECT_FALSE(fs::exists(dir_ / "one" / "cases"));
-  const std::string csv = ReadFile(dir_ / "one" / "summary.csv");
+  const std::string csv = ReadText(dir_ / "one" / "summary.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7);
   EXPECT_NE(csv.find("identified.mode1.frequency_hz"), std::string::npos);
   // The two 95 deg cases failed with their reason, and only they.
@@ -131,7 +93,7 @@ sweep:
   const CommandResult result =
       Run("campaign " + campaign.string() + " -o " + (dir_ / "out").string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  const std::string csv = ReadFile(dir_ / "out" / "summary.csv");
+  const std::string csv = ReadText(dir_ / "out" / "summary.csv");
   EXPECT_NE(csv.find("case_0000,0,ok,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("case_0001,1,numerical_failure,simulate,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("CVODES"), std::string::npos) << csv;
@@ -210,7 +172,7 @@ sweep:
   const CommandResult whole =
       Run("campaign " + campaign.string() + " -o " + (dir_ / "whole").string() + " --quiet");
   ASSERT_EQ(whole.exit_code, 0) << whole.err;
-  EXPECT_TRUE(ReadFile(killed / "campaign.h5") == ReadFile(dir_ / "whole" / "campaign.h5"))
+  EXPECT_TRUE(ReadText(killed / "campaign.h5") == ReadText(dir_ / "whole" / "campaign.h5"))
       << "the resumed campaign differs from an uninterrupted one";
   // Resuming a finished campaign does nothing.
   const CommandResult again =
@@ -234,7 +196,7 @@ TEST_F(CampaignCliTest, ResumeRedoesTemporariesAndDamagedCaseFiles) {
   const CommandResult result =
       Run("campaign " + campaign.string() + " -o " + out.string() + " --resume");
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_TRUE(ReadFile(out / "campaign.h5") == ReadFile(dir_ / "whole" / "campaign.h5"));
+  EXPECT_TRUE(ReadText(out / "campaign.h5") == ReadText(dir_ / "whole" / "campaign.h5"));
 }
 
 TEST_F(CampaignCliTest, ResumeRefusesADifferentCampaign) {
@@ -270,9 +232,9 @@ TEST_F(CampaignCliTest, TwoMpiRanksGiveTheSameFileAsOneProcess) {
                                 std::string(MBID_MPIEXEC) + " -n 2 ");
   ASSERT_EQ(mpi.exit_code, 0) << mpi.err;
   EXPECT_NE(mpi.err.find("on 2 ranks"), std::string::npos) << mpi.err;
-  EXPECT_TRUE(ReadFile(dir_ / "local" / "campaign.h5") == ReadFile(dir_ / "mpi" / "campaign.h5"))
+  EXPECT_TRUE(ReadText(dir_ / "local" / "campaign.h5") == ReadText(dir_ / "mpi" / "campaign.h5"))
       << "the MPI campaign file differs from the local one";
-  EXPECT_EQ(ReadFile(dir_ / "local" / "summary.csv"), ReadFile(dir_ / "mpi" / "summary.csv"));
+  EXPECT_EQ(ReadText(dir_ / "local" / "summary.csv"), ReadText(dir_ / "mpi" / "summary.csv"));
 #endif
 }
 
