@@ -30,7 +30,6 @@ RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
   if (!entry.IsMap()) entry.Fail("not a mapping", "{file: PATH} or {synthetic_modes: {...}}");
   entry.ExpectMap({"name", "file", "synthetic_modes"});
   RecordSource source;
-  source.field = entry.field();
   source.name = entry.String("name", default_name);
   if (source.name.empty() || source.name.find('/') != std::string::npos) {
     entry.FailAt("name", "'" + source.name + "'", "a non-empty test name without '/'");
@@ -99,14 +98,19 @@ LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel
   }
   loaded.measured = ReadMeasurement(source.file);
   loaded.origin = source.file;
-  for (const std::string& channel : loaded.measured.channels) {
+  RequireModelOutputs(loaded.measured, source.file, model);
+  return loaded;
+}
+
+void RequireModelOutputs(const Measurement& record, const std::string& origin,
+                         const model::MechanicalModel& model) {
+  for (const std::string& channel : record.channels) {
     if (!IsOutput(model, channel)) {
-      throw InputError(source.file, "channels",
+      throw InputError(origin, "channels",
                        fmt::format("channel '{}' is not an output of the model", channel),
                        OutputList(model));
     }
   }
-  return loaded;
 }
 
 }  // namespace mbid::app

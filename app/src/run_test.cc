@@ -19,8 +19,8 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
   say(fmt::format("identified {} modes ({}), K = {:.3f}", test.identified.modes.size(),
                   test.identified.method, test.identified.correlation.minCoeff()));
 
-  // Route 1 (eqs. 6-8) when there is one identified pole per coordinate; Route 2 starts from its
-  // chosen set, else from the scenario's values.
+  // Route 1 (eqs. 6-8) when there are enough identified poles (SolveAlgebraicRoute); Route 2
+  // starts from its chosen set, else from the scenario's values.
   updating::UpdatingSettings updating = settings.updating;
   test.start_note = "the scenario's values";
   std::string note;

@@ -13,6 +13,7 @@
 
 #include "mbid/app/commands.h"
 #include "mbid/app/identification_settings.h"
+#include "mbid/app/record_source.h"
 #include "mbid/app/scenario.h"
 #include "mbid/app/updating_glue.h"
 #include "mbid/common/error.h"
@@ -51,14 +52,7 @@ LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
   test.path = path;
   test.record = ReadMeasurement(path);
   // Checked here rather than left to the fit: identification would run first on any channels.
-  for (const std::string& channel : test.record.channels) {
-    const auto& outputs = model.output_names();
-    if (std::find(outputs.begin(), outputs.end(), channel) == outputs.end()) {
-      throw InputError(
-          path, "channels", fmt::format("channel '{}' is not an output of the model", channel),
-          fmt::format("channels among the model's outputs ({})", fmt::join(outputs, ", ")));
-    }
-  }
+  RequireModelOutputs(test.record, path, model);
   // A simulated test carries its own scenario: its excitation is the one of this record (a load
   // drop and an initial deflection can then be fitted together).
   const std::string yaml = IsHdf5(path) ? ReadScenarioYaml(path) : std::string();

@@ -15,9 +15,8 @@ namespace mbid::app {
 // section (docs/scenarios.md), one map or a list of maps, each naming a measurement file or the
 // modes of a synthetic record.
 struct RecordSource {
-  std::string name;   // the test's name in reports and result groups
-  std::string field;  // "record" or "record[1]", for messages
-  std::string file;   // a .csv/.h5 measurement file, resolved against the scenario's folder
+  std::string name;  // the test's name in reports and result groups
+  std::string file;  // a .csv/.h5 measurement file, resolved against the scenario's folder
   std::optional<simulation::ModalRecordSpec> synthetic;
 };
 
@@ -33,6 +32,10 @@ struct LoadedRecord {
   std::optional<Measurement> exact;  // the noise-free record of a synthetic one
   std::string origin;                // the file, or "synthetic modes"
 };
+
+// Throws InputError naming `origin` unless every channel of `record` is an output of `model`.
+void RequireModelOutputs(const Measurement& record, const std::string& origin,
+                         const model::MechanicalModel& model);
 
 // Reads the file (every channel must be an output of `model`) or synthesizes the record.
 LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel& model);
