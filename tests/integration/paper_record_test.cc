@@ -5,38 +5,19 @@
 
 #include <cmath>
 
+#include "../support/paper_table1.h"
 #include "mbid/identification/identify.h"
 #include "mbid/simulation/modal_record.h"
 
 namespace mbid {
 namespace {
 
-// Table 1 (method.md): f (Hz), decay (1/s), A_psi, A_phi (rad); each mode released from rest.
-simulation::ModalRecordSpec PaperRecord(double target_correlation, std::uint64_t seed) {
-  const double table1[4][4] = {{1.155, 6.77, 0.0112, 0.0055},
-                               {2.169, 1.52, 0.0046, 0.0008},
-                               {3.179, 3.67, 0.0010, 0.0062},
-                               {3.766, 1.98, 0.0035, 0.0069}};
-  simulation::ModalRecordSpec spec;
-  spec.channels = {"psi", "phi"};
-  spec.sample_rate_hz = 100;
-  spec.duration_s = 2.5;
-  spec.seed = seed;
-  if (target_correlation < 1) {
-    spec.target_correlation = {{"psi", target_correlation}, {"phi", target_correlation}};
-  }
-  for (const auto& mode : table1) {
-    const double phase = -std::atan(mode[1] / (2 * M_PI * mode[0]));
-    spec.modes.push_back(
-        {mode[0], mode[1], {{"psi", mode[2]}, {"phi", mode[3]}}, {{"psi", phase}, {"phi", phase}}});
-  }
-  return spec;
-}
+using testing::PaperRecordSpec;
 
 TEST(PaperRecordTest, RestartFromHigherOrdersFindsTheWeakModes) {
   // Seed 4 at K = 0.999 (4.5 % noise): at the signal order the identifier merges modes 3 and 4
   // (found while choosing the scenario's settings; docs/validation.md).
-  const simulation::ModalRecordSpec spec = PaperRecord(0.999, 4);
+  const simulation::ModalRecordSpec spec = PaperRecordSpec(0.999, 4);
   const Measurement record = simulation::SynthesizeModalRecord(spec);
   identification::IdentificationOptions options;
   const identification::ModalResult plain = identification::Identify(record, options, "paper");
@@ -55,7 +36,7 @@ TEST(PaperRecordTest, RestartFromHigherOrdersFindsTheWeakModes) {
 }
 
 TEST(PaperRecordTest, RestartAddsNothingToANoiselessRecord) {
-  const simulation::ModalRecordSpec spec = PaperRecord(1.0, 1);
+  const simulation::ModalRecordSpec spec = PaperRecordSpec();
   identification::IdentificationOptions options;
   options.hankel.extra_orders = 4;
   const identification::ModalResult result =

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../support/paper_table1.h"
 #include "crane_fixture.h"
 #include "mbid/identification/updating/characteristic.h"
 #include "mbid/model/linear_model.h"
@@ -15,37 +16,20 @@
 namespace mbid::updating {
 namespace {
 
-// Table 1 of the paper (method.md): frequency (Hz), beta (1/s), A_psi, A_phi (rad).
-struct PaperMode {
-  double frequency_hz, beta_per_s, a_psi, a_phi;
-};
-constexpr PaperMode kTable1[] = {{1.155, -6.77, 0.0112, 0.0055},
-                                 {2.169, -1.52, 0.0046, 0.0008},
-                                 {3.179, -3.67, 0.0010, 0.0062},
-                                 {3.766, -1.98, 0.0035, 0.0069}};
+using mbid::testing::kTable1;
+using mbid::testing::PaperMode;
 
 std::vector<std::complex<double>> PaperPoles() {
   std::vector<std::complex<double>> lambda;
   for (const PaperMode& mode : kTable1) {
-    lambda.emplace_back(mode.beta_per_s, 2 * M_PI * mode.frequency_hz);
+    lambda.emplace_back(-mode.decay_rate_per_s, 2 * M_PI * mode.frequency_hz);
   }
   return lambda;
 }
 
-// The noise-free record of scenarios/paper-ks5579.yaml: each mode released from rest.
+// The noise-free record of scenarios/paper-ks5579.yaml.
 Measurement PaperRecord() {
-  simulation::ModalRecordSpec spec;
-  spec.channels = {"psi", "phi"};
-  spec.sample_rate_hz = 100;
-  spec.duration_s = 2.5;
-  for (const PaperMode& mode : kTable1) {
-    const double phase = -std::atan(-mode.beta_per_s / (2 * M_PI * mode.frequency_hz));
-    spec.modes.push_back({mode.frequency_hz,
-                          -mode.beta_per_s,
-                          {{"psi", mode.a_psi}, {"phi", mode.a_phi}},
-                          {{"psi", phase}, {"phi", phase}}});
-  }
-  return simulation::SynthesizeModalRecord(spec);
+  return simulation::SynthesizeModalRecord(mbid::testing::PaperRecordSpec());
 }
 
 // The eigenvalues of [0 I; -M^-1 C  -M^-1 D] with C = diag(c) + K_g, D = diag(d), computed
