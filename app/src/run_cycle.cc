@@ -183,14 +183,8 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   const simulation::Excitation& excitation = scenario.RequireExcitation();
 
   RunSettings settings;
-  if (scenario.root.Has("identification")) {
-    settings.identification = ReadIdentificationSettings(scenario.root.Child("identification"));
-  }
-  settings.updating =
-      scenario.root.Has("updating")
-          ? updating::ReadUpdatingSettings(scenario.root.Child("updating"), *model,
-                                           scenario.simulation.integrator)
-          : updating::MakeDefaultUpdatingSettings(*model, scenario.simulation.integrator);
+  settings.identification = scenario.ReadIdentification();
+  settings.updating = scenario.ReadUpdating(*model);
   settings.updating.options.quiet = common.quiet;
   settings.min_correlation = scenario.validation_min_correlation;
 

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "mbid/app/identification_settings.h"
 #include "mbid/common/error.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/simulation/scenario_sections.h"
@@ -12,6 +13,17 @@ namespace mbid::app {
 
 std::unique_ptr<model::MechanicalModel> Scenario::MakeModel() const {
   return model::MakeModel(root.Child("model"));
+}
+
+identification::IdentificationOptions Scenario::ReadIdentification() const {
+  return root.Has("identification") ? ReadIdentificationSettings(root.Child("identification"))
+                                    : identification::IdentificationOptions();
+}
+
+updating::UpdatingSettings Scenario::ReadUpdating(const model::MechanicalModel& model) const {
+  return root.Has("updating")
+             ? updating::ReadUpdatingSettings(root.Child("updating"), model, simulation.integrator)
+             : updating::MakeDefaultUpdatingSettings(model, simulation.integrator);
 }
 
 const simulation::Excitation& Scenario::RequireExcitation() const {

@@ -112,16 +112,10 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
                      const std::string& output_path, const CommonOptions& common) {
   const Scenario scenario = LoadScenario(scenario_path);
   const auto model = scenario.MakeModel();
-  updating::UpdatingSettings settings =
-      scenario.root.Has("updating")
-          ? updating::ReadUpdatingSettings(scenario.root.Child("updating"), *model,
-                                           scenario.simulation.integrator)
-          : updating::MakeDefaultUpdatingSettings(*model, scenario.simulation.integrator);
+  updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
   settings.options.quiet = common.quiet;
   const identification::IdentificationOptions identification_options =
-      scenario.root.Has("identification")
-          ? ReadIdentificationSettings(scenario.root.Child("identification"))
-          : identification::IdentificationOptions();
+      scenario.ReadIdentification();
 
   // Every record is read and checked before any long work starts.
   std::vector<LoadedTest> tests;

@@ -13,6 +13,8 @@
 namespace mbid::app {
 namespace {
 
+using internal::Number;
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A swept value in the row: a number when the scalar is one, otherwise its YAML text.
@@ -24,12 +26,6 @@ nlohmann::ordered_json ValueJson(const YAML::Node& value) {
     if (!text.empty() && end != nullptr && *end == '\0' && std::isfinite(number)) return number;
   }
   return ValueText(value);
-}
-
-// JSON has no NaN or infinity: they become null (an empty cell in summary.csv).
-nlohmann::ordered_json Number(double value) {
-  if (!std::isfinite(value)) return nullptr;
-  return value;
 }
 
 void AddExactModes(const std::vector<model::Mode>& modes, CaseOutcome& outcome) {

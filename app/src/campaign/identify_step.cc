@@ -9,23 +9,12 @@
 #include "steps.h"
 
 namespace mbid::app::internal {
-namespace {
-
-nlohmann::ordered_json Number(double value) {
-  if (!std::isfinite(value)) return nullptr;
-  return value;
-}
-
-}  // namespace
 
 std::shared_ptr<const identification::ModalResult> RunIdentifyStep(const StepInput& input,
                                                                    CaseOutcome& outcome) {
-  identification::IdentificationOptions options;
-  if (input.scenario->root.Has("identification")) {
-    options = ReadIdentificationSettings(input.scenario->root.Child("identification"));
-  }
   const auto result = std::make_shared<const identification::ModalResult>(identification::Identify(
-      input.test->measured, FreeDecayOptions(options, input.scenario->RequireExcitation()),
+      input.test->measured,
+      FreeDecayOptions(input.scenario->ReadIdentification(), input.scenario->RequireExcitation()),
       input.scenario->path));
 
   nlohmann::ordered_json& row = outcome.row;

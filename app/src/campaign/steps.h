@@ -3,7 +3,9 @@
 // The identify and update steps of a campaign case: what each takes from the case and adds to
 // its results.
 
+#include <cmath>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "mbid/app/campaign_case.h"
 #include "mbid/app/scenario.h"
@@ -12,6 +14,12 @@
 #include "mbid/simulation/simulate.h"
 
 namespace mbid::app::internal {
+
+// A row value: JSON has no NaN or infinity, they become null (an empty cell in summary.csv).
+inline nlohmann::ordered_json Number(double value) {
+  if (!std::isfinite(value)) return nullptr;
+  return value;
+}
 
 // What a step sees of its case: the scenario, the case's model and its simulated test.
 struct StepInput {

@@ -15,23 +15,11 @@
 #include "steps.h"
 
 namespace mbid::app::internal {
-namespace {
-
-nlohmann::ordered_json Number(double value) {
-  if (!std::isfinite(value)) return nullptr;
-  return value;
-}
-
-}  // namespace
 
 void RunUpdateStep(const StepInput& input, CaseOutcome& outcome) {
   const Scenario& scenario = *input.scenario;
   const model::MechanicalModel& model = *input.model;
-  updating::UpdatingSettings settings =
-      scenario.root.Has("updating")
-          ? updating::ReadUpdatingSettings(scenario.root.Child("updating"), model,
-                                           scenario.simulation.integrator)
-          : updating::MakeDefaultUpdatingSettings(model, scenario.simulation.integrator);
+  updating::UpdatingSettings settings = scenario.ReadUpdating(model);
   settings.options.quiet = true;  // the campaign reports progress, not each fit
 
   std::string start = "scenario";

@@ -6,6 +6,8 @@
 
 #include "mbid/app/record_source.h"
 #include "mbid/common/yaml_reader.h"
+#include "mbid/identification/options.h"
+#include "mbid/identification/updating/settings.h"
 #include "mbid/model/mechanical_model.h"
 #include "mbid/simulation/excitation.h"
 #include "mbid/simulation/sensor.h"
@@ -32,6 +34,11 @@ struct Scenario {
 
   // A fresh model instance (one per worker).
   std::unique_ptr<model::MechanicalModel> MakeModel() const;
+  // The `identification:` section, or the identifier's defaults.
+  identification::IdentificationOptions ReadIdentification() const;
+  // The `updating:` section for `model`, or the defaults; the fits integrate with the
+  // scenario's integrator unless the section says otherwise.
+  updating::UpdatingSettings ReadUpdating(const model::MechanicalModel& model) const;
   // The excitation; an InputError if the scenario has none.
   const simulation::Excitation& RequireExcitation() const;
 };
