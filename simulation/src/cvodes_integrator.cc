@@ -197,8 +197,10 @@ class CvodesIntegrator::Impl {
       }
     }
     SetTimeAndY(t, N_VGetArrayPointer(y_.get()));
-    system_->realize(state_, realization == Realization::kPositions ? SimTK::Stage::Position
-                                                                    : SimTK::Stage::Acceleration);
+    if (realization != Realization::kNone) {
+      system_->realize(state_, realization == Realization::kPositions ? SimTK::Stage::Position
+                                                                      : SimTK::Stage::Acceleration);
+    }
     return state_;
   }
 

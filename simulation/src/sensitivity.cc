@@ -142,17 +142,16 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
     const double t = j * tau;
     if (!forcing_done && t >= forcing_end_s) {
       // Restart the multistep history at the kink of the load, sensitivities carried over.
-      integrator.AdvanceTo(forcing_end_s, CvodesIntegrator::Realization::kPositions);
+      integrator.AdvanceTo(forcing_end_s, CvodesIntegrator::Realization::kNone);
       result.statistics += integrator.statistics();
       const Eigen::MatrixXd carried = integrator.sensitivities();
       integrator.Initialize(SimTK::State(integrator.state()));
       integrator.InitializeSensitivities(p, scale, carried, sensitivity);
       forcing_done = true;
     }
-    // Outputs need positions only: realizing accelerations would cost a right-hand side.
+    // Outputs realize what they need themselves (the crane's: nothing).
     const SimTK::State& state =
-        j == 0 ? integrator.state()
-               : integrator.AdvanceTo(t, CvodesIntegrator::Realization::kPositions);
+        j == 0 ? integrator.state() : integrator.AdvanceTo(t, CvodesIntegrator::Realization::kNone);
     const Eigen::VectorXd y = simulated.CalcOutputs(state);
     Eigen::VectorXd q(n);
     for (int i = 0; i < n; ++i) q[i] = state.getQ()[i];

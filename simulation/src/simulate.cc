@@ -10,7 +10,9 @@
 namespace mbid::simulation {
 namespace {
 
-constexpr CvodesIntegrator::Realization kPositions = CvodesIntegrator::Realization::kPositions;
+// Outputs realize what they need themselves (the crane's: nothing); realizing here would cost
+// up to a right-hand side per sample.
+constexpr CvodesIntegrator::Realization kUnrealized = CvodesIntegrator::Realization::kNone;
 
 }  // namespace
 
@@ -65,15 +67,14 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
     if (!forcing_done && t >= result.forcing_end_s) {
       // Stop exactly where the forcing switches off (a kink in the load) and restart the
       // multistep history there.
-      const SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s, kPositions);
+      const SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s, kUnrealized);
       before_restart = integrator.statistics();
       integrator = CvodesIntegrator(simulated.system(), options.integrator);
       integrator.set_jacobian(jacobian);
       integrator.Initialize(at_end);
       forcing_done = true;
     }
-    // Outputs need positions only: realizing accelerations would cost a right-hand side.
-    const SimTK::State& state = j == 0 ? integrator.state() : integrator.AdvanceTo(t, kPositions);
+    const SimTK::State& state = j == 0 ? integrator.state() : integrator.AdvanceTo(t, kUnrealized);
     const Eigen::VectorXd y = simulated.CalcOutputs(state);
     for (size_t c = 0; c < sources.size(); ++c) {
       exact.values(j, static_cast<Eigen::Index>(c)) =

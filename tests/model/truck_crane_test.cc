@@ -164,6 +164,30 @@ TEST(TruckCraneTest, BoomAnglesFollowKinematics) {
   EXPECT_NEAR(y2[0], 0.2, 1e-15);
 }
 
+TEST(TruckCraneTest, OutputsEqualSimbodysBoomRotation) {
+  // CalcOutputs uses the closed-form boom axis; Simbody's realized boom body must give the same
+  // angles at large, mixed deflections (all four joints, up to 0.6 rad, slew and luff included).
+  // Both are a few rotations of unit vectors in double precision: agreement to 1e-14 rad.
+  TruckCraneParameters parameters = ReferenceParameters();
+  parameters.slew_rad = 2.5;  // past 90 degrees: atan2's branches and the wrap to (-pi, pi]
+  const TruckCrane crane(parameters);
+  const SimTK::SimbodyMatterSubsystem& matter = crane.system().getMatterSubsystem();
+  const SimTK::MobilizedBody& boom =
+      matter.getMobilizedBody(SimTK::MobilizedBodyIndex(matter.getNumBodies() - 1));
+  const Eigen::Vector4d scale(0.3, 0.6, -0.5, 0.4);  // rad
+  for (int k = 0; k < 7; ++k) {
+    const Eigen::VectorXd q = scale * std::sin(1.0 + k) + Eigen::Vector4d::Constant(0.01 * k);
+    const SimTK::State state = crane.MakeState(q, Eigen::VectorXd::Zero(4));
+    crane.system().realize(state, SimTK::Stage::Position);
+    const SimTK::Vec3 u = boom.getBodyRotation(state).x();
+    const double psi = std::remainder(std::atan2(u[1], u[0]) - parameters.slew_rad, 2 * M_PI);
+    const double phi = std::atan2(u[2], std::hypot(u[0], u[1])) - parameters.boom_elevation_rad;
+    const Eigen::VectorXd y = crane.CalcOutputs(crane.MakeState(q, Eigen::VectorXd::Zero(4)));
+    EXPECT_NEAR(y[0], psi, 1e-14) << k;
+    EXPECT_NEAR(y[1], phi, 1e-14) << k;
+  }
+}
+
 TEST(TruckCraneTest, ParametersRoundTripAndChangeTheModel) {
   TruckCrane crane(ReferenceParameters());
   EXPECT_EQ(crane.parameters().size(), 8u);  // c and d of four joints

@@ -75,7 +75,8 @@ class MechanicalModel {
   using ExternalLoadFunction = std::function<void(double t_s, std::vector<PointLoad>& loads,
                                                   Eigen::VectorXd& generalized_forces)>;
   virtual void SetExternalLoad(ExternalLoadFunction load) = 0;
-  // The outputs y (rad) of a state realized at least to Position.
+  // The outputs y (rad) at the state's q and u. The model realizes whatever it needs, so a
+  // state whose Y was just set will do.
   virtual Eigen::VectorXd CalcOutputs(const SimTK::State& state) const = 0;
   // Total mechanical energy (J): kinetic + gravity + spring potential.
   virtual double CalcEnergy(const SimTK::State& state) const = 0;

@@ -66,7 +66,8 @@ class CvodesIntegrator {
   // How far AdvanceTo() realizes the state it returns. A Simbody realization costs as much as a
   // right-hand side: callers that only read q, u or outputs skip forces and accelerations.
   enum class Realization {
-    kPositions,      // Stage::Position (outputs, kinematics); realize further as needed
+    kNone,           // t and Y set, inputs applied, nothing realized (MechanicalModel outputs)
+    kPositions,      // Stage::Position (kinematics); realize further as needed
     kAccelerations,  // Stage::Acceleration
   };
 
