@@ -118,6 +118,8 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
       }
     }
   });
+  // As in Simulate: the linearization as Newton Jacobian, for the state and the sensitivities.
+  integrator.set_jacobian(internal::CalcLinearizedJacobian(simulated));
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
   integrator.Initialize(simulated.MakeState(result.initial_q, zero));
   const int ny = integrator.state().getNY();

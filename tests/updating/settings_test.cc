@@ -124,8 +124,6 @@ TEST(SettingsTest, ErrorsNameTheFieldAndWhatWasExpected) {
   EXPECT_NE(ErrorOf("updating: {sensitivity: {corrector: simultanous}}", m).find("simultaneous"),
             std::string::npos);
   EXPECT_NE(ErrorOf("updating: {threads: 0}", m).find("threads"), std::string::npos);
-  EXPECT_NE(ErrorOf("updating: {integrator: {method: adams}}", m).find("staggered"),
-            std::string::npos);
   // Errors name the file and the field.
   EXPECT_NE(
       ErrorOf("updating: {algebraic: {starts: 0}}", m).find("scenario.yaml:updating.algebraic"),

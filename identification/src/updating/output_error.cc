@@ -553,15 +553,6 @@ bool UpdateOptions::IsValid(std::string* why) const {
   std::string inner;
   if (!integrator.IsValid(&inner)) return fail("integrator: " + inner);
   if (!sensitivity.IsValid(&inner)) return fail("sensitivity: " + inner);
-  if (jacobian == Jacobian::kSensitivities &&
-      integrator.method == simulation::IntegratorOptions::Method::kAdams &&
-      sensitivity.corrector == simulation::SensitivityOptions::Corrector::kSimultaneous &&
-      sensitivity.difference_quotient ==
-          simulation::SensitivityOptions::DifferenceQuotient::kForward) {
-    return fail(
-        "sensitivity: Adams with the simultaneous corrector and forward quotients fails in "
-        "SUNDIALS 6.4; expected corrector staggered, difference_quotient centered or method bdf");
-  }
   if (!(numeric_step > 0 && numeric_step < 1)) {
     return fail("numeric_step: " + Format(numeric_step) + "; expected a value in (0, 1)");
   }
