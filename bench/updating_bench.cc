@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "mbid/common/yaml_reader.h"
 #include "mbid/identification/updating/output_error.h"
@@ -49,8 +50,12 @@ const Setup& Reference() {
   return setup;
 }
 
+using Method = mbid::simulation::IntegratorOptions::Method;
+
+// `method`: the scenario's (BDF) unless given.
 void RunUpdate(benchmark::State& state, UpdateOptions::Jacobian jacobian,
-               mbid::simulation::SensitivityOptions::DifferenceQuotient quotient) {
+               mbid::simulation::SensitivityOptions::DifferenceQuotient quotient,
+               std::optional<Method> method = std::nullopt) {
   const Setup& setup = Reference();
   UpdateOptions options;
   for (const mbid::model::Parameter& p : setup.model->parameters()) {
@@ -60,6 +65,7 @@ void RunUpdate(benchmark::State& state, UpdateOptions::Jacobian jacobian,
   options.sensitivity.difference_quotient = quotient;
   options.integrator = setup.integrator;
   options.integrator.interpolate_outputs = true;
+  if (method) options.integrator.method = *method;
   options.threads = static_cast<int>(state.range(0));
   options.quiet = true;
   mbid::updating::UpdateResult result;
@@ -95,12 +101,15 @@ mbid::simulation::SensorOptions FitSensors(const Setup& setup) {
   return sensors;
 }
 
+// Argument 0: the scenario's BDF, 1: Adams.
 void BM_AnchorPlainSimulation(benchmark::State& state) {
   const Setup& setup = Reference();
+  mbid::simulation::SimulationOptions options = FitSimulation(setup);
+  if (state.range(0) == 1) options.integrator.method = Method::kAdams;
   mbid::simulation::SimulationResult result;
   for (auto _ : state) {
-    result = mbid::simulation::Simulate(*setup.model, setup.test.excitation, FitSimulation(setup),
-                                        FitSensors(setup));
+    result =
+        mbid::simulation::Simulate(*setup.model, setup.test.excitation, options, FitSensors(setup));
   }
   state.counters["rhs_evaluations"] = static_cast<double>(
       result.statistics.rhs_evaluations + result.statistics.rhs_evaluations_for_jacobian);
@@ -133,12 +142,16 @@ void BM_UpdateSensitivitiesForward(benchmark::State& state) {
   RunUpdate(state, UpdateOptions::Jacobian::kSensitivities,
             mbid::simulation::SensitivityOptions::DifferenceQuotient::kForward);
 }
+void BM_UpdateSensitivitiesForwardAdams(benchmark::State& state) {
+  RunUpdate(state, UpdateOptions::Jacobian::kSensitivities,
+            mbid::simulation::SensitivityOptions::DifferenceQuotient::kForward, Method::kAdams);
+}
 void BM_UpdateNumeric(benchmark::State& state) {
   RunUpdate(state, UpdateOptions::Jacobian::kNumeric,
             mbid::simulation::SensitivityOptions::DifferenceQuotient::kCentered);
 }
 
-BENCHMARK(BM_AnchorPlainSimulation)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_AnchorPlainSimulation)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // 0: centered quotients, 1: forward.
 BENCHMARK(BM_AnchorSensitivityRun)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // One fit takes seconds: one iteration each, wall time (the threads work in parallel).
@@ -151,6 +164,11 @@ BENCHMARK(BM_UpdateSensitivitiesCentered)
 BENCHMARK(BM_UpdateSensitivitiesForward)
     ->Arg(1)
     ->Arg(2)
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kSecond);
+BENCHMARK(BM_UpdateSensitivitiesForwardAdams)
+    ->Arg(1)
     ->Iterations(1)
     ->UseRealTime()
     ->Unit(benchmark::kSecond);
