@@ -56,10 +56,10 @@ void WriteSimulationInfo(H5Writer& file, const simulation::Excitation& excitatio
   file.WriteStringAttribute("/simulation", "excitation", excitation.type_name());
   file.WriteScalar("/simulation", "forcing_end_s", result.forcing_end_s, "s");
   file.WriteScalar("/simulation", "duration_s", options.duration_s, "s");
-  file.WriteStringAttribute("/simulation", "integrator",
-                            options.integrator.method == simulation::IntegratorOptions::Method::kBdf
-                                ? "cvodes_bdf"
-                                : "cvodes_adams");
+  // The method that ran (`auto` resolved).
+  file.WriteStringAttribute(
+      "/simulation", "integrator",
+      std::string("cvodes_") + simulation::MethodName(result.statistics.method));
   file.WriteScalar("/simulation", "relative_tolerance", options.integrator.relative_tolerance, "1");
   file.WriteScalar("/simulation", "absolute_tolerance", options.integrator.absolute_tolerance, "1");
   const nlohmann::json statistics = IntegratorStatisticsToJson(result.statistics);

@@ -311,6 +311,7 @@ class CvodesIntegrator::Impl {
                             &s.error_test_failures, &s.last_order, &current_order, &first_step,
                             &last_step, &current_step, &current_time);
     s.last_step_s = last_step;
+    s.method = method_;
     CVodeGetNonlinSolvStats(cv, &s.nonlinear_iterations, &s.nonlinear_convergence_failures);
     if (linear_solver_) {
       CVodeGetNumJacEvals(cv, &s.jacobian_evaluations);
@@ -342,7 +343,9 @@ class CvodesIntegrator::Impl {
     realtype* y = N_VGetArrayPointer(y_.get());
     for (int i = 0; i < n; ++i) y[i] = y0[i];
 
-    const bool bdf = options_.method == IntegratorOptions::Method::kBdf;
+    method_ = options_.method == IntegratorOptions::Method::kAuto ? ChooseMethod(jacobian_)
+                                                                  : options_.method;
+    const bool bdf = method_ == IntegratorOptions::Method::kBdf;
     cvode_.reset(CVodeCreate(bdf ? CV_BDF : CV_ADAMS, context));
     if (!cvode_) throw NumericalError("CVODES", "CVodeCreate returned NULL");
     void* cv = cvode_.get();
@@ -460,6 +463,7 @@ class CvodesIntegrator::Impl {
 
   const SimTK::System* system_;
   IntegratorOptions options_;
+  IntegratorOptions::Method method_ = IntegratorOptions::Method::kBdf;  // the one running
   TimeDependentInputs hook_;
   Eigen::MatrixXd jacobian_;  // empty: difference quotients
   SimTK::State state_;

@@ -1,5 +1,6 @@
 #include "mbid/simulation/integrator_options.h"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <sstream>
 #include <utility>
@@ -20,8 +21,8 @@ bool IntegratorOptions::IsValid(std::string* why) const {
     if (why != nullptr) *why = std::move(reason);
     return false;
   };
-  if (method != Method::kBdf && method != Method::kAdams) {
-    return fail("method: unknown value; expected kBdf or kAdams");
+  if (method != Method::kBdf && method != Method::kAdams && method != Method::kAuto) {
+    return fail("method: unknown value; expected kBdf, kAdams or kAuto");
   }
   // Below about 100 unit roundoffs CVODES cannot meet the tolerance (CV_TOO_MUCH_ACC); at 1
   // and above there is no accuracy left to control.
@@ -75,7 +76,34 @@ IntegratorStatistics& IntegratorStatistics::operator+=(const IntegratorStatistic
   rhs_evaluations_for_sensitivities += later.rhs_evaluations_for_sensitivities;
   last_step_s = later.last_step_s;
   last_order = later.last_order;
+  method = later.method;
   return *this;
+}
+
+IntegratorOptions::Method ChooseMethod(const Eigen::MatrixXd& jacobian) {
+  if (jacobian.size() == 0 || !jacobian.allFinite()) return IntegratorOptions::Method::kBdf;
+  const Eigen::VectorXcd eigenvalues =
+      Eigen::EigenSolver<Eigen::MatrixXd>(jacobian, false).eigenvalues();
+  double fastest_oscillation = 0.0, fastest = 0.0;
+  for (const std::complex<double>& lambda : eigenvalues) {
+    fastest_oscillation = std::max(fastest_oscillation, std::abs(lambda.imag()));
+    fastest = std::max(fastest, std::abs(lambda));
+  }
+  return fastest_oscillation > 0 && fastest <= kStiffnessRatio * fastest_oscillation
+             ? IntegratorOptions::Method::kAdams
+             : IntegratorOptions::Method::kBdf;
+}
+
+const char* MethodName(IntegratorOptions::Method method) {
+  switch (method) {
+    case IntegratorOptions::Method::kBdf:
+      return "bdf";
+    case IntegratorOptions::Method::kAdams:
+      return "adams";
+    case IntegratorOptions::Method::kAuto:
+      return "auto";
+  }
+  return "unknown";
 }
 
 }  // namespace mbid::simulation

@@ -100,10 +100,11 @@ Excitation ReadExcitation(const YamlReader& node, const model::MechanicalModel& 
 IntegratorOptions ReadIntegratorOptions(const YamlReader& node, IntegratorOptions o) {
   node.ExpectMap({"method", "relative_tolerance", "absolute_tolerance", "max_steps", "max_step_s",
                   "interpolate_outputs"});
-  const bool adams = o.method == IntegratorOptions::Method::kAdams;
-  o.method = node.Choice("method", {"bdf", "adams"}, adams ? "adams" : "bdf") == "adams"
-                 ? IntegratorOptions::Method::kAdams
-                 : IntegratorOptions::Method::kBdf;
+  using Method = IntegratorOptions::Method;
+  const std::string method = node.Choice("method", {"auto", "bdf", "adams"}, MethodName(o.method));
+  for (Method m : {Method::kAuto, Method::kBdf, Method::kAdams}) {
+    if (method == MethodName(m)) o.method = m;
+  }
   o.relative_tolerance = node.PositiveDouble("relative_tolerance", o.relative_tolerance);
   o.absolute_tolerance = node.PositiveDouble("absolute_tolerance", o.absolute_tolerance);
   o.max_steps = node.Int("max_steps", o.max_steps);

@@ -252,6 +252,63 @@ TEST(SimulateTest, TorsionalOscillatorFollowsItsClosedForm) {
   EXPECT_LT(max_error, 1e-10);
 }
 
+// The first-order matrix [0 I; -C -D] of uncoupled unit-inertia joints with the given undamped
+// angular frequencies (rad/s) and damping ratios: eigenvalues -zeta w +- i w sqrt(1 - zeta^2),
+// or two real ones when overdamped.
+Eigen::MatrixXd JointsJacobian(const std::vector<double>& w, const std::vector<double>& zeta) {
+  const int n = static_cast<int>(w.size());
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  jacobian.topRightCorner(n, n).setIdentity();
+  for (int i = 0; i < n; ++i) {
+    jacobian(n + i, i) = -w[i] * w[i];
+    jacobian(n + i, n + i) = -2 * zeta[i] * w[i];
+  }
+  return jacobian;
+}
+
+TEST(SimulateTest, AutoChoosesAdamsUnlessAnEigenvalueOutrunsTheOscillations) {
+  using Method = IntegratorOptions::Method;
+  // Lightly damped modes at 4 and 20 rad/s: the fastest |lambda| is the fastest oscillation.
+  EXPECT_EQ(ChooseMethod(JointsJacobian({4, 20}, {0.02, 0.05})), Method::kAdams);
+  // A third joint overdamped, zeta = 3 at 50 rad/s: a real eigenvalue of
+  // -50 (3 + sqrt(8)) = -291, 14.6x the fastest oscillation (20 rad/s, above the ratio 8): BDF.
+  EXPECT_EQ(ChooseMethod(JointsJacobian({4, 20, 50}, {0.02, 0.05, 3.0})), Method::kBdf);
+  // zeta = 1.1 at 50 rad/s: -50 (1.1 + sqrt(0.21)) = -78, 3.9x: still Adams.
+  EXPECT_EQ(ChooseMethod(JointsJacobian({4, 20, 50}, {0.02, 0.05, 1.1})), Method::kAdams);
+  // No oscillation at all, no Jacobian, or a broken one: BDF, the safe method.
+  EXPECT_EQ(ChooseMethod(JointsJacobian({4}, {2.0})), Method::kBdf);
+  EXPECT_EQ(ChooseMethod(Eigen::MatrixXd()), Method::kBdf);
+  Eigen::MatrixXd broken = JointsJacobian({4}, {0.1});
+  broken(1, 0) = std::nan("");
+  EXPECT_EQ(ChooseMethod(broken), Method::kBdf);
+}
+
+TEST(SimulateTest, AutoRunsAdamsOnTheCraneAndBdfWithAHeavilyDampedJoint) {
+  // The reference crane (stiffness ratio 1.0, docs/performance.md) runs Adams by default; with
+  // alpha's damping x500 (ratio 135) BDF, which Adams would need 3.5x the steps of. An explicit
+  // method is kept, and every run agrees with BDF at the tolerance (rtol 1e-8 on ~1e-3 rad).
+  const model::TruckCrane crane(ReferenceParameters());
+  SimulationOptions options;
+  options.duration_s = 2.0;
+  EXPECT_EQ(options.integrator.method, IntegratorOptions::Method::kAuto);  // the default
+  const Excitation deflection = Deflection(0.004, 0.004, -0.004, -0.006);
+  const SensorOptions sensors = NoiselessSensors(100.0, {"psi", "phi"});
+  const SimulationResult automatic = Simulate(crane, deflection, options, sensors);
+  EXPECT_EQ(automatic.statistics.method, IntegratorOptions::Method::kAdams);
+  SimulationOptions bdf = options;
+  bdf.integrator.method = IntegratorOptions::Method::kBdf;
+  const SimulationResult explicit_bdf = Simulate(crane, deflection, bdf, sensors);
+  EXPECT_EQ(explicit_bdf.statistics.method, IntegratorOptions::Method::kBdf);
+  EXPECT_LT(automatic.statistics.steps, 0.7 * explicit_bdf.statistics.steps);
+  EXPECT_LT((automatic.exact.values - explicit_bdf.exact.values).cwiseAbs().maxCoeff(), 1e-8);
+
+  model::TruckCraneParameters damped = ReferenceParameters();
+  damped.joints[0].damping_Nms_per_rad *= 500;
+  const model::TruckCrane damped_crane(damped);
+  EXPECT_EQ(Simulate(damped_crane, deflection, options, sensors).statistics.method,
+            IntegratorOptions::Method::kBdf);
+}
+
 TEST(SimulateTest, ReadsScenarioSections) {
   const YamlReader root = YamlReader::FromFile(kReference);
   const model::TruckCrane crane(ReferenceParameters());
@@ -261,6 +318,12 @@ TEST(SimulateTest, ReadsScenarioSections) {
   const SimulationOptions options = ReadSimulationOptions(root.Child("simulation"));
   EXPECT_EQ(options.duration_s, 8.0);
   EXPECT_EQ(options.integrator.relative_tolerance, 1e-8);
+  EXPECT_EQ(options.integrator.method, IntegratorOptions::Method::kBdf);  // as the file says
+  const YamlReader automatic =
+      YamlReader::FromString("integrator: {method: auto}\nduration_s: 1\n", "inline.yaml");
+  EXPECT_EQ(ReadSimulationOptions(automatic).integrator.method, IntegratorOptions::Method::kAuto);
+  const YamlReader omitted = YamlReader::FromString("duration_s: 1\n", "inline.yaml");
+  EXPECT_EQ(ReadSimulationOptions(omitted).integrator.method, IntegratorOptions::Method::kAuto);
   const SensorOptions sensors = ReadSensorOptions(root.Child("sensors"), crane);
   EXPECT_EQ(sensors.channels, (std::vector<std::string>{"psi", "phi"}));
   EXPECT_EQ(sensors.noise_std.at("phi"), 1e-5);

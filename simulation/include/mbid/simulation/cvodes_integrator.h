@@ -52,8 +52,9 @@ class CvodesIntegrator {
   // right-hand sides each time CVODES refreshes it). Newton with an approximate Jacobian only
   // converges more slowly; the error test, not the Jacobian, controls the accuracy. With a
   // Jacobian, Adams also iterates with Newton instead of fixed-point iteration, which takes
-  // fewer and longer steps at the same tolerance. Takes effect at the next Initialize(), which
-  // throws std::invalid_argument if the size is not NY x NY.
+  // fewer and longer steps at the same tolerance. Method kAuto chooses between BDF and Adams
+  // from this Jacobian (ChooseMethod; BDF without one). Takes effect at the next Initialize(),
+  // which throws std::invalid_argument if the size is not NY x NY.
   void set_jacobian(Eigen::MatrixXd jacobian);
 
   // Starts (or restarts) the integration from a copy of `initial` at initial.getTime(); the

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 
 namespace mbid::simulation {
@@ -11,9 +12,10 @@ struct IntegratorOptions {
     kBdf,    // Backward differentiation formulas, Newton iteration with a dense Jacobian.
     kAdams,  // Adams-Moulton, for non-stiff models: Newton with a given Jacobian
              // (CvodesIntegrator::set_jacobian; Simulate gives one), else fixed-point iteration.
+    kAuto,   // Adams if the given Jacobian is not stiff (ChooseMethod), else BDF.
   };
 
-  Method method = Method::kBdf;
+  Method method = Method::kAuto;
   // CVODES weights each component's local error by rtol * |y_i| + atol (y in SI units).
   double relative_tolerance = 1e-8;
   double absolute_tolerance = 1e-10;
@@ -30,6 +32,18 @@ struct IntegratorOptions {
   // True if the options can be used; otherwise false with the reason in `why` (if not null).
   bool IsValid(std::string* why) const;
 };
+
+// The method `auto` runs for a model whose Jacobian df/dY (e.g. the linearization) is
+// `jacobian`: Adams unless an eigenvalue is more than kStiffnessRatio times faster (in modulus)
+// than the fastest oscillation, BDF then, and for a Jacobian without oscillation or none at all.
+// Adams takes about half BDF's steps on lightly damped structures at a smaller error, but an
+// eigenvalue far outside its stability region (a heavily damped joint) holds its step down.
+// Measured on the reference crane with one joint's damping raised 2-500x (docs/performance.md):
+// Adams' steps / BDF's grow from 0.5 at ratio 1 to 0.7-0.85 at 5-7, 1.1 at 13, 2-3.5 at 40-135.
+inline constexpr double kStiffnessRatio = 8.0;
+IntegratorOptions::Method ChooseMethod(const Eigen::MatrixXd& jacobian);
+// "bdf", "adams" or "auto".
+const char* MethodName(IntegratorOptions::Method method);
 
 // How CvodesIntegrator integrates forward sensitivities s_i = dY/dp_i (CVODES, with difference
 // quotients of the right-hand side itself; docs/toolchain.md). Checked by IsValid() when the
@@ -73,6 +87,8 @@ struct IntegratorStatistics {
   long rhs_evaluations_for_sensitivities = 0;
   double last_step_s = 0.0;
   int last_order = 0;
+  // The method CVODES ran (`auto` resolved).
+  IntegratorOptions::Method method = IntegratorOptions::Method::kBdf;
 
   // Adds the counters of a later stretch of integration (after a restart); the last step and
   // order become the later stretch's.
