@@ -64,13 +64,15 @@ void WriteSimulationInfo(H5Writer& file, const simulation::Excitation& excitatio
   file.WriteScalar("/simulation", "absolute_tolerance", options.integrator.absolute_tolerance, "1");
   const nlohmann::json statistics = IntegratorStatisticsToJson(result.statistics);
   for (const auto& [name, value] : statistics.items()) {
+    if (!value.is_number()) continue;  // the method: the `integrator` attribute above
     file.WriteScalar("/simulation/statistics", name, value.get<double>(),
                      name == "last_step_s" ? "s" : "1");
   }
 }
 
 nlohmann::json IntegratorStatisticsToJson(const simulation::IntegratorStatistics& s) {
-  return {{"steps", s.steps},
+  return {{"method", simulation::MethodName(s.method)},
+          {"steps", s.steps},
           {"rhs_evaluations", s.rhs_evaluations},
           {"rhs_evaluations_for_jacobian", s.rhs_evaluations_for_jacobian},
           {"jacobian_evaluations", s.jacobian_evaluations},

@@ -90,9 +90,11 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
         simulation::Simulate(model, excitation, scenario.simulation, scenario.sensors);
     test.measured = test.simulation->measured;
     test.exact = test.simulation->exact;
-    progress.Say(fmt::format("simulated the test: {} ({} samples x {} channels, {} CVODES steps)",
-                             excitation.type_name(), test.measured.samples(),
-                             test.measured.channel_count(), test.simulation->statistics.steps));
+    progress.Say(
+        fmt::format("simulated the test: {} ({} samples x {} channels, {} CVODES {} steps)",
+                    excitation.type_name(), test.measured.samples(), test.measured.channel_count(),
+                    test.simulation->statistics.steps,
+                    simulation::MethodName(test.simulation->statistics.method)));
     tests.push_back(std::move(test));
     return tests;
   }

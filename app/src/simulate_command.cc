@@ -50,7 +50,7 @@ int RunSimulateCommand(const std::string& scenario_path, const std::string& outp
   if (!common.quiet && common.json_path != "-") {
     std::cerr << "mbid: wrote " << output_path << " (" << result.measured.samples() << " samples x "
               << result.measured.channel_count() << " channels, " << result.statistics.steps
-              << " CVODES steps)\n";
+              << " CVODES " << simulation::MethodName(result.statistics.method) << " steps)\n";
   }
   return 0;
 }

@@ -175,6 +175,9 @@ TEST_F(CliTest, SimulateWritesTheMeasurementFileH5pyReads) {
   EXPECT_EQ(summary["samples"], 801);  // 8 s at 100 Hz, both ends
   // reference-crane.md: the drop starts from alpha = 5.846515e-04 rad (7 digits).
   EXPECT_NEAR(summary["initial_q"]["alpha"].get<double>(), 5.846515e-04, 1e-10);
+  // The scenario names BDF; the summary says what ran, with its counters.
+  EXPECT_EQ(summary["integrator"]["method"], "bdf");
+  EXPECT_GT(summary["integrator"]["steps"].get<int>(), 0);
   if (!fs::exists("/usr/bin/python3") ||
       std::system("/usr/bin/python3 -c 'import h5py' 2>/dev/null") != 0) {
     GTEST_SKIP() << "h5py not installed";
@@ -191,6 +194,8 @@ TEST_F(CliTest, SimulateWritesTheMeasurementFileH5pyReads) {
       "assert 'load_drop' in f['scenario'].attrs['yaml']\n"
       "assert f['truth/parameters/c_alpha'][()] == 4.9e7\n"
       "assert f['truth/modes/frequency_hz'].shape == (4,)\n"
+      "assert f['simulation'].attrs['integrator'] == 'cvodes_bdf'\n"
+      "assert f['simulation/statistics/steps'][()] > 0\n"
       "print('ok')\n";
   const fs::path script_path = dir_ / "check.py";
   std::ofstream(script_path) << script;
