@@ -347,7 +347,9 @@ LinearModel TruckCrane::Linearize() const {
   linear.M = ToEigen(M);
 
   // Geometric stiffness K_g = -d(gravity force)/dq with springs and dampers off, by central
-  // differences with one Richardson step: error O(h^4) ~ 1e-16 of the gravity torque.
+  // differences with one Richardson step: error O(h^4) ~ 1e-16 of the gravity torque. One
+  // scratch state serves every evaluation here: a Simbody State copy costs about four
+  // right-hand sides.
   SimTK::State gravity_only = s;
   for (int i = 0; i < kDofs; ++i) {
     impl_->springs[i].setStiffness(gravity_only, 0.0);
@@ -381,8 +383,9 @@ LinearModel TruckCrane::Linearize() const {
   const Vec3 u = impl_->boom.getBodyRotation(s).x();
   const double rho2 = u[0] * u[0] + u[1] * u[1];
   const double rho = std::sqrt(rho2);
+  SimTK::State& v = gravity_only;  // velocity kinematics do not depend on forces
+  v.updQ() = 0;
   for (int j = 0; j < kDofs; ++j) {
-    SimTK::State v = s;
     v.updU() = 0;
     v.updU()[j] = 1;
     impl_->system.realize(v, SimTK::Stage::Velocity);
