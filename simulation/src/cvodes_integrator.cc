@@ -103,6 +103,7 @@ class CvodesIntegrator::Impl {
   }
 
   void set_time_dependent_inputs(TimeDependentInputs hook) { hook_ = std::move(hook); }
+  void set_multibody_system(const SimTK::MultibodySystem* system) { multibody_ = system; }
   void set_jacobian(Eigen::MatrixXd jacobian) { jacobian_ = std::move(jacobian); }
 
   void Initialize(const SimTK::State& initial) {
@@ -144,6 +145,8 @@ class CvodesIntegrator::Impl {
     }
     // Positions and velocities do not depend on the inputs: realizing them needs no hook.
     system_->realize(state, SimTK::Stage::Velocity);
+    // Auxiliary states get their derivatives only from the Acceleration stage.
+    forward_dynamics_operator_ = multibody_ != nullptr && state.getNZ() == 0;
     initialized_ = false;
     state_ = std::move(state);
     has_state_ = true;
@@ -419,11 +422,7 @@ class CvodesIntegrator::Impl {
     if (self->rhs_failures_ > kMaxRhsFailuresPerCall) return -1;
     try {
       self->SetTimeAndY(t, N_VGetArrayPointer(y));
-      self->system_->realize(self->state_, SimTK::Stage::Acceleration);
-      const SimTK::Vector& y_dot_state = self->state_.getYDot();
-      realtype* out = N_VGetArrayPointer(y_dot);
-      const int n = y_dot_state.size();
-      for (int i = 0; i < n; ++i) out[i] = y_dot_state[i];
+      self->CalcDerivative(N_VGetArrayPointer(y_dot));
       return 0;
     } catch (const std::exception& e) {
       self->RecordRhsError(t, e.what());
@@ -432,6 +431,25 @@ class CvodesIntegrator::Impl {
     }
     // Recoverable (CVODES retries with a smaller step) until the failure persists.
     return self->rhs_failures_ > kMaxRhsFailuresPerCall ? -1 : 1;
+  }
+
+  // Y' of the working state (t and Y set, inputs applied) into `out` (NY values).
+  void CalcDerivative(realtype* out) {
+    if (!forward_dynamics_operator_) {
+      system_->realize(state_, SimTK::Stage::Acceleration);
+      const SimTK::Vector& y_dot = state_.getYDot();
+      for (int i = 0; i < y_dot.size(); ++i) out[i] = y_dot[i];
+      return;
+    }
+    system_->realize(state_, SimTK::Stage::Dynamics);
+    multibody_->getMatterSubsystem().calcAccelerationIgnoringConstraints(
+        state_, multibody_->getMobilityForces(state_, SimTK::Stage::Dynamics),
+        multibody_->getRigidBodyForces(state_, SimTK::Stage::Dynamics), u_dot_,
+        body_accelerations_);
+    const SimTK::Vector& q_dot = state_.getQDot();
+    const int nq = q_dot.size();
+    for (int i = 0; i < nq; ++i) out[i] = q_dot[i];
+    for (int i = 0; i < u_dot_.size(); ++i) out[nq + i] = u_dot_[i];
   }
 
   // The given constant Jacobian (dense, column-major).
@@ -462,6 +480,12 @@ class CvodesIntegrator::Impl {
   }
 
   const SimTK::System* system_;
+  // The same system when it is a MultibodySystem (the forward-dynamics operator's right-hand
+  // side, used when the state has no z), else null.
+  const SimTK::MultibodySystem* multibody_ = nullptr;
+  bool forward_dynamics_operator_ = false;
+  SimTK::Vector u_dot_;                                   // scratch of CalcDerivative
+  SimTK::Vector_<SimTK::SpatialVec> body_accelerations_;  // scratch of CalcDerivative
   IntegratorOptions options_;
   IntegratorOptions::Method method_ = IntegratorOptions::Method::kBdf;  // the one running
   TimeDependentInputs hook_;
@@ -493,6 +517,11 @@ class CvodesIntegrator::Impl {
 
 CvodesIntegrator::CvodesIntegrator(const SimTK::System& system, const IntegratorOptions& options)
     : impl_(std::make_unique<Impl>(system, options)) {}
+CvodesIntegrator::CvodesIntegrator(const SimTK::MultibodySystem& system,
+                                   const IntegratorOptions& options)
+    : impl_(std::make_unique<Impl>(system, options)) {
+  impl_->set_multibody_system(&system);
+}
 CvodesIntegrator::~CvodesIntegrator() = default;
 CvodesIntegrator::CvodesIntegrator(CvodesIntegrator&&) noexcept = default;
 CvodesIntegrator& CvodesIntegrator::operator=(CvodesIntegrator&&) noexcept = default;
