@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <optional>
 
 #include "external_load_force.h"
@@ -168,6 +169,20 @@ struct TruckCrane::Impl {
   MechanicalModel::ExternalLoadFunction external_load;
   SimTK::State default_state;
   Eigen::Vector4d unloaded_gravity_force;
+
+  // M, the geometric stiffness K_g and H at q = 0 depend on the inertial data and the
+  // configuration, not on c and d: computed once (Linearize serves every simulation, sensitivity
+  // run and mode table; they cost about 30 right-hand sides), thread-safe for const use.
+  struct RestMatrices {
+    Eigen::MatrixXd M, K_g, H;
+  };
+  const RestMatrices& rest_matrices() const {
+    std::call_once(rest_once, [this] { rest = CalcRestMatrices(); });
+    return rest;
+  }
+  RestMatrices CalcRestMatrices() const;
+  mutable std::once_flag rest_once;
+  mutable RestMatrices rest;
 };
 
 TruckCrane::TruckCrane(const TruckCraneParameters& parameters)
@@ -335,29 +350,26 @@ Eigen::VectorXd TruckCrane::SolveStaticEquilibrium(const std::vector<PointLoad>&
                                                  std::to_string(f.norm()) + " N*m");
 }
 
-LinearModel TruckCrane::Linearize() const {
-  LinearModel linear;
-  linear.coordinates = kCoordinates;
-  linear.outputs = kOutputs;
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(kDofs);
-  SimTK::State s = MakeState(zero, zero);
-  impl_->system.realize(s, SimTK::Stage::Position);
-  SimTK::Matrix M;
-  impl_->matter.calcM(s, M);
-  linear.M = ToEigen(M);
-
-  // Geometric stiffness K_g = -d(gravity force)/dq with springs and dampers off, by central
-  // differences with one Richardson step: error O(h^4) ~ 1e-16 of the gravity torque. One
-  // scratch state serves every evaluation here: a Simbody State copy costs about four
-  // right-hand sides.
-  SimTK::State gravity_only = s;
+TruckCrane::Impl::RestMatrices TruckCrane::Impl::CalcRestMatrices() const {
+  RestMatrices result;
+  // One scratch state at q = 0 with springs and dampers off serves every evaluation (a Simbody
+  // State copy costs about four right-hand sides); M and H do not depend on the forces.
+  SimTK::State s = default_state;
   for (int i = 0; i < kDofs; ++i) {
-    impl_->springs[i].setStiffness(gravity_only, 0.0);
-    impl_->dampers[i].setDamping(gravity_only, 0.0);
+    springs[i].setStiffness(s, 0.0);
+    dampers[i].setDamping(s, 0.0);
   }
-  auto gravity_force = [&](const Eigen::VectorXd& q) {
-    return impl_->CalcStaticForceAt(gravity_only, q, {});
-  };
+  s.updQ() = 0;
+  s.updU() = 0;
+  system.realize(s, SimTK::Stage::Position);
+  SimTK::Matrix M;
+  matter.calcM(s, M);
+  result.M = ToEigen(M);
+  const Vec3 u = boom.getBodyRotation(s).x();  // the boom axis at rest, for H below
+
+  // Geometric stiffness K_g = -d(gravity force)/dq by central differences with one Richardson
+  // step: error O(h^4) ~ 1e-16 of the gravity torque.
+  auto gravity_force = [&](const Eigen::VectorXd& q) { return CalcStaticForceAt(s, q, {}); };
   auto central = [&](int j, double h) {
     Eigen::VectorXd dq = Eigen::VectorXd::Zero(kDofs);
     dq[j] = h;
@@ -368,30 +380,38 @@ LinearModel TruckCrane::Linearize() const {
   for (int j = 0; j < kDofs; ++j) {
     K_g.col(j) = -(4 * central(j, h / 2) - central(j, h)) / 3;
   }
-  K_g = (0.5 * (K_g + K_g.transpose())).eval();  // a Hessian: symmetric up to roundoff
-  linear.C = K_g;
+  result.K_g = 0.5 * (K_g + K_g.transpose());  // a Hessian: symmetric up to roundoff
+
+  // H exactly: a unit speed of coordinate j turns the boom axis u at w_GK, du = w x u, and
+  // psi = atan2(u_y, u_x), phi = atan2(u_z, |u_xy|) differentiate in closed form.
+  result.H.resize(2, kDofs);
+  const double rho2 = u[0] * u[0] + u[1] * u[1];
+  const double rho = std::sqrt(rho2);
+  s.updQ() = 0;
+  for (int j = 0; j < kDofs; ++j) {
+    s.updU() = 0;
+    s.updU()[j] = 1;
+    system.realize(s, SimTK::Stage::Velocity);
+    const Vec3 du = boom.getBodyAngularVelocity(s) % u;
+    result.H(0, j) = (u[0] * du[1] - u[1] * du[0]) / rho2;
+    result.H(1, j) = (rho2 * du[2] - u[2] * (u[0] * du[0] + u[1] * du[1])) / rho;
+  }
+  return result;
+}
+
+LinearModel TruckCrane::Linearize() const {
+  const Impl::RestMatrices& rest = impl_->rest_matrices();
+  LinearModel linear;
+  linear.coordinates = kCoordinates;
+  linear.outputs = kOutputs;
+  linear.M = rest.M;
+  linear.H = rest.H;
+  linear.C = rest.K_g;
   linear.D = Eigen::MatrixXd::Zero(kDofs, kDofs);
   for (int i = 0; i < kDofs; ++i) {
     linear.C(i, i) += impl_->parameters.joints[i].stiffness_Nm_per_rad;
     // Dampers are the only velocity-dependent forces; gyroscopic terms are quadratic in u.
     linear.D(i, i) = impl_->parameters.joints[i].damping_Nms_per_rad;
-  }
-
-  // H exactly: a unit speed of coordinate j turns the boom axis u at w_GK, du = w x u, and
-  // psi = atan2(u_y, u_x), phi = atan2(u_z, |u_xy|) differentiate in closed form.
-  linear.H.resize(2, kDofs);
-  const Vec3 u = impl_->boom.getBodyRotation(s).x();
-  const double rho2 = u[0] * u[0] + u[1] * u[1];
-  const double rho = std::sqrt(rho2);
-  SimTK::State& v = gravity_only;  // velocity kinematics do not depend on forces
-  v.updQ() = 0;
-  for (int j = 0; j < kDofs; ++j) {
-    v.updU() = 0;
-    v.updU()[j] = 1;
-    impl_->system.realize(v, SimTK::Stage::Velocity);
-    const Vec3 du = impl_->boom.getBodyAngularVelocity(v) % u;
-    linear.H(0, j) = (u[0] * du[1] - u[1] * du[0]) / rho2;
-    linear.H(1, j) = (rho2 * du[2] - u[2] * (u[0] * du[0] + u[1] * du[1])) / rho;
   }
   return linear;
 }

@@ -188,6 +188,27 @@ TEST(TruckCraneTest, OutputsEqualSimbodysBoomRotation) {
   }
 }
 
+TEST(TruckCraneTest, LinearizationFollowsParameterChangesExactly) {
+  // M, K_g and H are computed once per model; C and D must still follow SetParameter. After a
+  // change the linearization equals that of a crane built with the new values, bit for bit.
+  TruckCrane crane(ReferenceParameters());
+  const LinearModel before = crane.Linearize();
+  crane.SetParameter("c_theta", 7.0e6);
+  crane.SetParameter("d_alpha", 3.0e5);
+  TruckCraneParameters changed = ReferenceParameters();
+  changed.joints[3].stiffness_Nm_per_rad = 7.0e6;
+  changed.joints[0].damping_Nms_per_rad = 3.0e5;
+  const LinearModel after = crane.Linearize();
+  const LinearModel fresh = TruckCrane(changed).Linearize();
+  EXPECT_EQ(after.M, fresh.M);
+  EXPECT_EQ(after.C, fresh.C);
+  EXPECT_EQ(after.D, fresh.D);
+  EXPECT_EQ(after.H, fresh.H);
+  // The spring alone changed; roundoff of sums near 1e7 is 2e-9.
+  EXPECT_NEAR(after.C(3, 3) - before.C(3, 3), 7.0e6 - 9.4e6, 1e-6);
+  EXPECT_EQ(after.D(0, 0), 3.0e5);
+}
+
 TEST(TruckCraneTest, ParametersRoundTripAndChangeTheModel) {
   TruckCrane crane(ReferenceParameters());
   EXPECT_EQ(crane.parameters().size(), 8u);  // c and d of four joints
