@@ -313,10 +313,11 @@ Eigen::VectorXd TruckCrane::CalcStaticGeneralizedForce(const Eigen::VectorXd& q,
 }
 
 Eigen::VectorXd TruckCrane::SolveStaticEquilibrium(const std::vector<PointLoad>& loads) const {
-  // Newton's chord method on f(q) = 0: the tangent stiffness -df/dq by central differences at
-  // the start, kept while the steps shrink fast (the loads are small against the springs, so
-  // the tangent hardly changes) and refreshed when they do not. The root's accuracy depends only
-  // on f, so the iteration reaches machine precision. One scratch state serves every evaluation.
+  // Newton's chord method on f(q) = 0: the tangent df/dq starts as the unloaded crane's -C at
+  // rest (springs plus the cached geometric stiffness: no evaluations), kept while the steps
+  // shrink fast (the loads are small against the springs, so the tangent hardly changes) and
+  // refreshed by central differences when they do not. The root's accuracy depends only on f,
+  // so the iteration reaches machine precision. One scratch state serves every evaluation.
   SimTK::State s = MakeState(Eigen::VectorXd::Zero(kDofs), Eigen::VectorXd::Zero(kDofs));
   auto force = [&](const Eigen::VectorXd& q) { return impl_->CalcStaticForceAt(s, q, loads); };
   auto tangent = [&](const Eigen::VectorXd& q) {
@@ -331,7 +332,11 @@ Eigen::VectorXd TruckCrane::SolveStaticEquilibrium(const std::vector<PointLoad>&
   };
   Eigen::VectorXd q = Eigen::VectorXd::Zero(kDofs);
   Eigen::VectorXd f = force(q);
-  Eigen::PartialPivLU<Eigen::Matrix4d> lu = tangent(q);
+  Eigen::Matrix4d rest_tangent = -impl_->rest_matrices().K_g;
+  for (int i = 0; i < kDofs; ++i) {
+    rest_tangent(i, i) -= impl_->parameters.joints[i].stiffness_Nm_per_rad;
+  }
+  Eigen::PartialPivLU<Eigen::Matrix4d> lu(rest_tangent);
   double last_step = std::numeric_limits<double>::infinity();
   for (int iteration = 0; iteration < 50; ++iteration) {
     const Eigen::VectorXd step = lu.solve(-f);
