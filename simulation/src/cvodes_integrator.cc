@@ -106,9 +106,9 @@ class CvodesIntegrator::Impl {
   void set_multibody_system(const SimTK::MultibodySystem* system) { multibody_ = system; }
   void set_jacobian(Eigen::MatrixXd jacobian) { jacobian_ = std::move(jacobian); }
 
-  void Initialize(const SimTK::State& initial) {
-    // Copy first: `initial` may be our own working state.
-    SimTK::State state = initial;
+  // Takes the state by value: a caller's copy (`initial` may be our own working state) or a
+  // moved-in one, which saves a State copy (about four right-hand sides).
+  void Initialize(SimTK::State state) {
     try {
       system_->realize(state, SimTK::Stage::Instance);
     } catch (const std::exception& e) {
@@ -532,7 +532,10 @@ void CvodesIntegrator::set_time_dependent_inputs(TimeDependentInputs hook) {
 void CvodesIntegrator::set_jacobian(Eigen::MatrixXd jacobian) {
   impl_->set_jacobian(std::move(jacobian));
 }
-void CvodesIntegrator::Initialize(const SimTK::State& initial) { impl_->Initialize(initial); }
+void CvodesIntegrator::Initialize(const SimTK::State& initial) {
+  impl_->Initialize(SimTK::State(initial));
+}
+void CvodesIntegrator::Initialize(SimTK::State&& initial) { impl_->Initialize(std::move(initial)); }
 const SimTK::State& CvodesIntegrator::AdvanceTo(double t, Realization realization) {
   return impl_->AdvanceTo(t, realization);
 }

@@ -1,6 +1,7 @@
 #include "mbid/simulation/simulate.h"
 
 #include <cmath>
+#include <utility>
 
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
@@ -41,7 +42,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   IntegratorOptions forced_options = options.integrator;
   forced_options.interpolate_outputs = false;
   CvodesIntegrator integrator(simulated.system(), forced ? forced_options : options.integrator);
-  const SimTK::State initial =
+  SimTK::State initial =
       simulated.MakeState(result.initial_q, Eigen::VectorXd::Zero(model.coordinate_count()));
   // The linearization's Jacobian costs a few dozen realizations once, against NY right-hand
   // sides per difference-quotient Jacobian (22 of them in the crane's load drop), and lets Adams
@@ -51,7 +52,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
     jacobian = internal::CalcLinearizedJacobian(simulated);
   }
   integrator.set_jacobian(jacobian);
-  integrator.Initialize(initial);
+  integrator.Initialize(std::move(initial));
 
   Measurement exact;
   exact.channels = sensors.channels;
@@ -67,11 +68,11 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
     if (!forcing_done && t >= result.forcing_end_s) {
       // Stop exactly where the forcing switches off (a kink in the load) and restart the
       // multistep history there.
-      const SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s, kUnrealized);
+      SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s, kUnrealized);
       before_restart = integrator.statistics();
       integrator = CvodesIntegrator(simulated.system(), options.integrator);
       integrator.set_jacobian(jacobian);
-      integrator.Initialize(at_end);
+      integrator.Initialize(std::move(at_end));
       forcing_done = true;
     }
     const SimTK::State& state = j == 0 ? integrator.state() : integrator.AdvanceTo(t, kUnrealized);

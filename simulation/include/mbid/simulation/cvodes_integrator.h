@@ -70,6 +70,8 @@ class CvodesIntegrator {
   // belongs to a system with constraints or quaternions, and NumericalError if CVODES cannot
   // be set up.
   void Initialize(const SimTK::State& initial);
+  // The same, taking over `initial` instead of copying it.
+  void Initialize(SimTK::State&& initial);
 
   // How far AdvanceTo() realizes the state it returns. A Simbody realization costs as much as a
   // right-hand side: callers that only read q, u or outputs skip forces and accelerations.
