@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
@@ -119,9 +120,10 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
     }
   });
   // As in Simulate: the linearization as Newton Jacobian, for the state and the sensitivities.
-  integrator.set_jacobian(internal::CalcLinearizedJacobian(simulated));
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
-  integrator.Initialize(simulated.MakeState(result.initial_q, zero));
+  SimTK::State initial = simulated.MakeState(result.initial_q, zero);
+  integrator.set_jacobian(internal::CalcNewtonJacobian(simulated, initial));
+  integrator.Initialize(std::move(initial));
   const int ny = integrator.state().getNY();
   Eigen::MatrixXd initial_sensitivity = Eigen::MatrixXd::Zero(ny, count);
   initial_sensitivity.topRows(n) = result.initial_q_sensitivity;  // Y = [q | u | z], u(0) = 0

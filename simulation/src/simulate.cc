@@ -44,13 +44,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   CvodesIntegrator integrator(simulated.system(), forced ? forced_options : options.integrator);
   SimTK::State initial =
       simulated.MakeState(result.initial_q, Eigen::VectorXd::Zero(model.coordinate_count()));
-  // The linearization's Jacobian costs a few dozen realizations once, against NY right-hand
-  // sides per difference-quotient Jacobian (22 of them in the crane's load drop), and lets Adams
-  // use Newton. Y = [q | u] for every MechanicalModel; anything else keeps difference quotients.
-  Eigen::MatrixXd jacobian;
-  if (initial.getNY() == 2 * model.coordinate_count()) {
-    jacobian = internal::CalcLinearizedJacobian(simulated);
-  }
+  const Eigen::MatrixXd jacobian = internal::CalcNewtonJacobian(simulated, initial);
   integrator.set_jacobian(jacobian);
   integrator.Initialize(std::move(initial));
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "mbid/common/error.h"
+#include "mbid/model/simbody.h"
 
 namespace mbid::simulation::internal {
 
@@ -51,7 +52,9 @@ std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalM
   return forced;
 }
 
-Eigen::MatrixXd CalcLinearizedJacobian(const model::MechanicalModel& model) {
+Eigen::MatrixXd CalcNewtonJacobian(const model::MechanicalModel& model,
+                                   const SimTK::State& initial) {
+  if (initial.getNY() != 2 * model.coordinate_count()) return Eigen::MatrixXd();
   const model::LinearModel linear = model.Linearize();
   const Eigen::Index n = linear.M.rows();
   const Eigen::LDLT<Eigen::MatrixXd> mass(linear.M);  // symmetric positive definite

@@ -29,7 +29,11 @@ std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalM
 
 // The Newton iteration's Jacobian d[q' u']/d[q u] from the linearization M q'' + D q' + C q = 0:
 // [0 I; -M^-1 C  -M^-1 D] (2n x 2n), computed once per simulation. Near the equilibrium it is
-// the exact Jacobian; elsewhere an approximation that Newton tolerates.
-Eigen::MatrixXd CalcLinearizedJacobian(const model::MechanicalModel& model);
+// the exact Jacobian; elsewhere an approximation that Newton tolerates. It costs less than one
+// difference-quotient Jacobian (NY right-hand sides; 22 of them in the crane's load drop), lets
+// Adams use Newton and lets method `auto` choose. Empty (CVODES' difference quotients) unless
+// the state `initial` of `model` has Y = [q | u], as every MechanicalModel's has.
+Eigen::MatrixXd CalcNewtonJacobian(const model::MechanicalModel& model,
+                                   const SimTK::State& initial);
 
 }  // namespace mbid::simulation::internal
