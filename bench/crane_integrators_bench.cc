@@ -10,6 +10,7 @@
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/model/simbody.h"
+#include "mbid/model/truck_crane.h"
 #include "mbid/simulation/simulate.h"
 
 namespace {

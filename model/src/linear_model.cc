@@ -21,6 +21,10 @@ std::vector<Mode> CalcModes(const LinearModel& linear) {
       linear.D.rows() != n || linear.D.cols() != n || linear.H.cols() != n) {
     throw std::invalid_argument("CalcModes: M, D, C must be n x n and H m x n");
   }
+  if (!linear.output_orders.empty() &&
+      static_cast<Eigen::Index>(linear.output_orders.size()) != linear.H.rows()) {
+    throw std::invalid_argument("CalcModes: one output order per row of H");
+  }
   // First-order form x' = A x, x = [q; q'] (the exact poles of eq. 1 with r = 0).
   const Eigen::PartialPivLU<Eigen::MatrixXd> M_lu(linear.M);
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
@@ -42,6 +46,10 @@ std::vector<Mode> CalcModes(const LinearModel& linear) {
     mode.shape.cwiseAbs().maxCoeff(&largest);
     mode.shape /= mode.shape[largest];
     mode.output_shape = linear.H * mode.shape;
+    // A rate output sees the shape differentiated: q' = lambda q, q'' = lambda^2 q.
+    for (size_t i = 0; i < linear.output_orders.size(); ++i) {
+      mode.output_shape[static_cast<Eigen::Index>(i)] *= std::pow(lambda, linear.output_orders[i]);
+    }
     (lambda.imag() > 0 ? oscillatory : real).push_back(mode);
   }
   std::sort(oscillatory.begin(), oscillatory.end(),

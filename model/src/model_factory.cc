@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "mbid/common/error.h"
+#include "mbid/model/multibody_model.h"
+#include "mbid/model/truck_crane_description.h"
 
 namespace mbid::model {
 namespace {
@@ -108,11 +110,22 @@ TorsionalOscillatorParameters ReadTorsionalOscillatorParameters(const YamlReader
 
 std::unique_ptr<MechanicalModel> MakeModel(const YamlReader& model) {
   const std::string type =
-      model.Choice("type", {"truck_crane", "torsional_oscillator"}, "truck_crane");
+      model.Choice("type", {"truck_crane", "multibody", "torsional_oscillator"}, "truck_crane");
   if (type == "torsional_oscillator") {
     return std::make_unique<TorsionalOscillator>(ReadTorsionalOscillatorParameters(model));
   }
-  return std::make_unique<TruckCrane>(ReadTruckCraneParameters(model));
+  try {
+    if (type == "multibody") return std::make_unique<MultibodyModel>(ReadMachineDescription(model));
+    // The shorthand: the crane's keys expand to its description.
+    return std::make_unique<MultibodyModel>(DescribeTruckCrane(ReadTruckCraneParameters(model)),
+                                            "truck_crane");
+  } catch (const InputError& error) {
+    if (error.source() != "machine description") throw;
+    // A check of the built model (e.g. a free coordinate that gravity drives): anchor it here.
+    throw InputError(model.source(),
+                     model.field().empty() ? error.field() : model.field() + "." + error.field(),
+                     error.problem(), error.expected());
+  }
 }
 
 }  // namespace mbid::model

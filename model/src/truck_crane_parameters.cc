@@ -1,8 +1,9 @@
+#include "mbid/model/truck_crane_parameters.h"
+
 #include <cmath>
 #include <string>
 
 #include "mbid/common/error.h"
-#include "mbid/model/truck_crane.h"
 
 namespace mbid::model {
 namespace {

@@ -11,6 +11,7 @@
 #include "mbid/model/model_factory.h"
 #include "mbid/model/simbody.h"
 #include "mbid/model/torsional_oscillator.h"
+#include "mbid/model/truck_crane.h"
 #include "mbid/simulation/cvodes_integrator.h"
 #include "mbid/simulation/scenario_sections.h"
 

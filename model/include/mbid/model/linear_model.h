@@ -18,6 +18,9 @@ struct LinearModel {
   Eigen::MatrixXd D;                     // n x n, N*m*s/rad
   Eigen::MatrixXd C;                     // n x n, N*m/rad
   Eigen::MatrixXd H;                     // m x n, rad/rad
+  // Per output, the derivative of q that H maps: 0 (y = H q), 1 (y = H q'), 2 (y = H q'').
+  // Empty means all 0.
+  std::vector<int> output_orders;
 };
 
 // One complex pole of the first-order system and its shape. For an underdamped pair only the
@@ -25,7 +28,7 @@ struct LinearModel {
 struct Mode {
   std::complex<double> lambda;    // 1/s; decaying modes have Re(lambda) < 0
   Eigen::VectorXcd shape;         // per coordinate, unit largest magnitude
-  Eigen::VectorXcd output_shape;  // H * shape
+  Eigen::VectorXcd output_shape;  // H * shape, times lambda^order for rate outputs
 
   double frequency_hz() const;           // Im(lambda) / (2 pi), damped
   double decay_rate_per_s() const;       // -Re(lambda)

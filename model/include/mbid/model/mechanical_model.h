@@ -44,6 +44,15 @@ class MechanicalModel {
   virtual const std::vector<std::string>& output_names() const = 0;
   // Output units, one per output.
   virtual const std::vector<std::string>& output_units() const = 0;
+  // Per output, how often q is differentiated in it: 0 for positions and angles (y = H q in the
+  // linearization), 1 for velocities (y = H q'), 2 for accelerations (y = H q'').
+  virtual std::vector<int> output_derivative_orders() const {
+    return std::vector<int>(output_names().size(), 0);
+  }
+  // Per coordinate, its unit: "rad" or "m".
+  virtual std::vector<std::string> coordinate_units() const {
+    return std::vector<std::string>(coordinate_names().size(), "rad");
+  }
   int coordinate_count() const { return static_cast<int>(coordinate_names().size()); }
   int output_count() const { return static_cast<int>(output_names().size()); }
   // Names of points that accept external loads.

@@ -5,7 +5,7 @@
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/mechanical_model.h"
 #include "mbid/model/torsional_oscillator.h"
-#include "mbid/model/truck_crane.h"
+#include "mbid/model/truck_crane_parameters.h"
 
 namespace mbid::model {
 
@@ -15,7 +15,9 @@ TruckCraneParameters ReadTruckCraneParameters(const YamlReader& model);
 // The `model:` section of a torsional oscillator: inertia_kgm2, joints.angle.{stiffness, damping}.
 TorsionalOscillatorParameters ReadTorsionalOscillatorParameters(const YamlReader& model);
 
-// The model named by `model.type`; an unknown type is an InputError listing the known ones.
+// The model named by `model.type`: `multibody` (docs/machine-description.md), `truck_crane`
+// (a shorthand that expands to the crane's description) or `torsional_oscillator`; an unknown
+// type is an InputError listing the known ones.
 std::unique_ptr<MechanicalModel> MakeModel(const YamlReader& model);
 
 }  // namespace mbid::model

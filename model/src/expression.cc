@@ -1,0 +1,51 @@
+#include "mbid/model/expression.h"
+
+#include <muParser.h>
+
+#include <cctype>
+#include <cmath>
+#include <stdexcept>
+
+namespace mbid::model {
+
+void ExpressionContext::Define(const std::string& name, double value) {
+  const bool valid =
+      !name.empty() && std::isalpha(static_cast<unsigned char>(name[0])) &&
+      name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
+          std::string::npos;
+  if (!valid) {
+    throw std::invalid_argument("'" + name +
+                                "' is not a parameter name (letters, digits, '_', starting with "
+                                "a letter)");
+  }
+  if (name == "pi") throw std::invalid_argument("'pi' is reserved for the constant");
+  values_[name] = value;
+}
+
+double ExpressionContext::Evaluate(const std::string& text) const {
+  mu::Parser parser;
+  // muparser names its constant _pi; the contract says pi. Variables are bound to copies the
+  // parser reads at Eval().
+  parser.DefineConst("pi", M_PI);
+  std::map<std::string, double> copies = values_;
+  for (auto& [name, value] : copies) parser.DefineVar(name, &value);
+  double value = 0.0;
+  try {
+    parser.SetExpr(text);
+    value = parser.Eval();
+  } catch (const mu::Parser::exception_type& error) {
+    const std::string token = error.GetToken();
+    const mu::EErrorCodes code = error.GetCode();
+    if ((code == mu::ecUNASSIGNABLE_TOKEN || code == mu::ecUNEXPECTED_VAR) && !token.empty() &&
+        std::isalpha(static_cast<unsigned char>(token[0]))) {
+      throw std::invalid_argument("unknown parameter '" + token + "' in '" + text + "'");
+    }
+    throw std::invalid_argument("'" + text + "' does not parse: " + error.GetMsg());
+  }
+  if (!std::isfinite(value)) {
+    throw std::invalid_argument("'" + text + "' is not finite (" + std::to_string(value) + ")");
+  }
+  return value;
+}
+
+}  // namespace mbid::model

@@ -1,0 +1,456 @@
+// The description-built model against closed forms (pendulum, slider, two-link arm), Simbody's
+// own kinematics, energy conservation, finite differences of its outputs, and the hand-written
+// truck crane.
+#include "mbid/model/multibody_model.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+
+#include "mbid/common/error.h"
+#include "mbid/common/yaml_reader.h"
+#include "mbid/model/model_factory.h"
+#include "mbid/model/simbody.h"
+#include "mbid/model/truck_crane.h"
+#include "mbid/model/truck_crane_description.h"
+
+namespace mbid::model {
+namespace {
+
+const std::string kSource = std::string(MBID_SOURCE_DIR);
+
+std::unique_ptr<MechanicalModel> FromYaml(const std::string& text) {
+  return MakeModel(YamlReader(YAML::Load(text), "machine.yaml", "model"));
+}
+
+// A pendulum of mass m on a massless rod of length L under a revolute joint about y with a
+// torsional spring c. Hanging down (com at -L z), gravity adds m g L of stiffness.
+TEST(MultibodyModelTest, PendulumMatchesClosedForm) {
+  const double m = 2.0, L = 1.5, c = 300.0, g = 9.81, I = 0.01;  // I about the CoM, tiny
+  const auto pendulum = FromYaml(R"(
+type: multibody
+parameters: {m: 2.0, L: 1.5}
+bodies:
+  bob: {parent: ground, joint: {type: revolute, coordinates: [q], axis: [0, 1, 0]},
+        mass_kg: m, com_m: [0, 0, "-L"], inertia_kgm2: [0.01, 0.01, 0.01]}
+springs:
+  q: {stiffness_Nm_per_rad: 300.0, damping_Nms_per_rad: 0}
+outputs:
+  angle: {type: coordinate, coordinate: q}
+)");
+  const LinearModel linear = pendulum->Linearize();
+  EXPECT_NEAR(linear.M(0, 0), m * L * L + I, 1e-12);
+  // Richardson-extrapolated geometric stiffness: O(h^4) ~ 1e-12 relative.
+  EXPECT_NEAR(linear.C(0, 0), c + m * g * L, 1e-8);
+  const std::vector<Mode> modes = CalcModes(linear);
+  ASSERT_EQ(modes.size(), 1u);
+  EXPECT_NEAR(modes[0].frequency_hz(), std::sqrt((c + m * g * L) / (m * L * L + I)) / (2 * M_PI),
+              1e-10);
+  // Hanging straight down, gravity has no torque: the spring carries nothing.
+  EXPECT_NEAR(static_cast<const MultibodyModel&>(*pendulum).neutral_positions()[0], 0.0, 1e-15);
+}
+
+// A horizontal arm (com at +L x): gravity's torque m g L at q = 0 is carried by the spring's
+// preload, q_n = -m g L / c about +y (a weight pulls the tip down: a positive turn about y
+// lifts it), and the geometric stiffness vanishes (d/dq of m g L cos q at 0).
+TEST(MultibodyModelTest, HorizontalArmPreloadAndStiffness) {
+  const double m = 50.0, L = 2.0, c = 4.0e4, g = 9.81;
+  const auto arm = FromYaml(R"(
+type: multibody
+bodies:
+  arm: {parent: ground, joint: {type: revolute, coordinates: [q], axis: [0, 1, 0]},
+        mass_kg: 50.0, com_m: [2.0, 0, 0], inertia_kgm2: [1, 1, 1]}
+springs:
+  q: {stiffness_Nm_per_rad: 4.0e4, damping_Nms_per_rad: 10}
+points:
+  tip: {body: arm, at_m: [4.0, 0, 0]}
+payload_point: tip
+outputs:
+  tip_z: {type: displacement, point: tip, direction: [0, 0, 1]}
+)");
+  const auto& model = static_cast<const MultibodyModel&>(*arm);
+  // The weight -m g z at +L x has the torque +m g L about y.
+  EXPECT_NEAR(model.neutral_positions()[0], -m * g * L / c, 1e-14);
+  const LinearModel linear = arm->Linearize();
+  EXPECT_NEAR(linear.C(0, 0), c, 1e-6);
+  EXPECT_NEAR(linear.M(0, 0), m * L * L + 1.0, 1e-10);
+  EXPECT_NEAR(linear.D(0, 0), 10.0, 0);
+  // The tip rises by -4 m * q (a turn about +y moves +x down): H = -4 m/rad.
+  EXPECT_NEAR(linear.H(0, 0), -4.0, 1e-14);
+  EXPECT_TRUE(model.CalcStaticGeneralizedForce(Eigen::VectorXd::Zero(1), {}).isZero(1e-9));
+  // A payload of 100 kg at 4 m turns the arm down (+q about y): Newton solves the exact balance
+  // -c q + m g L (cos q - 1) + 100 g 4 cos q = 0 (spring with its preload, arm, payload).
+  const Eigen::VectorXd q = arm->SolveStaticEquilibrium(arm->CalcPayloadLoads(100.0));
+  EXPECT_NEAR(-c * q[0] + m * g * L * (std::cos(q[0]) - 1) + 100 * g * 4 * std::cos(q[0]), 0.0,
+              1e-8);
+  // First order: q ~ 0.1 rad, so the cosines leave O(q^2) ~ 1% out.
+  EXPECT_NEAR(q[0], 100 * g * 4 / c, 2e-2 * 100 * g * 4 / c);
+}
+
+// An azimuth needs a direction off the vertical at q = 0.
+TEST(MultibodyModelTest, VerticalAzimuthDirectionIsRefused) {
+  try {
+    FromYaml(R"(
+type: multibody
+bodies:
+  arm: {parent: ground, joint: {type: revolute, coordinates: [q], axis: [0, 1, 0]},
+        mass_kg: 50.0, com_m: [2.0, 0, 0], inertia_kgm2: [1, 1, 1]}
+springs:
+  q: {stiffness_Nm_per_rad: 4.0e4}
+outputs:
+  heading: {type: azimuth, body: arm, direction: [0, 0, 1]}
+)");
+    FAIL() << "accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.field(), "model.outputs.heading.direction") << error.what();
+    EXPECT_NE(std::string(error.what()).find("vertical"), std::string::npos) << error.what();
+  }
+}
+
+// A mass on a vertical slider: omega^2 = c / m exactly; the spring's neutral position
+// carries the weight, q_n = m g / c.
+TEST(MultibodyModelTest, VerticalSliderMatchesClosedForm) {
+  const auto slider = FromYaml(R"(
+type: multibody
+bodies:
+  carriage: {parent: ground, joint: {type: prismatic, coordinates: [z], axis: [0, 0, 2]},
+             mass_kg: 120.0, inertia_kgm2: [1, 1, 1]}
+springs:
+  z: {stiffness_N_per_m: 2.0e6, damping_Ns_per_m: 1.0e3}
+outputs:
+  z: {type: coordinate, coordinate: z}
+  v: {type: velocity, point: centre, direction: [0, 0, 1]}
+points:
+  centre: {body: carriage, at_m: [0, 0, 0]}
+)");
+  const auto& model = static_cast<const MultibodyModel&>(*slider);
+  EXPECT_NEAR(model.neutral_positions()[0], 120.0 * 9.81 / 2.0e6, 1e-15);
+  const LinearModel linear = slider->Linearize();
+  EXPECT_NEAR(linear.C(0, 0), 2.0e6, 1e-6);  // no geometric stiffness on a straight slide
+  const std::vector<Mode> modes = CalcModes(linear);
+  const double wn = std::sqrt(2.0e6 / 120.0), zeta = 1.0e3 / (2 * std::sqrt(2.0e6 * 120.0));
+  EXPECT_NEAR(modes[0].frequency_hz(), wn * std::sqrt(1 - zeta * zeta) / (2 * M_PI), 1e-9);
+  EXPECT_EQ(slider->output_units(), (std::vector<std::string>{"m", "m/s"}));
+  EXPECT_EQ(slider->coordinate_units(), (std::vector<std::string>{"m"}));
+  EXPECT_EQ(slider->parameters()[0].units, "N/m");
+  EXPECT_EQ(slider->parameters()[1].units, "N*s/m");
+  // The velocity output sees lambda times the shape.
+  EXPECT_NEAR(std::abs(modes[0].output_shape[1] - modes[0].lambda * modes[0].output_shape[0]), 0,
+              1e-12 * std::abs(modes[0].lambda));
+}
+
+// A planar two-link arm (both pins about y, gravity off): at q = 0 the textbook mass matrix
+// M11 = I1 + I2 + m1 a1^2 + m2 (l1^2 + a2^2 + 2 l1 a2), M12 = I2 + m2 (a2^2 + l1 a2),
+// M22 = I2 + m2 a2^2 with a_i the CoM distances and I_i the moments about y at the CoMs.
+TEST(MultibodyModelTest, TwoLinkMassMatrixMatchesClosedForm) {
+  const auto arm = FromYaml(R"(
+type: multibody
+gravity_mps2: 0
+bodies:
+  upper: {parent: ground, joint: {type: revolute, coordinates: [q1], axis: [0, 1, 0]},
+          mass_kg: 30, com_m: [0.8, 0, 0], inertia_kgm2: [0.5, 6.0, 6.2]}
+  lower: {parent: upper, joint: {type: revolute, coordinates: [q2], axis: [0, 1, 0], in_parent_m: [2.0, 0, 0]},
+          mass_kg: 12, com_m: [0.7, 0, 0], inertia_kgm2: [0.2, 2.0, 2.1]}
+springs:
+  q1: {stiffness_Nm_per_rad: 1.0e5}
+  q2: {stiffness_Nm_per_rad: 2.0e4}
+outputs:
+  q2: {type: coordinate, coordinate: q2}
+)");
+  const LinearModel linear = arm->Linearize();
+  const double m1 = 30, m2 = 12, a1 = 0.8, a2 = 0.7, l1 = 2.0, I1 = 6.0, I2 = 2.0;
+  Eigen::Matrix2d M;
+  M << I1 + I2 + m1 * a1 * a1 + m2 * (l1 * l1 + a2 * a2 + 2 * l1 * a2),
+      I2 + m2 * (a2 * a2 + l1 * a2), I2 + m2 * (a2 * a2 + l1 * a2), I2 + m2 * a2 * a2;
+  EXPECT_LT((linear.M - M).norm(), 1e-12 * M.norm());
+  EXPECT_LT((linear.C - Eigen::Vector2d(1.0e5, 2.0e4).asDiagonal().toDenseMatrix()).norm(), 1e-9);
+}
+
+// A machine with every joint type and frame option: the description's kinematics (used for
+// position outputs) equals Simbody's realized body poses.
+const char* kEveryJoint = R"(
+type: multibody
+parameters: {tilt_deg: 12.0}
+bodies:
+  carriage: {parent: ground, joint: {type: prismatic, coordinates: [x], axis: [1, 0.2, 0], in_parent_m: [0.5, 0.1, 1.0],
+             in_parent_rotation_deg: [{z: 20}, {x: 5}]}, mass_kg: 400, com_m: [0.1, 0, 0.2], inertia_kgm2: [40, 50, 60, 1, -2, 0.5]}
+  mast: {parent: carriage, joint: {type: universal, coordinates: [a, b], axes: [[0, 0, 1], [0, 1, 0]], in_parent_m: [0.3, 0, 0.5],
+         in_parent_rotation_deg: [{y: "tilt_deg"}], in_body_m: [0, 0, -0.1], in_body_rotation_deg: [{x: 10}]},
+         mass_kg: 150, com_m: [0, 0, 2.0], inertia_kgm2: [200, 205, 8]}
+  head: {parent: mast, joint: {type: weld, in_parent_m: [0, 0, 4.0], in_parent_rotation_deg: [{z: 90}]},
+         mass_kg: 30, com_m: [0.2, 0, 0], inertia_kgm2: [1, 2, 2.5]}
+  jib: {parent: head, joint: {type: revolute, coordinates: [c], axis: [0, -1, 0], in_parent_m: [0.4, 0, 0]},
+        mass_kg: 60, com_m: [1.5, 0, 0], inertia_kgm2: [0.5, 45, 45]}
+springs:
+  x: {stiffness_N_per_m: 5.0e5, damping_Ns_per_m: 2.0e3}
+  a: {stiffness_Nm_per_rad: 8.0e5, damping_Nms_per_rad: 1.0e3}
+  b: {stiffness_Nm_per_rad: 9.0e5, damping_Nms_per_rad: 1.5e3}
+  c: {stiffness_Nm_per_rad: 3.0e5, damping_Nms_per_rad: 800}
+points:
+  tip: {body: jib, at_m: [3.0, 0, 0.1]}
+payload_point: tip
+outputs:
+  heading: {type: azimuth, body: jib, direction: [1, 0, 0]}
+  pitch: {type: elevation, body: jib, direction: [1, 0, 0]}
+  tip_x: {type: displacement, point: tip, direction: [1, 0, 0]}
+  tip_n: {type: displacement, point: tip, direction: [0, 0, 1], frame: body}
+  tip_v: {type: velocity, point: tip, direction: [0, 1, 1], frame: body}
+  tip_a: {type: acceleration, point: tip, direction: [0, 0, 1]}
+  jib_rate: {type: angular_velocity, body: jib, axis: [0, 1, 0], frame: body}
+  c: {type: coordinate, coordinate: c}
+)";
+
+TEST(MultibodyModelTest, KinematicsMatchSimbody) {
+  const auto machine = FromYaml(kEveryJoint);
+  const auto& model = static_cast<const MultibodyModel&>(*machine);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> uniform(-0.7, 0.7);  // large, not small, turns
+  const SimTK::SimbodyMatterSubsystem& matter = machine->system().getMatterSubsystem();
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::VectorXd q(4);
+    for (int i = 0; i < 4; ++i) q[i] = uniform(random);
+    SimTK::State s = machine->MakeState(q, Eigen::VectorXd::Zero(4));
+    machine->system().realize(s, SimTK::Stage::Position);
+    const char* names[] = {"carriage", "mast", "head", "jib"};
+    for (int b = 0; b < 4; ++b) {
+      Eigen::Matrix3d R;
+      Eigen::Vector3d p;
+      model.CalcBodyPose(q, names[b], &R, &p);
+      const SimTK::Transform& X =
+          matter.getMobilizedBody(SimTK::MobilizedBodyIndex(b + 1)).getBodyTransform(s);
+      for (int r = 0; r < 3; ++r) {
+        EXPECT_NEAR(p[r], X.p()[r], 1e-13) << names[b];
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(R(r, c), X.R().asMat33()(r, c), 1e-14) << names[b];
+      }
+    }
+  }
+  // Outputs are deviations: zero at q = 0, u = 0 with the machine at rest (accelerations too:
+  // the preload balances gravity).
+  const SimTK::State rest = machine->MakeState(Eigen::VectorXd::Zero(4), Eigen::VectorXd::Zero(4));
+  EXPECT_LT(machine->CalcOutputs(rest).norm(), 1e-9);
+}
+
+// H against central differences of the nonlinear outputs: position outputs by q, velocity
+// outputs by u at rest, accelerations by the accelerations of a unit generalized force.
+TEST(MultibodyModelTest, OutputMatrixMatchesDifferences) {
+  const auto machine = FromYaml(kEveryJoint);
+  const LinearModel linear = machine->Linearize();
+  ASSERT_EQ(linear.output_orders, (std::vector<int>{0, 0, 0, 0, 1, 2, 1, 0}));
+  const double h = 1e-6;  // outputs smooth on the scale of 1 rad / 1 m: error ~1e-12 + 1e-10
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(4);
+  for (int j = 0; j < 4; ++j) {
+    Eigen::VectorXd e = zero;
+    e[j] = h;
+    const Eigen::VectorXd dq = (machine->CalcOutputs(machine->MakeState(e, zero)) -
+                                machine->CalcOutputs(machine->MakeState(-e, zero))) /
+                               (2 * h);
+    const Eigen::VectorXd du = machine->CalcOutputs(machine->MakeState(zero, e)) / h;
+    for (int i = 0; i < 8; ++i) {
+      if (linear.output_orders[i] == 0) EXPECT_NEAR(linear.H(i, j), dq[i], 1e-8) << i << "," << j;
+      if (linear.output_orders[i] == 1) EXPECT_NEAR(linear.H(i, j), du[i], 1e-8) << i << "," << j;
+    }
+  }
+  // Accelerations: at rest with q = 0 a generalized force f gives q'' = M^-1 f, y = H q''.
+  auto forced = machine->Clone();
+  const Eigen::Vector4d f(100.0, -50.0, 80.0, 30.0);
+  forced->SetExternalLoad(
+      [&](double, std::vector<PointLoad>&, Eigen::VectorXd& generalized) { generalized = f; });
+  const Eigen::VectorXd y = forced->CalcOutputs(forced->MakeState(zero, zero));
+  const Eigen::VectorXd qdd = linear.M.lu().solve(Eigen::VectorXd(f));
+  EXPECT_NEAR(y[5], linear.H.row(5).dot(qdd), 1e-10 * std::max(1.0, std::abs(y[5])));
+}
+
+// Simbody's stepTo returns early at the start of an interval; step until `t` is reached.
+void AdvanceTo(SimTK::Integrator& integrator, double t) {
+  while (integrator.getTime() < t) integrator.stepTo(t);
+}
+
+// Energy of the undamped machine is conserved along a large-amplitude motion (Simbody's
+// integrator at tight tolerance), and the velocity and acceleration outputs are the time
+// derivatives of the displacement along it.
+TEST(MultibodyModelTest, EnergyConservedAndRatesAreDerivatives) {
+  auto machine = FromYaml(kEveryJoint);
+  for (const char* name : {"d_x", "d_a", "d_b", "d_c"}) machine->SetParameter(name, 0.0);
+  Eigen::VectorXd q0(4), u0(4);
+  q0 << 0.02, 0.05, -0.04, 0.08;
+  u0 << 0.1, -0.2, 0.3, 0.1;
+  SimTK::State s = machine->MakeState(q0, u0);
+  const double e0 = machine->CalcEnergy(s);
+  SimTK::RungeKuttaMersonIntegrator integrator(machine->system());
+  integrator.setAccuracy(1e-12);
+  integrator.initialize(s);
+  // Five displacement samples 0.2 ms apart around t = 0.2 s: fourth-order stencils leave
+  // (omega h)^4 ~ 2e-7 of the fastest mode (~100 rad/s).
+  const double h = 2e-4;
+  Eigen::VectorXd y[5];
+  for (int k = 0; k < 5; ++k) {
+    AdvanceTo(integrator, 0.2 + (k - 2) * h);
+    y[k] = machine->CalcOutputs(integrator.getState());
+    EXPECT_NEAR(machine->CalcEnergy(integrator.getState()), e0, 1e-8 * std::abs(e0) + 1e-6);
+  }
+  // The same machine with tip_v and tip_a along ground x, the direction of tip_x: their values
+  // at the middle sample are tip_x's first and second time derivatives.
+  std::string text = kEveryJoint;
+  for (const auto& [from, to] :
+       {std::pair<std::string, std::string>{"direction: [0, 1, 1], frame: body}",
+                                            "direction: [1, 0, 0]}"},
+        std::pair<std::string, std::string>{"point: tip, direction: [0, 0, 1]}\n  jib_rate",
+                                            "point: tip, direction: [1, 0, 0]}\n  jib_rate"}}) {
+    text.replace(text.find(from), from.size(), to);
+  }
+  auto rates = FromYaml(text);
+  for (const char* name : {"d_x", "d_a", "d_b", "d_c"}) rates->SetParameter(name, 0.0);
+  integrator.initialize(s);
+  AdvanceTo(integrator, 0.2);
+  SimTK::State at_middle = rates->MakeState(Eigen::VectorXd::Zero(4), Eigen::VectorXd::Zero(4));
+  at_middle.setTime(0.2);
+  at_middle.updQ() = integrator.getState().getQ();
+  at_middle.updU() = integrator.getState().getU();
+  const Eigen::VectorXd r = rates->CalcOutputs(at_middle);
+  const double velocity = (y[0][2] - 8 * y[1][2] + 8 * y[3][2] - y[4][2]) / (12 * h);
+  // Roundoff of the second difference: 1e-12 of ~0.3 m times 64 over 12 h^2 ~ 1e-4 m/s^2.
+  const double acceleration =
+      (-y[0][2] + 16 * y[1][2] - 30 * y[2][2] + 16 * y[3][2] - y[4][2]) / (12 * h * h);
+  EXPECT_NEAR(r[4], velocity, 1e-5 * std::abs(velocity));
+  EXPECT_NEAR(r[5], acceleration, 1e-5 * std::abs(acceleration));
+}
+
+// The crane's description gives today's hand-written crane's matrices, modes and outputs.
+TEST(MultibodyModelTest, CraneDescriptionMatchesHandWrittenCrane) {
+  const TruckCraneParameters parameters = ReadTruckCraneParameters(
+      YamlReader::FromFile(kSource + "/scenarios/reference-crane.yaml").Child("model"));
+  const TruckCrane crane(parameters);
+  const MultibodyModel described(DescribeTruckCrane(parameters), "truck_crane");
+  const LinearModel a = crane.Linearize(), b = described.Linearize();
+  EXPECT_LT((a.M - b.M).norm(), 1e-12 * a.M.norm());
+  EXPECT_LT((a.C - b.C).norm(), 1e-12 * a.C.norm());
+  EXPECT_LT((a.D - b.D).norm(), 1e-15 * a.D.norm());
+  EXPECT_LT((a.H - b.H).norm(), 1e-14);
+  const std::vector<Mode> ma = CalcModes(a), mb = CalcModes(b);
+  ASSERT_EQ(ma.size(), mb.size());
+  for (size_t k = 0; k < ma.size(); ++k) {
+    EXPECT_LT(std::abs(ma[k].lambda - mb[k].lambda), 1e-12 * std::abs(ma[k].lambda));
+    EXPECT_LT((ma[k].output_shape - mb[k].output_shape).norm(), 1e-10);
+  }
+  EXPECT_LT((crane.neutral_angles() - described.neutral_positions()).norm(), 1e-15);
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> uniform(-0.5, 0.5);
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::VectorXd q(4);
+    for (int i = 0; i < 4; ++i) q[i] = uniform(random);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(4);
+    EXPECT_LT((crane.CalcOutputs(crane.MakeState(q, zero)) -
+               described.CalcOutputs(described.MakeState(q, zero)))
+                  .norm(),
+              1e-14);
+    EXPECT_NEAR(crane.CalcEnergy(crane.MakeState(q, q)),
+                described.CalcEnergy(described.MakeState(q, q)),
+                1e-9 * std::abs(crane.CalcEnergy(crane.MakeState(q, q))));
+  }
+  const Eigen::VectorXd qa = crane.SolveStaticEquilibrium(crane.CalcPayloadLoads(650.0));
+  const Eigen::VectorXd qb = described.SolveStaticEquilibrium(described.CalcPayloadLoads(650.0));
+  EXPECT_LT((qa - qb).norm(), 1e-14);
+}
+
+// The crane written out in the contract's keys (scenarios/reference-crane-description.yaml)
+// equals the `type: truck_crane` shorthand.
+TEST(MultibodyModelTest, CraneDescriptionFileEqualsShorthand) {
+  const auto shorthand =
+      MakeModel(YamlReader::FromFile(kSource + "/scenarios/reference-crane.yaml").Child("model"));
+  const auto described = MakeModel(
+      YamlReader::FromFile(kSource + "/scenarios/reference-crane-description.yaml").Child("model"));
+  EXPECT_EQ(shorthand->type(), "truck_crane");
+  EXPECT_EQ(described->type(), "multibody");
+  const LinearModel a = shorthand->Linearize(), b = described->Linearize();
+  // Degrees to radians and back through the expression library: roundoff only.
+  EXPECT_LT((a.M - b.M).norm(), 1e-12 * a.M.norm());
+  EXPECT_LT((a.C - b.C).norm(), 1e-12 * a.C.norm());
+  EXPECT_LT((a.H - b.H).norm(), 1e-13);
+  EXPECT_EQ(a.outputs, b.outputs);
+  EXPECT_EQ(shorthand->parameters().size(), described->parameters().size());
+}
+
+struct BadCase {
+  const char* name;
+  const char* replace;  // text of kEveryJoint to replace
+  const char* with;
+  const char* field;  // expected key path in the message
+  const char* words;  // expected words in the message
+};
+
+class BadDescriptionTest : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadDescriptionTest, IsAnInputErrorNamingTheKeyPath) {
+  const BadCase& bad = GetParam();
+  std::string text = kEveryJoint;
+  const size_t at = text.find(bad.replace);
+  ASSERT_NE(at, std::string::npos) << bad.replace;
+  text.replace(at, std::string(bad.replace).size(), bad.with);
+  try {
+    FromYaml(text);
+    FAIL() << "accepted: " << bad.name;
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(error.source(), "machine.yaml") << message;
+    EXPECT_NE(message.find(bad.field), std::string::npos) << message;
+    EXPECT_NE(message.find(bad.words), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Contract, BadDescriptionTest,
+    ::testing::Values(
+        BadCase{"unknown key", "mass_kg: 60", "mas_kg: 60", "model.bodies.jib", "mas_kg"},
+        BadCase{"parent not above", "parent: carriage", "parent: jib", "model.bodies.mast.parent",
+                "not defined above"},
+        BadCase{"coordinate twice", "coordinates: [c]", "coordinates: [a]",
+                "model.bodies.jib.joint.coordinates", "twice"},
+        BadCase{"spring on unknown coordinate", "  c: {stiffness_Nm_per_rad: 3.0e5",
+                "  d: {stiffness_Nm_per_rad: 3.0e5", "model.springs.d", "unknown coordinate"},
+        BadCase{"output unknown body", "body: jib, direction: [1, 0, 0]}\n  pitch",
+                "body: boom, direction: [1, 0, 0]}\n  pitch", "model.outputs.heading.body",
+                "unknown body"},
+        BadCase{"output unknown point", "tip_x: {type: displacement, point: tip",
+                "tip_x: {type: displacement, point: top", "model.outputs.tip_x.point",
+                "unknown point"},
+        BadCase{"output unknown coordinate", "coordinate: c}", "coordinate: e}",
+                "model.outputs.c.coordinate", "unknown coordinate"},
+        BadCase{"zero axis", "axis: [0, -1, 0]", "axis: [0, 0, 0]", "model.bodies.jib.joint.axis",
+                "zero axis"},
+        BadCase{"massless leaf", "mass_kg: 60,", "mass_kg: 0,", "model.bodies.jib", "massless"},
+        BadCase{"negative mass", "mass_kg: 30,", "mass_kg: -30,", "model.bodies.head.mass_kg",
+                "mass"},
+        BadCase{"inertia not positive definite", "[1, 2, 2.5]", "[1, -2, 2.5]",
+                "model.bodies.head.inertia_kgm2", "positive"},
+        BadCase{"triangle inequality", "[1, 2, 2.5]", "[1, 2, 4]", "model.bodies.head.inertia_kgm2",
+                "triangle"},
+        BadCase{"expression does not parse", "\"tilt_deg\"", "\"tilt_deg *\"",
+                "model.bodies.mast.joint.in_parent_rotation_deg", "tilt_deg *"},
+        BadCase{"unknown parameter", "\"tilt_deg\"", "\"tilt_degs / 2\"",
+                "model.bodies.mast.joint.in_parent_rotation_deg", "unknown parameter 'tilt_degs'"},
+        BadCase{"inertia size", "[1, 2, 2.5]", "[1, 2]", "model.bodies.head.inertia_kgm2",
+                "2 entries"},
+        BadCase{"universal axes not perpendicular", "axes: [[0, 0, 1], [0, 1, 0]]",
+                "axes: [[0, 0, 1], [0, 1, 1]]", "model.bodies.mast.joint.axes", "perpendicular"},
+        BadCase{"free coordinate under gravity",
+                "  c: {stiffness_Nm_per_rad: 3.0e5, damping_Nms_per_rad: 800}\n", "",
+                "model.springs", "gravity"},
+        BadCase{"unknown joint type", "type: weld", "type: ball", "model.bodies.head.joint.type",
+                "ball"},
+        BadCase{"payload point unknown", "payload_point: tip", "payload_point: hook",
+                "model.payload_point", "unknown point"},
+        BadCase{"unknown output type", "type: angular_velocity", "type: angular_rate",
+                "model.outputs.jib_rate.type", "angular_rate"}),
+    [](const ::testing::TestParamInfo<BadCase>& info) {
+      std::string name = info.param.name;
+      for (char& c : name) {
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+      }
+      return name;
+    });
+
+}  // namespace
+}  // namespace mbid::model
