@@ -57,6 +57,66 @@ std::map<std::string, double> ReadChannelValues(const YamlReader& sensors, const
   return values;
 }
 
+namespace {
+
+// Sensor keys say their unit: `<base>_rad`, `_m`, `_mps`, `_mps2`, `_radps` for channels in rad,
+// m, m/s, m/s^2 and rad/s. A number applies to every channel of that unit; a map names channels.
+struct UnitSuffix {
+  const char* suffix;
+  const char* units;
+};
+constexpr UnitSuffix kUnitSuffixes[] = {
+    {"rad", "rad"}, {"m", "m"}, {"mps", "m/s"}, {"mps2", "m/s^2"}, {"radps", "rad/s"}};
+
+std::vector<std::string> SensorKeys(const std::string& base) {
+  std::vector<std::string> keys;
+  for (const UnitSuffix& unit : kUnitSuffixes) keys.push_back(base + "_" + unit.suffix);
+  return keys;
+}
+
+std::map<std::string, double> ReadSensorValues(const YamlReader& sensors, const std::string& base,
+                                               const std::vector<std::string>& channels,
+                                               const std::map<std::string, std::string>& units,
+                                               bool non_negative) {
+  std::map<std::string, double> values;
+  for (const UnitSuffix& unit : kUnitSuffixes) {
+    const std::string key = base + "_" + unit.suffix;
+    if (!sensors.Has(key)) continue;
+    std::vector<std::string> matching;
+    for (const std::string& channel : channels) {
+      if (units.at(channel) == unit.units) matching.push_back(channel);
+    }
+    const YamlReader node = sensors.Child(key);
+    if (node.IsMap()) {
+      for (const std::string& channel : node.Keys()) {
+        const auto found = units.find(channel);
+        if (found != units.end() && found->second != unit.units) {
+          node.FailAt(channel,
+                      "channel '" + channel + "' is in " + found->second + ", not " + unit.units,
+                      "the key of the channel's unit");
+        }
+      }
+      node.ExpectMap(matching);
+      for (const std::string& channel : node.Keys()) values[channel] = node.Double(channel);
+    } else {
+      if (matching.empty()) {
+        sensors.FailAt(key, "no channel is in " + std::string(unit.units),
+                       "a key whose unit some channel has");
+      }
+      const double value = sensors.Double(key);
+      for (const std::string& channel : matching) values[channel] = value;
+    }
+    for (const auto& [channel, value] : values) {
+      if (non_negative && value < 0) {
+        sensors.FailAt(key, "negative value for " + channel, "a value >= 0 in the channel's unit");
+      }
+    }
+  }
+  return values;
+}
+
+}  // namespace
+
 Excitation ReadExcitation(const YamlReader& node, const model::MechanicalModel& model) {
   Excitation excitation;
   const std::string type =
@@ -66,15 +126,27 @@ Excitation ReadExcitation(const YamlReader& node, const model::MechanicalModel& 
     excitation.type = Excitation::Type::kLoadDrop;
     excitation.payload_mass_kg = node.PositiveDouble("payload_mass_kg");
   } else if (type == "initial_deflection") {
-    node.ExpectMap({"type", "deflection_rad"});
+    node.ExpectMap({"type", "deflection_rad", "deflection_m"});
     excitation.type = Excitation::Type::kInitialDeflection;
-    const YamlReader deflection = node.Child("deflection_rad");
-    deflection.ExpectMap(model.coordinate_names());
-    for (const std::string& coordinate : deflection.Keys()) {
-      excitation.deflection_rad[coordinate] = deflection.Double(coordinate);
+    // Angles of rotational coordinates under deflection_rad, slides of prismatic ones under
+    // deflection_m; both are kept in SI in one map.
+    const std::vector<std::string> units = model.coordinate_units();
+    for (const auto& [key, unit] : {std::pair<const char*, const char*>{"deflection_rad", "rad"},
+                                    std::pair<const char*, const char*>{"deflection_m", "m"}}) {
+      if (!node.Has(key)) continue;
+      std::vector<std::string> coordinates;
+      for (size_t i = 0; i < units.size(); ++i) {
+        if (units[i] == unit) coordinates.push_back(model.coordinate_names()[i]);
+      }
+      const YamlReader deflection = node.Child(key);
+      deflection.ExpectMap(coordinates);
+      for (const std::string& coordinate : deflection.Keys()) {
+        excitation.deflection_rad[coordinate] = deflection.Double(coordinate);
+      }
     }
     if (excitation.deflection_rad.empty()) {
-      node.FailAt("deflection_rad", "no coordinate given", "at least one coordinate's angle");
+      node.FailAt("deflection_rad", "no coordinate given",
+                  "at least one coordinate's deflection (deflection_rad or deflection_m)");
     }
   } else if (type == "impulse") {
     node.ExpectMap({"type", "point", "force_N", "coordinate", "torque_Nm", "duration_s", "shape"});
@@ -127,8 +199,11 @@ SimulationOptions ReadSimulationOptions(const YamlReader& node) {
 
 SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalModel& model) {
   SensorOptions options;
-  node.ExpectMap(
-      {"sample_rate_hz", "channels", "noise_std_rad", "bias_rad", "quantization_step_rad", "seed"});
+  std::vector<std::string> keys{"sample_rate_hz", "channels", "seed"};
+  for (const char* base : {"noise_std", "bias", "quantization_step"}) {
+    for (const std::string& key : SensorKeys(base)) keys.push_back(key);
+  }
+  node.ExpectMap(keys);
   options.sample_rate_hz = node.PositiveDouble("sample_rate_hz", options.sample_rate_hz);
   if (node.Has("channels")) options.channels = node.StringList("channels");
   if (options.channels.empty()) node.FailAt("channels", "no channel", "at least one channel");
@@ -145,11 +220,21 @@ SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalM
       node.FailAt("channels", "channel '" + channel + "' listed twice", "unique channel names");
     }
   }
-  // Every channel of the crane is an angle, so the sensor keys carry rad.
-  options.noise_std = ReadChannelValues(node, "noise_std_rad", options.channels, true);
-  options.bias = ReadChannelValues(node, "bias_rad", options.channels, false);
+  std::map<std::string, std::string> units;
+  for (int i = 0; i < model.output_count(); ++i) {
+    units[model.output_names()[static_cast<size_t>(i)]] =
+        model.output_units()[static_cast<size_t>(i)];
+  }
+  const std::vector<std::string> coordinate_units = model.coordinate_units();
+  for (int i = 0; i < model.coordinate_count(); ++i) {
+    // An output of the same name wins, as in the channel lookup.
+    units.emplace(model.coordinate_names()[static_cast<size_t>(i)],
+                  coordinate_units[static_cast<size_t>(i)]);
+  }
+  options.noise_std = ReadSensorValues(node, "noise_std", options.channels, units, true);
+  options.bias = ReadSensorValues(node, "bias", options.channels, units, false);
   options.quantization_step =
-      ReadChannelValues(node, "quantization_step_rad", options.channels, true);
+      ReadSensorValues(node, "quantization_step", options.channels, units, true);
   const int seed = node.Int("seed", 1);
   if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
   options.seed = static_cast<std::uint64_t>(seed);

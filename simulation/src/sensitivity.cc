@@ -21,8 +21,9 @@ using internal::ResolveChannels;
 // Relative step of the central differences of the initial coordinates: the static equilibrium
 // is solved to roundoff and is smooth in the parameters, so the O(h^2) error is ~1e-8.
 constexpr double kInitialStateStep = 1e-4;
-// Step (rad) of dy/dq: outputs are angles smooth on the scale of 1 rad, so the truncation error
-// h^2 ~ 1e-12 and the roundoff 1e-16 / h ~ 1e-10 stay far below the sensitivities' tolerance.
+// Step (rad or m, rad/s or m/s) of dy/dq and dy/du: outputs are smooth on the scale of 1 rad or
+// 1 m, so the truncation error h^2 ~ 1e-12 and the roundoff 1e-16 / h ~ 1e-10 stay far below
+// the sensitivities' tolerance.
 constexpr double kOutputStep_rad = 1e-6;
 
 // dq(0)/dp for each model parameter, by central differences on a clone.
@@ -138,9 +139,19 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   exact.values.resize(samples, channel_count);
   result.output_sensitivities.assign(count, Eigen::MatrixXd(samples, channel_count));
 
-  // Outputs depend on q alone: a scratch state of the same system serves for dy/dq.
+  // Position outputs depend on q alone; rate outputs (velocities, accelerations) also on u and
+  // the time, and accelerations on the parameters through the forces. A scratch state of the
+  // same system, carrying the nominal parameters, serves for the output Jacobians.
+  const std::vector<int> orders = simulated.output_derivative_orders();
+  int highest_order = 0;
+  for (const ChannelSource& source : sources) {
+    if (source.is_output)
+      highest_order = std::max(highest_order, orders[static_cast<size_t>(source.index)]);
+  }
+  const int jacobian_columns = highest_order > 0 ? 2 * n : n;
   SimTK::State scratch = simulated.MakeState(result.initial_q, zero);
-  Eigen::MatrixXd dy_dq(simulated.output_count(), n);
+  Eigen::MatrixXd dy_dY(simulated.output_count(), jacobian_columns);
+  Eigen::MatrixXd dy_dp = Eigen::MatrixXd::Zero(simulated.output_count(), model_count);
   bool forcing_done = !(forcing_end_s > 0);
   for (int j = 0; j < samples; ++j) {
     const double t = j * tau;
@@ -159,16 +170,35 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
     const Eigen::VectorXd y = simulated.CalcOutputs(state);
     Eigen::VectorXd q(n);
     for (int i = 0; i < n; ++i) q[i] = state.getQ()[i];
-    for (int i = 0; i < n; ++i) {
+    scratch.setTime(state.getTime());
+    for (int i = 0; i < jacobian_columns; ++i) {
       for (int sign : {1, -1}) {
-        for (int r = 0; r < n; ++r) scratch.updQ()[r] = q[r];
-        scratch.updQ()[i] += sign * kOutputStep_rad;
+        scratch.updQ() = state.getQ();
+        if (highest_order > 0) scratch.updU() = state.getU();
+        if (i < n) {
+          scratch.updQ()[i] += sign * kOutputStep_rad;
+        } else {
+          scratch.updU()[i - n] += sign * kOutputStep_rad;
+        }
         const Eigen::VectorXd y_step = simulated.CalcOutputs(scratch);
         if (sign > 0) {
-          dy_dq.col(i) = y_step;
+          dy_dY.col(i) = y_step;
         } else {
-          dy_dq.col(i) = (dy_dq.col(i) - y_step) / (2 * kOutputStep_rad);
+          dy_dY.col(i) = (dy_dY.col(i) - y_step) / (2 * kOutputStep_rad);
         }
+      }
+    }
+    if (highest_order == 2) {
+      // Forces are affine in stiffness and damping: central differences are exact to roundoff.
+      scratch.updQ() = state.getQ();
+      scratch.updU() = state.getU();
+      for (int k = 0; k < model_count; ++k) {
+        const double step = 1e-6 * scale[k];
+        simulated.ApplyParameterToState(scratch, model_parameters[k], p[k] + step);
+        const Eigen::VectorXd up = simulated.CalcOutputs(scratch);
+        simulated.ApplyParameterToState(scratch, model_parameters[k], p[k] - step);
+        dy_dp.col(k) = (up - simulated.CalcOutputs(scratch)) / (2 * step);
+        simulated.ApplyParameterToState(scratch, model_parameters[k], p[k]);
       }
     }
     const Eigen::MatrixXd& s = integrator.sensitivities();
@@ -176,8 +206,12 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
       const ChannelSource& source = sources[c];
       exact.values(j, c) = source.is_output ? y[source.index] : q[source.index];
       for (int k = 0; k < count; ++k) {
-        result.output_sensitivities[k](j, c) =
-            source.is_output ? dy_dq.row(source.index).dot(s.col(k).head(n)) : s(source.index, k);
+        double value = s(source.index, k);
+        if (source.is_output) {
+          value = dy_dY.row(source.index).dot(s.col(k).head(jacobian_columns));
+          if (k < model_count) value += dy_dp(source.index, k);
+        }
+        result.output_sensitivities[k](j, c) = value;
       }
     }
   }

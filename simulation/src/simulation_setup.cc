@@ -20,7 +20,8 @@ std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
       const int i = static_cast<int>(output - outputs.begin());
       sources.push_back({true, i, model.output_units()[i]});
     } else if (coordinate != coordinates.end()) {
-      sources.push_back({false, static_cast<int>(coordinate - coordinates.begin()), "rad"});
+      const int i = static_cast<int>(coordinate - coordinates.begin());
+      sources.push_back({false, i, model.coordinate_units()[static_cast<size_t>(i)]});
     } else {
       throw InputError("sensors", "channels", "unknown channel '" + channel + "'",
                        "an output or a coordinate of the model");

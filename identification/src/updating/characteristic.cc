@@ -199,7 +199,13 @@ void FitAmplitudes(const CharacteristicProblem& problem, const CharacteristicOpt
   Eigen::VectorXd b(samples * m);
   std::vector<Eigen::VectorXcd> output_shapes;
   for (Eigen::Index k = 0; k < n; ++k) {
-    output_shapes.push_back(problem.H * solution.shapes[static_cast<size_t>(k)]);
+    Eigen::VectorXcd shape = problem.H * solution.shapes[static_cast<size_t>(k)];
+    // Rate outputs see the mode differentiated: lambda or lambda^2 times the shape.
+    for (size_t i = 0; i < problem.output_orders.size(); ++i) {
+      shape[static_cast<Eigen::Index>(i)] *=
+          std::pow(problem.lambda[static_cast<size_t>(k)], problem.output_orders[i]);
+    }
+    output_shapes.push_back(shape);
   }
   for (Eigen::Index j = 0; j < samples; ++j) {
     const double t = record.start_time_s + static_cast<double>(j) * record.sample_interval_s;
@@ -331,6 +337,7 @@ CharacteristicProblem MakeCharacteristicProblem(
   CharacteristicProblem problem;
   problem.M = linear.M;
   problem.H = linear.H;
+  problem.output_orders = linear.output_orders;
   problem.coordinates = linear.coordinates;
   problem.outputs = linear.outputs;
   problem.lambda = lambda;
@@ -338,6 +345,19 @@ CharacteristicProblem MakeCharacteristicProblem(
   problem.c_reference.resize(n);
   problem.d_reference.resize(n);
   problem.K_g = linear.C;
+  const std::vector<model::Parameter> parameters = model.parameters();
+  for (const std::string& name : linear.coordinates) {
+    const bool sprung =
+        std::any_of(parameters.begin(), parameters.end(),
+                    [&](const model::Parameter& p) { return p.name == "c_" + name; });
+    if (!sprung) {
+      throw InputError("characteristic equation", "coordinates",
+                       "coordinate '" + name +
+                           "' has no spring, and eq. 7 solves for c and d of every "
+                           "coordinate",
+                       "a spring on every coordinate for Route 1 (Route 2 tunes the sprung ones)");
+    }
+  }
   for (int i = 0; i < n; ++i) {
     const std::string& name = linear.coordinates[static_cast<size_t>(i)];
     problem.c_reference[i] = model.GetParameter("c_" + name);

@@ -27,9 +27,11 @@ namespace mbid::updating {
 // What eq. 7 needs: the model's linearization at the test configuration, the poles, and
 // optionally the record (eq. 8) and the initial state the test is known to start from.
 struct CharacteristicProblem {
-  Eigen::MatrixXd M;                     // n x n, kg*m^2
-  Eigen::MatrixXd K_g;                   // n x n, gravity stiffness C - diag(c), N*m/rad
-  Eigen::MatrixXd H;                     // m x n, rad/rad
+  Eigen::MatrixXd M;    // n x n, kg*m^2
+  Eigen::MatrixXd K_g;  // n x n, gravity stiffness C - diag(c), N*m/rad
+  Eigen::MatrixXd H;    // m x n, rad/rad
+  // Per output, the derivative of q that H maps (model::LinearModel::output_orders); empty: 0.
+  std::vector<int> output_orders;
   std::vector<std::string> coordinates;  // n names: parameters are c_<name>, d_<name>
   std::vector<std::string> outputs;      // m names: the rows of H, matched to record channels
   // Identified poles, one per mode (Im > 0), 1/s. n of them.
