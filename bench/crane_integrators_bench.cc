@@ -10,7 +10,7 @@
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/model/simbody.h"
-#include "mbid/model/truck_crane.h"
+#include "mbid/model/truck_crane_description.h"
 #include "mbid/simulation/simulate.h"
 
 namespace {
@@ -24,11 +24,12 @@ constexpr double kDuration = 10.0;  // s
 constexpr double kRate = 100.0;     // Hz
 constexpr double kTolerance = 1e-8;
 
-const mbid::model::TruckCrane& Crane() {
-  static const mbid::model::TruckCrane crane(mbid::model::ReadTruckCraneParameters(
-      mbid::YamlReader::FromFile(std::string(MBID_SOURCE_DIR) +
-                                 "/scenarios/reference-crane-load-drop.yaml")
-          .Child("model")));
+const mbid::model::MultibodyModel& Crane() {
+  static const mbid::model::MultibodyModel crane =
+      mbid::model::MakeTruckCrane(mbid::model::ReadTruckCraneParameters(
+          mbid::YamlReader::FromFile(std::string(MBID_SOURCE_DIR) +
+                                     "/scenarios/reference-crane-load-drop.yaml")
+              .Child("model")));
   return crane;
 }
 
@@ -104,7 +105,7 @@ BENCHMARK(BM_CvodesAdams)->Unit(benchmark::kMillisecond);
 template <class Integrator>
 void RunSimbody(benchmark::State& state, double accuracy = kTolerance) {
   Reference();
-  const mbid::model::TruckCrane& crane = Crane();
+  const mbid::model::MultibodyModel& crane = Crane();
   const Eigen::VectorXd q0 = crane.SolveStaticEquilibrium(crane.CalcPayloadLoads(650.0));
   const int samples = static_cast<int>(kDuration * kRate) + 1;
   Eigen::MatrixXd y(samples, 2);

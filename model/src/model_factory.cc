@@ -117,8 +117,7 @@ std::unique_ptr<MechanicalModel> MakeModel(const YamlReader& model) {
   try {
     if (type == "multibody") return std::make_unique<MultibodyModel>(ReadMachineDescription(model));
     // The shorthand: the crane's keys expand to its description.
-    return std::make_unique<MultibodyModel>(DescribeTruckCrane(ReadTruckCraneParameters(model)),
-                                            "truck_crane");
+    return std::make_unique<MultibodyModel>(MakeTruckCrane(ReadTruckCraneParameters(model)));
   } catch (const InputError& error) {
     if (error.source() != "machine description") throw;
     // A check of the built model (e.g. a free coordinate that gravity drives): anchor it here.

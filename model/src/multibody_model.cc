@@ -446,6 +446,9 @@ MultibodyModel::MultibodyModel(MachineDescription machine, std::string type)
     : impl_(std::make_unique<Impl>(std::move(machine), std::move(type))) {}
 
 MultibodyModel::~MultibodyModel() = default;
+// The Simbody system refers to the Impl by address; moving the pointer keeps it in place.
+MultibodyModel::MultibodyModel(MultibodyModel&&) noexcept = default;
+MultibodyModel& MultibodyModel::operator=(MultibodyModel&&) noexcept = default;
 
 const MachineDescription& MultibodyModel::description() const { return impl_->machine; }
 std::string MultibodyModel::type() const { return impl_->type; }

@@ -76,4 +76,8 @@ MachineDescription DescribeTruckCrane(const TruckCraneParameters& p) {
   return machine;
 }
 
+MultibodyModel MakeTruckCrane(const TruckCraneParameters& parameters) {
+  return MultibodyModel(DescribeTruckCrane(parameters), "truck_crane");
+}
+
 }  // namespace mbid::model

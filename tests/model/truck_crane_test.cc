@@ -1,7 +1,6 @@
-// The truck crane against the independent reference of docs/reference-crane.md and against
-// finite differences of its own nonlinear forces and outputs.
-#include "mbid/model/truck_crane.h"
-
+// The truck crane (its machine description, as `type: truck_crane` expands) against the
+// independent reference of docs/reference-crane.md and against finite differences of its own
+// nonlinear forces and outputs.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -11,6 +10,7 @@
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/model/simbody.h"
+#include "mbid/model/truck_crane_description.h"
 
 namespace mbid::model {
 namespace {
@@ -39,7 +39,7 @@ void ExpectMatrixNear(const Eigen::MatrixXd& actual, const Eigen::MatrixXd& expe
 }
 
 TEST(TruckCraneTest, LinearModelMatchesReference) {
-  const TruckCrane crane(ReferenceParameters());
+  const MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   const LinearModel linear = crane.Linearize();
   Eigen::MatrixXd M(4, 4), C(4, 4), H(2, 4);
   M << 1.527234387e+05, 1.673841514e+04, 2.331638945e+04, -3.539826254e+04,  //
@@ -62,7 +62,7 @@ TEST(TruckCraneTest, LinearModelMatchesReference) {
 }
 
 TEST(TruckCraneTest, ModesMatchReference) {
-  const TruckCrane crane(ReferenceParameters());
+  const MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   const std::vector<Mode> modes = CalcModes(crane.Linearize());
   ASSERT_EQ(modes.size(), 4u);  // four underdamped modes, one per degree of freedom
   const double frequency_hz[] = {0.576553150, 1.512559861, 2.263377565, 3.088456892};
@@ -81,7 +81,7 @@ TEST(TruckCraneTest, ModesMatchReference) {
 
 TEST(TruckCraneTest, ModesSatisfyQuadraticEigenproblem) {
   // (lambda^2 M + lambda D + C) v = 0 (eq. 6) for every mode: residual at roundoff of |C| |v|.
-  const TruckCrane crane(ReferenceParameters());
+  const MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   const LinearModel linear = crane.Linearize();
   for (const Mode& mode : CalcModes(linear)) {
     const std::complex<double> l = mode.lambda;
@@ -95,7 +95,7 @@ TEST(TruckCraneTest, ModesSatisfyQuadraticEigenproblem) {
 TEST(TruckCraneTest, UnloadedCraneRestsAtZero) {
   // The preload rule: the springs carry the dead weight at q = 0. Residual at roundoff of the
   // gravity torques (~1e5 N*m), 1e-9 N*m.
-  const TruckCrane crane(ReferenceParameters());
+  const MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   const Eigen::VectorXd f = crane.CalcStaticGeneralizedForce(Eigen::VectorXd::Zero(4), {});
   EXPECT_LT(f.lpNorm<Eigen::Infinity>(), 1e-9);
   EXPECT_LT(crane.SolveStaticEquilibrium({}).lpNorm<Eigen::Infinity>(), 1e-15);
@@ -103,7 +103,7 @@ TEST(TruckCraneTest, UnloadedCraneRestsAtZero) {
 
 TEST(TruckCraneTest, LoadedEquilibriumMatchesReference) {
   // docs/reference-crane.md: the 650 kg load drop starts from these q (7 significant digits).
-  const TruckCrane crane(ReferenceParameters());
+  const MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   const double payload_kg = 650.0;
   const std::vector<PointLoad> loads{{"boom_tip", Eigen::Vector3d(0, 0, -payload_kg * 9.81)}};
   const Eigen::VectorXd q = crane.SolveStaticEquilibrium(loads);
@@ -119,7 +119,7 @@ TEST(TruckCraneTest, StiffnessMatchesFiniteDifferenceOfForces) {
   // C = -d f / d q of the full nonlinear rest force (springs + gravity) at q = 0, by central
   // differences with h = 1e-6 rad: truncation ~h^2 and roundoff ~1e-16 f/h leave ~1e-6 N*m/rad
   // on entries up to 5e7, so 1e-7 relative to the largest entry.
-  const TruckCrane crane(ReferenceParameters());
+  const MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   const LinearModel linear = crane.Linearize();
   Eigen::MatrixXd C_fd(4, 4);
   const double h = 1e-6;
@@ -136,7 +136,7 @@ TEST(TruckCraneTest, StiffnessMatchesFiniteDifferenceOfForces) {
 TEST(TruckCraneTest, OutputJacobianMatchesFiniteDifferences) {
   // H from angular velocities vs central differences of the nonlinear outputs, h = 1e-6 rad:
   // error ~h^2 ~ 1e-12 plus roundoff 1e-16/1e-6 = 1e-10.
-  const TruckCrane crane(ReferenceParameters());
+  const MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   const LinearModel linear = crane.Linearize();
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(4);
   for (int j = 0; j < 4; ++j) {
@@ -153,7 +153,7 @@ TEST(TruckCraneTest, OutputJacobianMatchesFiniteDifferences) {
 TEST(TruckCraneTest, BoomAnglesFollowKinematics) {
   // With alpha = gamma = 0 the boom azimuth is eta and the elevation theta exactly
   // (R_K = Rz(psi0 + eta) Ry(-(phi0 + theta))).
-  const TruckCrane crane(ReferenceParameters());
+  const MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   Eigen::VectorXd q(4);
   q << 0, 0, 0.1, -0.2;
   const Eigen::VectorXd y = crane.CalcOutputs(crane.MakeState(q, Eigen::VectorXd::Zero(4)));
@@ -170,7 +170,7 @@ TEST(TruckCraneTest, OutputsEqualSimbodysBoomRotation) {
   // Both are a few rotations of unit vectors in double precision: agreement to 1e-14 rad.
   TruckCraneParameters parameters = ReferenceParameters();
   parameters.slew_rad = 2.5;  // past 90 degrees: atan2's branches and the wrap to (-pi, pi]
-  const TruckCrane crane(parameters);
+  const MultibodyModel crane = MakeTruckCrane(parameters);
   const SimTK::SimbodyMatterSubsystem& matter = crane.system().getMatterSubsystem();
   const SimTK::MobilizedBody& boom =
       matter.getMobilizedBody(SimTK::MobilizedBodyIndex(matter.getNumBodies() - 1));
@@ -191,7 +191,7 @@ TEST(TruckCraneTest, OutputsEqualSimbodysBoomRotation) {
 TEST(TruckCraneTest, LinearizationFollowsParameterChangesExactly) {
   // M, K_g and H are computed once per model; C and D must still follow SetParameter. After a
   // change the linearization equals that of a crane built with the new values, bit for bit.
-  TruckCrane crane(ReferenceParameters());
+  MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   const LinearModel before = crane.Linearize();
   crane.SetParameter("c_theta", 7.0e6);
   crane.SetParameter("d_alpha", 3.0e5);
@@ -199,7 +199,7 @@ TEST(TruckCraneTest, LinearizationFollowsParameterChangesExactly) {
   changed.joints[3].stiffness_Nm_per_rad = 7.0e6;
   changed.joints[0].damping_Nms_per_rad = 3.0e5;
   const LinearModel after = crane.Linearize();
-  const LinearModel fresh = TruckCrane(changed).Linearize();
+  const LinearModel fresh = MakeTruckCrane(changed).Linearize();
   EXPECT_EQ(after.M, fresh.M);
   EXPECT_EQ(after.C, fresh.C);
   EXPECT_EQ(after.D, fresh.D);
@@ -210,7 +210,7 @@ TEST(TruckCraneTest, LinearizationFollowsParameterChangesExactly) {
 }
 
 TEST(TruckCraneTest, ParametersRoundTripAndChangeTheModel) {
-  TruckCrane crane(ReferenceParameters());
+  MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   EXPECT_EQ(crane.parameters().size(), 8u);  // c and d of four joints
   crane.SetParameter("c_gamma", 2.2e6);
   EXPECT_EQ(crane.GetParameter("c_gamma"), 2.2e6);
@@ -226,8 +226,8 @@ TEST(TruckCraneTest, ParametersRoundTripAndChangeTheModel) {
 TEST(TruckCraneTest, AttachedPayloadKeepsUnloadedRestAndLowersFrequencies) {
   TruckCraneParameters parameters = ReferenceParameters();
   parameters.attached_payload_kg = 650.0;
-  const TruckCrane loaded(parameters);
-  const TruckCrane unloaded(ReferenceParameters());
+  const MultibodyModel loaded = MakeTruckCrane(parameters);
+  const MultibodyModel unloaded = MakeTruckCrane(ReferenceParameters());
   // Payload mass at the tip adds m L^2 to the luffing inertia: 650 * 10^2.
   EXPECT_NEAR(loaded.Linearize().M(3, 3) - unloaded.Linearize().M(3, 3), 650.0 * 100.0, 1e-6);
   const std::vector<Mode> modes_loaded = CalcModes(loaded.Linearize());
@@ -240,13 +240,13 @@ TEST(TruckCraneTest, AttachedPayloadKeepsUnloadedRestAndLowersFrequencies) {
 TEST(TruckCraneTest, ValidationRejectsUnphysicalData) {
   TruckCraneParameters p = ReferenceParameters();
   p.boom_mass_kg = -1;
-  EXPECT_THROW(TruckCrane{p}, InputError);
+  EXPECT_THROW(MakeTruckCrane(p), InputError);
   p = ReferenceParameters();
   p.base_inertia_kgm2 = Eigen::Vector3d(1, 1, 3);  // 3 > 1 + 1
-  EXPECT_THROW(TruckCrane{p}, InputError);
+  EXPECT_THROW(MakeTruckCrane(p), InputError);
   p = ReferenceParameters();
   p.boom_elevation_rad = M_PI / 2;
-  EXPECT_THROW(TruckCrane{p}, InputError);
+  EXPECT_THROW(MakeTruckCrane(p), InputError);
 }
 
 }  // namespace
@@ -257,7 +257,7 @@ namespace {
 
 TEST(TruckCraneTest, ApplyParameterToStateMatchesSetParameter) {
   // Same accelerations, bit for bit, whether the parameter comes from the model or the state.
-  TruckCrane crane(ReferenceParameters());
+  MultibodyModel crane = MakeTruckCrane(ReferenceParameters());
   Eigen::VectorXd q(4), u(4);
   q << 0.001, -0.002, 0.003, 0.004;  // a generic state: every spring and damper acts
   u << 0.01, 0.02, -0.03, 0.04;

@@ -11,7 +11,7 @@
 #include "mbid/model/model_factory.h"
 #include "mbid/model/simbody.h"
 #include "mbid/model/torsional_oscillator.h"
-#include "mbid/model/truck_crane.h"
+#include "mbid/model/truck_crane_description.h"
 #include "mbid/simulation/cvodes_integrator.h"
 #include "mbid/simulation/scenario_sections.h"
 
@@ -66,7 +66,7 @@ TEST(SimulateTest, EnergyIsConservedWithoutDamping) {
   // (kinetic + gravity + springs) drifts by less than 1e-8 of itself (the bound).
   model::TruckCraneParameters parameters = ReferenceParameters();
   for (auto& joint : parameters.joints) joint.damping_Nms_per_rad = 0.0;
-  const model::TruckCrane crane(parameters);
+  const model::MultibodyModel crane = model::MakeTruckCrane(parameters);
   SimulationOptions options;
   options.duration_s = 10.0;
   // Adams: the most accurate CVODES family on this smooth, non-stiff motion (docs/performance).
@@ -97,7 +97,7 @@ TEST(SimulateTest, EnergyIsConservedWithoutDamping) {
 TEST(SimulateTest, SmallLoadDropFollowsLinearModel) {
   // A 10 kg drop deflects ~1e-4 rad: the nonlinear terms are O(q) ~ 1e-4 of the response, so the
   // nonlinear and linear responses agree to 1e-3 of the amplitude (the bound).
-  const model::TruckCrane crane(ReferenceParameters());
+  const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   Excitation drop;
   drop.type = Excitation::Type::kLoadDrop;
   drop.payload_mass_kg = 10.0;
@@ -117,7 +117,7 @@ TEST(SimulateTest, SmallLoadDropFollowsLinearModel) {
 TEST(SimulateTest, CvodesMatchesSimbodyRungeKuttaMerson) {
   // Both at rtol 1e-10 on the reference free decay: the trajectories agree to 1e-8 rad (global
   // errors of both are ~1e-10 of the 1e-2 rad amplitude).
-  const model::TruckCrane crane(ReferenceParameters());
+  const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   SimulationOptions options;
   options.duration_s = 4.0;
   options.integrator.relative_tolerance = 1e-10;
@@ -141,7 +141,7 @@ TEST(SimulateTest, CvodesMatchesSimbodyRungeKuttaMerson) {
 }
 
 TEST(SimulateTest, SensorModelIsSeededAndAddsWhatItSays) {
-  const model::TruckCrane crane(ReferenceParameters());
+  const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   SimulationOptions options;
   options.duration_s = 2.0;
   SensorOptions sensors = NoiselessSensors(100.0, {"psi", "phi"});
@@ -165,7 +165,7 @@ TEST(SimulateTest, SensorModelIsSeededAndAddsWhatItSays) {
 }
 
 TEST(SimulateTest, QuantizationRoundsToTheStep) {
-  const model::TruckCrane crane(ReferenceParameters());
+  const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   SimulationOptions options;
   options.duration_s = 1.0;
   SensorOptions sensors = NoiselessSensors(100.0, {"psi"});
@@ -185,7 +185,7 @@ TEST(SimulateTest, ImpulseDeliversItsMomentum) {
   // Dampers off: they would take d M^-1 T / 4 ~ 0.4% (gamma is light once eta is coupled in).
   model::TruckCraneParameters parameters = ReferenceParameters();
   for (auto& joint : parameters.joints) joint.damping_Nms_per_rad = 0.0;
-  model::TruckCrane crane(parameters);
+  model::MultibodyModel crane = model::MakeTruckCrane(parameters);
   Excitation impulse;
   impulse.type = Excitation::Type::kImpulse;
   impulse.coordinate = "gamma";
@@ -210,7 +210,7 @@ TEST(SimulateTest, ImpulseDeliversItsMomentum) {
 }
 
 TEST(SimulateTest, BurstAndImpulseRunThroughSimulate) {
-  const model::TruckCrane crane(ReferenceParameters());
+  const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   SimulationOptions options;
   options.duration_s = 3.0;
   Excitation burst;
@@ -288,7 +288,7 @@ TEST(SimulateTest, AutoRunsAdamsOnTheCraneAndBdfWithAHeavilyDampedJoint) {
   // The reference crane (stiffness ratio 1.0, docs/performance.md) runs Adams by default; with
   // alpha's damping x500 (ratio 135) BDF, which Adams would need 3.5x the steps of. An explicit
   // method is kept, and every run agrees with BDF at the tolerance (rtol 1e-8 on ~1e-3 rad).
-  const model::TruckCrane crane(ReferenceParameters());
+  const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   SimulationOptions options;
   options.duration_s = 2.0;
   EXPECT_EQ(options.integrator.method, IntegratorOptions::Method::kAuto);  // the default
@@ -305,14 +305,14 @@ TEST(SimulateTest, AutoRunsAdamsOnTheCraneAndBdfWithAHeavilyDampedJoint) {
 
   model::TruckCraneParameters damped = ReferenceParameters();
   damped.joints[0].damping_Nms_per_rad *= 500;
-  const model::TruckCrane damped_crane(damped);
+  const model::MultibodyModel damped_crane = model::MakeTruckCrane(damped);
   EXPECT_EQ(Simulate(damped_crane, deflection, options, sensors).statistics.method,
             IntegratorOptions::Method::kBdf);
 }
 
 TEST(SimulateTest, ReadsScenarioSections) {
   const YamlReader root = YamlReader::FromFile(kReference);
-  const model::TruckCrane crane(ReferenceParameters());
+  const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   const Excitation excitation = ReadExcitation(root.Child("excitation"), crane);
   EXPECT_EQ(excitation.type, Excitation::Type::kInitialDeflection);
   EXPECT_EQ(excitation.deflection_rad.at("theta"), -0.006);

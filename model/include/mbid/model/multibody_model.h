@@ -21,6 +21,8 @@ class MultibodyModel final : public MechanicalModel {
   // type() reports ("multibody", or a shorthand's name such as "truck_crane").
   explicit MultibodyModel(MachineDescription machine, std::string type = "multibody");
   ~MultibodyModel() override;
+  MultibodyModel(MultibodyModel&&) noexcept;
+  MultibodyModel& operator=(MultibodyModel&&) noexcept;
 
   const MachineDescription& description() const;
 
