@@ -548,6 +548,10 @@ void MultibodyModel::ApplyParameterToState(SimTK::State& state, const std::strin
   } else {
     impl_->dampers[static_cast<size_t>(slot)].setDamping(state, value);
   }
+  // Simbody caches position-dependent forces (the spring's) at the Position stage, which a new
+  // parameter alone does not invalidate: without this, a state realized before would keep the
+  // old spring force (a caller that also sets q, as the integrator does, would not notice).
+  state.invalidateAllCacheAtOrAbove(SimTK::Stage::Position);
 }
 
 const SimTK::MultibodySystem& MultibodyModel::system() const { return impl_->system; }
