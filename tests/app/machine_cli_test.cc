@@ -1,0 +1,96 @@
+// Machines from descriptions through the command line: the excavator's whole cycle, the crane's
+// two spellings, and bad descriptions stopped with one line and nothing written.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "command_test.h"
+
+namespace mbid::testing {
+namespace {
+
+const fs::path kScenarios = fs::path(MBID_SOURCE_DIR) / "scenarios";
+
+class MachineCliTest : public CommandTest {};
+
+TEST_F(MachineCliTest, ExcavatorRunPassesAndRecoversItsJoints) {
+  const fs::path out = dir_ / "excavator";
+  const CommandResult result =
+      Run("run " + (kScenarios / "excavator-arm.yaml").string() + " -o " + out.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));
+  EXPECT_TRUE(summary["validation"]["passed"].get<bool>());
+  EXPECT_EQ(summary["updating"]["termination"], "converged");
+  // The scenario's springs are the truth of the simulated test. A tuned value within 4 of its
+  // standard deviations (the bound for "determined"); the units from the model.
+  const std::map<std::string, double> truth{{"c_swing", 3.0e7}, {"c_boom", 6.4e7},
+                                            {"c_stick", 2.5e7}, {"d_swing", 2.0e5},
+                                            {"d_boom", 3.0e5},  {"d_stick", 8.0e4}};
+  for (const auto& [name, value] : truth) {
+    const nlohmann::json& p = summary["updating"]["parameters"][name];
+    EXPECT_LT(std::abs(p["value"].get<double>() - value), 4 * p["std"].get<double>()) << name;
+    EXPECT_EQ(p["units"], name[0] == 'c' ? "N*m/rad" : "N*m*s/rad") << name;
+  }
+}
+
+TEST_F(MachineCliTest, CraneShorthandAndDescriptionGiveTheSameModes) {
+  const fs::path a = dir_ / "a.json", b = dir_ / "b.json";
+  ASSERT_EQ(Run("modes " + (kScenarios / "reference-crane.yaml").string() + " --json " + a.string())
+                .exit_code,
+            0);
+  ASSERT_EQ(Run("modes " + (kScenarios / "reference-crane-description.yaml").string() + " --json " +
+                b.string())
+                .exit_code,
+            0);
+  const nlohmann::json ja = nlohmann::json::parse(ReadText(a));
+  const nlohmann::json jb = nlohmann::json::parse(ReadText(b));
+  ASSERT_EQ(ja["modes"].size(), 4u);
+  ASSERT_EQ(jb["modes"].size(), 4u);
+  for (size_t k = 0; k < 4; ++k) {
+    const double fa = ja["modes"][k]["frequency_hz"].get<double>();
+    EXPECT_NEAR(jb["modes"][k]["frequency_hz"].get<double>(), fa, 1e-12 * fa) << k;
+  }
+}
+
+struct BadMachine {
+  const char* name;
+  const char* from;
+  const char* to;
+  const char* key_path;
+};
+
+class BadMachineTest : public CommandTest, public ::testing::WithParamInterface<BadMachine> {};
+
+TEST_P(BadMachineTest, ExitsTwoWithOneLineAndWritesNothing) {
+  const BadMachine& bad = GetParam();
+  const fs::path scenario =
+      WriteVariant(kScenarios / "excavator-arm.yaml", "machine.yaml", bad.from, bad.to);
+  const fs::path json = dir_ / "modes.json";
+  const CommandResult result = Run("modes " + scenario.string() + " --json " + json.string());
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_NE(result.err.find(scenario.string() + ":" + bad.key_path), std::string::npos)
+      << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  EXPECT_FALSE(fs::exists(json));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Contract, BadMachineTest,
+    ::testing::Values(
+        BadMachine{"UnknownParameter", "\"boom_length_m / 2\"", "\"boom_lenght_m / 2\"",
+                   "model.bodies.boom.com_m[0]"},
+        BadMachine{"ParentBelow", "parent: boom, joint: {type: revolute, coordinates: [stick]",
+                   "parent: bucket, joint: {type: revolute, coordinates: [stick]",
+                   "model.bodies.stick.parent"},
+        BadMachine{"ZeroAxis", "coordinates: [swing], axis: [0, 0, 1]",
+                   "coordinates: [swing], axis: [0, 0, 0]", "model.bodies.upper.joint.axis"},
+        BadMachine{"TriangleInequality", "[40.0, 700.0, 700.0]", "[40.0, 700.0, 1700.0]",
+                   "model.bodies.stick.inertia_kgm2"},
+        BadMachine{"SensorKeyOfAbsentUnit", "noise_std_mps2: 2.0e-03", "noise_std_m: 2.0e-03",
+                   "sensors.noise_std_m"},
+        BadMachine{"SensorUnitOfAnotherChannel", "noise_std_rad: 1.0e-05",
+                   "noise_std_rad: {a_bucket_z: 1.0e-3}", "sensors.noise_std_rad.a_bucket_z"}),
+    [](const ::testing::TestParamInfo<BadMachine>& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace mbid::testing
