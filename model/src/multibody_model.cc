@@ -119,20 +119,51 @@ struct MultibodyModel::Impl {
         machine.payload_point.empty() ? "" : FindPoint(machine.payload_point).body;
 
     SimTK::Force::UniformGravity(forces, matter, Vec3(0, 0, -machine.gravity_mps2));
-    for (const BodyDescription& body : machine.bodies) {
-      const int index = static_cast<int>(mobods.size());
-      body_index[body.name] = index;
-      MobilizedBody& parent = body.parent == "ground"
-                                  ? matter.updGround()
-                                  : mobods[static_cast<size_t>(body_index.at(body.parent))];
+    const std::vector<bool> merged = FindMergeableFrames();
+    for (size_t b = 0; b < machine.bodies.size(); ++b) {
+      const BodyDescription& body = machine.bodies[b];
+      body_index[body.name] = static_cast<int>(b);
+      parents.push_back(body.parent == "ground" ? -1 : body_index.at(body.parent));
+      if (merged[b]) {
+        // Its joint becomes the first axis of its child's universal joint.
+        mobods.emplace_back();
+        continue;
+      }
+      const int parent_index = parents.back();
+      const bool universal_from_pair =
+          parent_index >= 0 && merged[static_cast<size_t>(parent_index)];
+      const BodyDescription* frame =
+          universal_from_pair ? &machine.bodies[static_cast<size_t>(parent_index)] : nullptr;
+      const int holder =
+          universal_from_pair ? parents[static_cast<size_t>(parent_index)] : parent_index;
+      MobilizedBody& parent = holder < 0 ? matter.updGround() : mobods[static_cast<size_t>(holder)];
       const JointDescription& joint = body.joint;
+      const SimTK::Body::Rigid rigid(CalcMassProperties(
+          body, body.name == payload_body ? machine.attached_payload_kg : 0.0, payload_at));
+      if (universal_from_pair) {
+        // R_PC = R_PF Rot(a1, q1) R_F2 Rot(a2, q2) R_CM^T = (R_PF R_F2) Rot(R_F2^T a1, q1)
+        // Rot(a2, q2) R_CM^T: a universal joint with the frame's first axis turned into it.
+        JointDescription combined;
+        combined.type = JointType::kUniversal;
+        combined.axes = {joint.in_parent_rotation.transpose() * frame->joint.axes[0].normalized(),
+                         joint.axes[0].normalized()};
+        const Rotation align = CalcAlignment(combined);
+        const Transform X_PF(
+            Rotation(ToMat33(frame->joint.in_parent_rotation * joint.in_parent_rotation), true) *
+                align,
+            ToVec3(frame->joint.in_parent_m));
+        const Transform X_BM(Rotation(ToMat33(joint.in_body_rotation), true) * align,
+                             ToVec3(joint.in_body_m));
+        mobods.push_back(MobilizedBody::Universal(parent, X_PF, rigid, X_BM));
+        AddCoordinate(*frame, 0, mobods.back(), 0);
+        AddCoordinate(body, 0, mobods.back(), 1);
+        continue;
+      }
       const Rotation align = CalcAlignment(joint);
       const Transform X_PF(Rotation(ToMat33(joint.in_parent_rotation), true) * align,
                            ToVec3(joint.in_parent_m));
       const Transform X_BM(Rotation(ToMat33(joint.in_body_rotation), true) * align,
                            ToVec3(joint.in_body_m));
-      const SimTK::Body::Rigid rigid(CalcMassProperties(
-          body, body.name == payload_body ? machine.attached_payload_kg : 0.0, payload_at));
       switch (joint.type) {
         case JointType::kRevolute:
           mobods.push_back(MobilizedBody::Pin(parent, X_PF, rigid, X_BM));
@@ -147,22 +178,8 @@ struct MultibodyModel::Impl {
           mobods.push_back(MobilizedBody::Weld(parent, X_PF, rigid, X_BM));
           break;
       }
-      parents.push_back(body.parent == "ground" ? -1 : body_index.at(body.parent));
       for (size_t which = 0; which < joint.coordinates.size(); ++which) {
-        Coordinate coordinate;
-        coordinate.body = index;
-        coordinate.which = static_cast<int>(which);
-        coordinate.translational = joint.type == JointType::kPrismatic;
-        const SpringDescription* spring = machine.FindSpring(joint.coordinates[which]);
-        if (spring != nullptr) {
-          coordinate.spring = static_cast<int>(springs.size());
-          springs.push_back(SimTK::Force::MobilityLinearSpring(
-              forces, mobods.back(), SimTK::MobilizerUIndex(coordinate.which), spring->stiffness,
-              0.0));
-          dampers.push_back(SimTK::Force::MobilityLinearDamper(
-              forces, mobods.back(), SimTK::MobilizerUIndex(coordinate.which), spring->damping));
-        }
-        coordinate_data.push_back(coordinate);
+        AddCoordinate(body, which, mobods.back(), static_cast<int>(which));
       }
     }
     SimTK::Force::Custom(
@@ -182,9 +199,71 @@ struct MultibodyModel::Impl {
     for (const Coordinate& c : coordinate_data)
       coordinate_units.push_back(c.translational ? "m" : "rad");
 
+    PrepareKinematics();
     ResolveOutputs();
     unloaded_gravity_force = CalcUnloadedGravityForce();
     CheckFreeCoordinates();
+  }
+
+  // A massless frame on a revolute joint whose only child turns on a revolute joint at the same
+  // point about a perpendicular axis is a universal joint: Simbody gets one mobilizer for the
+  // pair instead of a massless body (a tenth of a right-hand side on the crane). Frames that
+  // carry points or body outputs stay bodies.
+  std::vector<bool> FindMergeableFrames() const {
+    const size_t count = machine.bodies.size();
+    std::vector<bool> merged(count, false);
+    std::map<std::string, int> index;
+    for (size_t b = 0; b < count; ++b) index[machine.bodies[b].name] = static_cast<int>(b);
+    for (size_t b = 0; b < count; ++b) {
+      const BodyDescription& frame = machine.bodies[b];
+      const JointDescription& joint = frame.joint;
+      if (frame.mass_kg != 0 || joint.type != JointType::kRevolute ||
+          !joint.in_body_m.isZero(0.0) || !joint.in_body_rotation.isIdentity(0.0)) {
+        continue;
+      }
+      if (frame.parent != "ground" && merged[static_cast<size_t>(index.at(frame.parent))]) continue;
+      // The child must follow at once, so that q keeps the description's order.
+      if (b + 1 == count || machine.bodies[b + 1].parent != frame.name) continue;
+      int children = 0;
+      const BodyDescription* child = nullptr;
+      for (const BodyDescription& other : machine.bodies) {
+        if (other.parent == frame.name) {
+          ++children;
+          child = &other;
+        }
+      }
+      if (children != 1 || child->joint.type != JointType::kRevolute ||
+          !child->joint.in_parent_m.isZero(0.0)) {
+        continue;
+      }
+      const Eigen::Vector3d first =
+          child->joint.in_parent_rotation.transpose() * joint.axes[0].normalized();
+      if (std::abs(first.dot(child->joint.axes[0].normalized())) > 1e-12) continue;
+      bool referenced = false;
+      for (const PointDescription& point : machine.points) referenced |= point.body == frame.name;
+      for (const OutputDescription& output : machine.outputs)
+        referenced |= output.body == frame.name;
+      merged[b] = !referenced;
+    }
+    return merged;
+  }
+
+  // Coordinate `which` of `body` is mobility `mobility` of `mobod`, with its spring-damper.
+  void AddCoordinate(const BodyDescription& body, size_t which, const MobilizedBody& mobod,
+                     int mobility) {
+    Coordinate coordinate;
+    coordinate.body = body_index.at(body.name);
+    coordinate.which = mobility;
+    coordinate.translational = body.joint.type == JointType::kPrismatic;
+    const SpringDescription* spring = machine.FindSpring(body.joint.coordinates[which]);
+    if (spring != nullptr) {
+      coordinate.spring = static_cast<int>(springs.size());
+      springs.push_back(SimTK::Force::MobilityLinearSpring(
+          forces, mobod, SimTK::MobilizerUIndex(mobility), spring->stiffness, 0.0));
+      dampers.push_back(SimTK::Force::MobilityLinearDamper(
+          forces, mobod, SimTK::MobilizerUIndex(mobility), spring->damping));
+    }
+    coordinate_data.push_back(coordinate);
   }
 
   const PointDescription& FindPoint(const std::string& name) const {
@@ -220,6 +299,9 @@ struct MultibodyModel::Impl {
       output_names.push_back(description.name);
       output_units.push_back(OutputUnits(machine, description));
       output_orders.push_back(OutputDerivativeOrder(description.type));
+      if (output.body >= 0 && OutputDerivativeOrder(output.type) == 0) {
+        pose_count = std::max(pose_count, static_cast<size_t>(output.body) + 1);
+      }
       outputs.push_back(output);
     }
     // Reference values at q = 0: outputs are deviations from them.
@@ -310,36 +392,72 @@ struct MultibodyModel::Impl {
     Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
   };
-  std::vector<Pose> CalcPoses(const Eigen::VectorXd& q) const {
-    std::vector<Pose> poses(machine.bodies.size());
+  // Per body, what the pose needs of its joint: the turns' cross-product matrices K and K^2
+  // (Rodrigues: Rot(a, t) = I + sin t K + (1 - cos t) K^2) and which frame terms are trivial.
+  struct JointKinematics {
+    Eigen::Matrix3d K[2], K2[2];
+    Eigen::Vector3d slide = Eigen::Vector3d::Zero();
+    bool parent_turned = false, body_turned = false, body_offset = false;
+  };
+  void PrepareKinematics() {
+    for (const BodyDescription& body : machine.bodies) {
+      const JointDescription& joint = body.joint;
+      JointKinematics k;
+      for (size_t i = 0; i < joint.axes.size(); ++i) {
+        const Eigen::Vector3d a = joint.axes[i].normalized();
+        k.K[i] << 0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0;
+        k.K2[i] = k.K[i] * k.K[i];
+        if (joint.type == JointType::kPrismatic) k.slide = a;
+      }
+      k.parent_turned = !joint.in_parent_rotation.isIdentity(0.0);
+      k.body_turned = !joint.in_body_rotation.isIdentity(0.0);
+      k.body_offset = !joint.in_body_m.isZero(0.0);
+      kinematics.push_back(k);
+    }
+  }
+  static Eigen::Matrix3d Turn(const JointKinematics& k, int i, double angle) {
+    return Eigen::Matrix3d::Identity() + std::sin(angle) * k.K[i] + (1 - std::cos(angle)) * k.K2[i];
+  }
+  // Poses of the first `count` bodies (all by default).
+  std::vector<Pose> CalcPoses(const Eigen::VectorXd& q, size_t count = SIZE_MAX) const {
+    count = std::min(count, machine.bodies.size());
+    std::vector<Pose> poses(count);
     Eigen::Index next = 0;
-    for (size_t b = 0; b < machine.bodies.size(); ++b) {
+    for (size_t b = 0; b < count; ++b) {
       const JointDescription& joint = machine.bodies[b].joint;
+      const JointKinematics& k = kinematics[b];
       Eigen::Matrix3d R_FM = Eigen::Matrix3d::Identity();
       Eigen::Vector3d p_FM = Eigen::Vector3d::Zero();
       switch (joint.type) {
         case JointType::kRevolute:
-          R_FM = Eigen::AngleAxisd(q[next++], joint.axes[0].normalized()).toRotationMatrix();
+          R_FM = Turn(k, 0, q[next++]);
           break;
         case JointType::kPrismatic:
-          p_FM = q[next++] * joint.axes[0].normalized();
+          p_FM = q[next++] * k.slide;
           break;
         case JointType::kUniversal:
-          R_FM = Eigen::AngleAxisd(q[next], joint.axes[0].normalized()).toRotationMatrix() *
-                 Eigen::AngleAxisd(q[next + 1], joint.axes[1].normalized()).toRotationMatrix();
+          R_FM = Turn(k, 0, q[next]) * Turn(k, 1, q[next + 1]);
           next += 2;
           break;
         case JointType::kWeld:
           break;
       }
-      const Pose parent = parents[b] < 0 ? Pose{} : poses[static_cast<size_t>(parents[b])];
       // X_GB = X_GP X_PF X_FM X_MB with X_MB the inverse of X_BM.
-      const Eigen::Matrix3d R_PM = joint.in_parent_rotation * R_FM;
-      const Eigen::Matrix3d R_PB = R_PM * joint.in_body_rotation.transpose();
-      const Eigen::Vector3d p_PB =
-          joint.in_parent_m + joint.in_parent_rotation * p_FM - R_PB * joint.in_body_m;
-      poses[b].R = parent.R * R_PB;
-      poses[b].p = parent.p + parent.R * p_PB;
+      Eigen::Matrix3d R_PB =
+          k.parent_turned ? Eigen::Matrix3d(joint.in_parent_rotation * R_FM) : R_FM;
+      if (k.body_turned) R_PB = R_PB * joint.in_body_rotation.transpose();
+      Eigen::Vector3d p_PB =
+          joint.in_parent_m +
+          (k.parent_turned ? Eigen::Vector3d(joint.in_parent_rotation * p_FM) : p_FM);
+      if (k.body_offset) p_PB -= R_PB * joint.in_body_m;
+      if (parents[b] < 0) {
+        poses[b].R = R_PB;
+        poses[b].p = p_PB;
+      } else {
+        const Pose& parent = poses[static_cast<size_t>(parents[b])];
+        poses[b].R = parent.R * R_PB;
+        poses[b].p = parent.p + parent.R * p_PB;
+      }
     }
     return poses;
   }
@@ -363,6 +481,8 @@ struct MultibodyModel::Impl {
   std::vector<Coordinate> coordinate_data;
   std::vector<SimTK::Force::MobilityLinearSpring> springs;
   std::vector<SimTK::Force::MobilityLinearDamper> dampers;
+  std::vector<JointKinematics> kinematics;
+  size_t pose_count = 0;  // bodies up to the last one a position output needs
   std::vector<Output> outputs;
   std::vector<std::string> output_names;
   std::vector<std::string> output_units;
@@ -584,11 +704,7 @@ Eigen::VectorXd MultibodyModel::CalcOutputs(const SimTK::State& state) const {
   // Positions from the description's kinematics; rates from Simbody, realized as far as needed.
   int highest_order = 0;
   for (int order : m.output_orders) highest_order = std::max(highest_order, order);
-  bool needs_poses = false;
-  for (const Impl::Output& output : m.outputs) {
-    needs_poses = needs_poses || OutputDerivativeOrder(output.type) == 0;
-  }
-  const std::vector<Impl::Pose> poses = needs_poses ? m.CalcPoses(q) : std::vector<Impl::Pose>();
+  const std::vector<Impl::Pose> poses = m.CalcPoses(q, m.pose_count);
   if (highest_order > 0) {
     m.system.realize(state,
                      highest_order == 1 ? SimTK::Stage::Velocity : SimTK::Stage::Acceleration);

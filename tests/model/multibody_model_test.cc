@@ -383,6 +383,33 @@ TEST(MultibodyModelTest, CraneDescriptionFileEqualsShorthand) {
   EXPECT_EQ(shorthand->parameters().size(), described->parameters().size());
 }
 
+// A massless frame on a pin whose only child turns on a perpendicular pin at the same point is
+// given to Simbody as one universal joint; a point on the frame keeps it a body. Both give the
+// same machine: M, C, H and a loaded equilibrium equal to roundoff.
+TEST(MultibodyModelTest, MergedMasslessFrameEqualsTheFrameAsABody) {
+  const std::string path = kSource + "/scenarios/reference-crane-description.yaml";
+  const auto merged = MakeModel(YamlReader::FromFile(path).Child("model"));
+  YAML::Node root = YAML::LoadFile(path);
+  root["model"]["points"]["yaw_pivot"] = YAML::Load("{body: yaw, at_m: [0, 0, 0]}");
+  const auto frame = MakeModel(YamlReader(root["model"], path, "model"));
+  EXPECT_EQ(merged->system().getMatterSubsystem().getNumBodies(),
+            4);                                                       // ground, base, slewing, boom
+  EXPECT_EQ(frame->system().getMatterSubsystem().getNumBodies(), 5);  // and yaw
+  const LinearModel a = merged->Linearize(), b = frame->Linearize();
+  EXPECT_LT((a.M - b.M).norm(), 1e-12 * a.M.norm());
+  EXPECT_LT((a.C - b.C).norm(), 1e-12 * a.C.norm());
+  EXPECT_LT((a.H - b.H).norm(), 1e-14);
+  const Eigen::VectorXd qa = merged->SolveStaticEquilibrium(merged->CalcPayloadLoads(650.0));
+  const Eigen::VectorXd qb = frame->SolveStaticEquilibrium(frame->CalcPayloadLoads(650.0));
+  EXPECT_LT((qa - qb).norm(), 1e-14);
+  Eigen::VectorXd q(4), u(4);
+  q << 0.2, -0.1, 0.3, -0.25;
+  u << 0.1, 0.2, -0.3, 0.4;
+  EXPECT_NEAR(merged->CalcEnergy(merged->MakeState(q, u)),
+              frame->CalcEnergy(frame->MakeState(q, u)),
+              1e-9 * std::abs(frame->CalcEnergy(frame->MakeState(q, u))));
+}
+
 struct BadCase {
   const char* name;
   const char* replace;  // text of kEveryJoint to replace
