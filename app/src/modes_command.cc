@@ -21,6 +21,11 @@ int RunModesCommand(const std::string& scenario_path, const CommonOptions& commo
     std::cout << fmt::format("{:>4} {:>14} {:>16} {:>13} {:>15}\n", "mode", "frequency_hz",
                              "decay_rate_per_s", "damping_ratio", "undamped_hz");
     for (size_t k = 0; k < modes.size(); ++k) {
+      if (modes[k].lambda == 0.0) {
+        std::cout << fmt::format("{:>4} {:>14} (a free coordinate's rigid-body motion)\n", k + 1,
+                                 "pole at 0");
+        continue;
+      }
       std::cout << fmt::format("{:>4} {:>14.9f} {:>16.9f} {:>13.9f} {:>15.9f}\n", k + 1,
                                modes[k].frequency_hz(), modes[k].decay_rate_per_s(),
                                modes[k].damping_ratio(), modes[k].undamped_frequency_hz());

@@ -34,9 +34,14 @@ std::vector<Mode> CalcModes(const LinearModel& linear) {
   const Eigen::EigenSolver<Eigen::MatrixXd> eigen(A);
   if (eigen.info() != Eigen::Success) throw std::runtime_error("CalcModes: eigensolver failed");
 
+  // Rigid-body motions (free coordinates) give a double pole at 0 that the eigensolver returns
+  // as +-1e-8 i or so: a pole at roundoff of the largest one is no oscillation.
+  const double roundoff = 1e-7 * std::max(1.0, eigen.eigenvalues().cwiseAbs().maxCoeff());
   std::vector<Mode> oscillatory, real;
   for (Eigen::Index k = 0; k < 2 * n; ++k) {
-    const std::complex<double> lambda = eigen.eigenvalues()[k];
+    std::complex<double> lambda = eigen.eigenvalues()[k];
+    // Both members become real poles at 0, as a double root should.
+    if (std::abs(lambda) < roundoff) lambda = 0.0;
     // Keep one member of each conjugate pair; a real pole is its own partner.
     if (lambda.imag() < 0) continue;
     Mode mode;

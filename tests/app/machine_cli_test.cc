@@ -52,6 +52,27 @@ TEST_F(MachineCliTest, CraneShorthandAndDescriptionGiveTheSameModes) {
   }
 }
 
+// A free coordinate (the swing without its drive's spring: a vertical axis, so gravity does not
+// drive it) is a rigid-body motion: two poles at 0, reported as such; the cycle still runs,
+// with Route 1 skipped and named why.
+TEST_F(MachineCliTest, FreeCoordinateIsARigidBodyMotion) {
+  const fs::path scenario =
+      WriteVariant(kScenarios / "excavator-arm.yaml", "free.yaml",
+                   "    swing: {stiffness_Nm_per_rad: 3.0e7, damping_Nms_per_rad: 2.0e5}\n", "");
+  const fs::path json = dir_ / "modes.json";
+  ASSERT_EQ(Run("modes " + scenario.string() + " --json " + json.string()).exit_code, 0);
+  const nlohmann::json modes = nlohmann::json::parse(ReadText(json))["modes"];
+  int rigid = 0;
+  for (const nlohmann::json& mode : modes) rigid += mode.value("rigid_body", false) ? 1 : 0;
+  EXPECT_EQ(rigid, 2);
+  EXPECT_EQ(modes.size(), 4u);  // boom and stick ring, the swing's double pole at 0
+  const CommandResult run = Run("run " + scenario.string() + " -o " + (dir_ / "run").string());
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("Route 1 (eq. 7): skipped; coordinate 'swing' has no spring"),
+            std::string::npos)
+      << run.err;
+}
+
 struct BadMachine {
   const char* name;
   const char* from;
