@@ -65,7 +65,7 @@ void SyncFolder(const std::string& path) {
 
 }  // namespace internal
 
-AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+AtomicFile::AtomicFile(std::string path, bool sync) : path_(std::move(path)), sync_(sync) {
   if (path_.empty()) {
     throw InputError("(output)", "", "empty output path", "a file name");
   }
@@ -100,7 +100,7 @@ void AtomicFile::Commit() {
   if (!fs::exists(temp_path_, ec)) {
     throw std::runtime_error("cannot commit " + path_ + ": nothing was written to " + temp_path_);
   }
-  internal::SyncFile(temp_path_);
+  if (sync_) internal::SyncFile(temp_path_);
   interrupt_cleanup_->Commit([this] {
     std::error_code error;
     fs::rename(temp_path_, path_, error);
@@ -110,7 +110,7 @@ void AtomicFile::Commit() {
     }
   });
   committed_ = true;
-  internal::SyncFolder(fs::path(path_).parent_path().string());
+  if (sync_) internal::SyncFolder(fs::path(path_).parent_path().string());
 }
 
 }  // namespace mbid

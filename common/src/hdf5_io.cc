@@ -297,7 +297,7 @@ void CheckNumeric(H5T_class_t type_class) {
 // ---- H5Writer -----------------------------------------------------------------------------
 
 struct H5Writer::Impl {
-  explicit Impl(const std::string& path) : atomic(path) {}
+  Impl(const std::string& path, bool sync) : atomic(path, sync) {}
 
   // Runs HDF5 calls for `object`, turning HDF5's exceptions into std::runtime_error.
   template <typename Body>
@@ -319,10 +319,10 @@ struct H5Writer::Impl {
   bool committed = false;
 };
 
-H5Writer::H5Writer(const std::string& path) {
+H5Writer::H5Writer(const std::string& path, bool sync) {
   H5Lock lock(H5Mutex());
   H5::Exception::dontPrint();
-  impl_ = std::make_unique<Impl>(path);
+  impl_ = std::make_unique<Impl>(path, sync);
   try {
     try {
       // In memory (the core driver without a backing store): HDF5 never meets a disk error.

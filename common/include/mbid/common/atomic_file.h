@@ -20,7 +20,9 @@ namespace mbid {
 // fails.
 class AtomicFile {
  public:
-  explicit AtomicFile(std::string path);
+  // `sync` false skips the fsyncs, for files whose reader checks them anyway (a campaign's case
+  // files: --resume reads each back and runs a damaged case again).
+  explicit AtomicFile(std::string path, bool sync = true);
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -33,6 +35,7 @@ class AtomicFile {
   std::string path_;
   std::string temp_path_;
   std::unique_ptr<RemoveOnInterrupt> interrupt_cleanup_;
+  bool sync_;
   bool committed_ = false;
 };
 
