@@ -305,4 +305,29 @@ TEST_F(OutputSafetyTest, AbsurdWorkerCountIsInvalidInput) {
   EXPECT_TRUE(Entries(work_).empty());
 }
 
+TEST_F(OutputSafetyTest, AFullDiskIsAFailureAndLeavesNothing) {
+  // A file-size limit fails writes (EFBIG) as a full disk does (ENOSPC). 100 blocks (50 or
+  // 100 KiB by the shell's block size) hold the figures but not run.h5 (about 200 kB).
+  const CommandResult result =
+      Run("run " + Scenario().string() + " --quiet -o " + (work_ / "out").string(),
+          "ulimit -f 100 && ");
+  EXPECT_EQ(result.exit_code, 1) << result.err;  // not 139 (SIGSEGV in HDF5) nor 153 (SIGXFSZ)
+  EXPECT_EQ(result.err.rfind("mbid: failure: cannot write ", 0), 0u) << result.err;
+  EXPECT_TRUE(Entries(work_).empty());
+}
+
+TEST_F(OutputSafetyTest, AWorkerThreadThatCannotStartEndsTheCampaignCleanly) {
+  // New threads get stacks of `ulimit -s` (2 GB here); in 3 GB of address space the second
+  // cannot start. std::thread then throws, which once ended in std::terminate (exit 134).
+  const fs::path campaign = Write("c.yaml", "name: c\nbase: " + kReference + "\nsweep:\n" +
+                                                "  - grid:\n      simulation.duration_s: [1, 2]\n");
+  const CommandResult result =
+      Run("campaign " + campaign.string() + " -o " + (work_ / "o").string() + " --workers 2",
+          "ulimit -s 2000000 && ulimit -v 3000000 && ");
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_NE(result.err.find("mbid: failure: cannot start worker thread"), std::string::npos)
+      << result.err;
+  EXPECT_TRUE(fs::exists(work_ / "o" / "campaign.json"));  // the folder stays resumable
+}
+
 }  // namespace
