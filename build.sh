@@ -31,7 +31,8 @@ cmake --build "$build_dir" -j2
 case "${1:-run}" in
   run)
     shift || true
-    "$build_dir/app/mbid" run "$@"
+    # Again and again into results/<name>/: replacing an earlier run's results is the point.
+    "$build_dir/app/mbid" run --overwrite "$@"
     ;;
   test)
     ctest --test-dir "$build_dir" --output-on-failure -j2 --timeout 900

@@ -8,6 +8,7 @@
 #include "mbid/app/scenario.h"
 #include "mbid/app/version.h"
 #include "mbid/common/error.h"
+#include "mbid/common/interrupt_cleanup.h"
 #include "mbid/identification/options.h"
 
 namespace {
@@ -42,6 +43,8 @@ int Main(int argc, char** argv) {
   run->add_option("SCENARIO", scenario_path, "Scenario YAML file")
       ->default_str("scenarios/reference-crane.yaml");
   run->add_option("-o,--output", output_dir, "Results folder (default results/<scenario name>)");
+  run->add_flag("--overwrite", common.overwrite,
+                "Replace the results folder if an earlier mbid run wrote it (never other folders)");
 
   std::string campaign_path;
   int campaign_workers = 0;
@@ -139,6 +142,8 @@ int Main(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // First, before any thread exists: SIGINT/SIGTERM then remove unfinished outputs.
+  mbid::InstallInterruptCleanup();
   try {
     return Main(argc, argv);
   } catch (const mbid::InputError& error) {

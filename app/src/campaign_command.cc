@@ -1,4 +1,8 @@
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <memory>
+#include <thread>
 
 #include "campaign/cluster.h"
 #include "mbid/app/campaign.h"
@@ -7,6 +11,20 @@
 #include "mbid/common/error.h"
 
 namespace mbid::app {
+namespace {
+
+// Threads beyond a few per core only add memory and contention; 100000 would fail to start.
+void CheckWorkerCount(int workers) {
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int most = 4 * cores;
+  if (workers > most) {
+    throw InputError("--workers", "",
+                     fmt::format("{} threads on {} core{}", workers, cores, cores > 1 ? "s" : ""),
+                     fmt::format("at most {} (4 per core)", most));
+  }
+}
+
+}  // namespace
 
 int RunCampaignCommand(const std::string& campaign_path, const std::string& output_dir, int workers,
                        bool resume, const CommonOptions& common) {
@@ -14,6 +32,7 @@ int RunCampaignCommand(const std::string& campaign_path, const std::string& outp
   const std::unique_ptr<internal::Cluster> cluster = internal::JoinCluster();
   Campaign campaign;
   try {
+    CheckWorkerCount(workers);
     campaign = LoadCampaign(campaign_path);
   } catch (const std::exception& error) {
     // Every rank finds the same mistake; rank 0 alone reports it.

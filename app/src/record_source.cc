@@ -31,8 +31,10 @@ RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
   entry.ExpectMap({"name", "file", "synthetic_modes"});
   RecordSource source;
   source.name = entry.String("name", default_name);
-  if (source.name.empty() || source.name.find('/') != std::string::npos) {
-    entry.FailAt("name", "'" + source.name + "'", "a non-empty test name without '/'");
+  // The name is an HDF5 group and, with several tests, the folder of the test's figures.
+  if (source.name.empty() || source.name.find('/') != std::string::npos || source.name == "." ||
+      source.name == "..") {
+    entry.FailAt("name", "'" + source.name + "'", "a non-empty test name without '/', not . or ..");
   }
   const bool has_file = entry.Has("file");
   if (has_file == entry.Has("synthetic_modes")) {

@@ -1,7 +1,6 @@
 #include "mbid/app/run_cycle.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -18,6 +17,7 @@
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
+#include "mbid/common/output_folder.h"
 #include "mbid/identification/identify.h"
 #include "mbid/identification/updating/result_io.h"
 #include "mbid/identification/updating/settings.h"
@@ -45,38 +45,6 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
 };
 
-// A results folder built under a temporary name and renamed over `final` on Commit().
-class StagingFolder {
- public:
-  explicit StagingFolder(fs::path final_path) : final_(std::move(final_path)) {
-    const fs::path parent = final_.has_parent_path() ? final_.parent_path() : fs::path(".");
-    std::error_code error;
-    fs::create_directories(parent, error);
-    if (error || !fs::is_directory(parent)) {
-      throw InputError(final_.string(), "", "cannot create the parent folder",
-                       "a writable location for the results");
-    }
-    staging_ = parent / fmt::format(".{}.tmp-{}", final_.filename().string(), ::getpid());
-    fs::remove_all(staging_);
-    fs::create_directories(staging_);
-  }
-  ~StagingFolder() {
-    std::error_code ignored;
-    if (!committed_) fs::remove_all(staging_, ignored);
-  }
-  fs::path operator/(const std::string& name) const { return staging_ / name; }
-  void Commit() {
-    fs::remove_all(final_);
-    fs::rename(staging_, final_);
-    committed_ = true;
-  }
-
- private:
-  fs::path final_;
-  fs::path staging_;
-  bool committed_ = false;
-};
-
 // The tests of the run: the scenario's records, or one test simulated from the model.
 std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::MechanicalModel& model,
                                   const simulation::Excitation& excitation,
@@ -84,7 +52,8 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
   std::vector<RunTest> tests;
   if (scenario.records.empty()) {
     RunTest test;
-    test.name = scenario.name;
+    // An HDF5 group name (/updating/tests/<name>): "." or "a/b" would be a path there.
+    test.name = SafeFileName(scenario.name, scenario.path, "name");
     test.origin = "simulation";
     test.simulation =
         simulation::Simulate(model, excitation, scenario.simulation, scenario.sensors);
@@ -166,16 +135,65 @@ std::string VerdictLine(const std::vector<RunTest>& tests, double threshold, boo
                      threshold, passed ? "PASSED" : "FAILED");
 }
 
+bool IsHdf5File(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string signature(8, '\0');
+  in.read(signature.data(), 8);
+  return in && signature == "\x89HDF\r\n\x1a\n";
+}
+
+bool IsRunSummary(const fs::path& path) {
+  std::ifstream in(path);
+  const nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
+  return summary.is_object() && summary.contains("scenario") && summary.contains("validation");
+}
+
+bool IsFigure(const fs::directory_entry& entry) {
+  std::error_code error;
+  return entry.is_regular_file(error) && !entry.is_symlink(error) &&
+         entry.path().extension() == ".png";
+}
+
 }  // namespace
+
+bool IsRunFolder(const std::string& folder) {
+  std::error_code error;
+  bool has_run_h5 = false;
+  bool has_summary = false;
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_symlink(error)) return false;
+    if (entry.is_directory(error)) {
+      // The figures of one test, when the run had several.
+      for (const auto& figure : fs::directory_iterator(entry.path(), error)) {
+        if (!IsFigure(figure)) return false;
+      }
+      if (error) return false;
+      continue;
+    }
+    if (!entry.is_regular_file(error)) return false;
+    if (name == "run.h5") {
+      has_run_h5 = IsHdf5File(entry.path());
+    } else if (name == "summary.json") {
+      has_summary = IsRunSummary(entry.path());
+    } else if (name != "report.md" && name != OutputFolder::kMarkerFile && !IsFigure(entry)) {
+      return false;
+    }
+  }
+  if (error) return false;
+  return (has_run_h5 && has_summary) || OutputFolder::HasMarker(folder, "run");
+}
 
 int RunValidationCycle(const std::string& scenario_path, const std::string& output_dir,
                        const CommonOptions& common) {
   const Progress progress(common.quiet);
   const Scenario scenario = LoadScenario(scenario_path);
+  // The name may hold anything YAML allows ("..", "a/b", "$(x)"): it must not choose the place.
   const fs::path final_dir =
-      output_dir.empty() ? fs::path("results") / scenario.name : fs::path(output_dir);
+      output_dir.empty() ? fs::path("results") / SafeFileName(scenario.name, scenario_path, "name")
+                         : fs::path(output_dir);
   progress.Say(fmt::format("scenario {} ({})", scenario.name, scenario_path));
-  StagingFolder folder(final_dir);
+  OutputFolder folder(final_dir, "run", common.overwrite, IsRunFolder);
 
   const auto model = scenario.MakeModel();
   const model::LinearModel linear = model->Linearize();

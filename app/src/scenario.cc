@@ -46,10 +46,8 @@ Scenario LoadScenarioFromText(const std::string& text, const std::string& source
   scenario.root.ExpectMap({"name", "model", "excitation", "simulation", "sensors", "record",
                            "identification", "updating", "validation"});
   scenario.name = scenario.root.String("name");
-  if (scenario.name.empty() || scenario.name.find('/') != std::string::npos) {
-    scenario.root.FailAt("name", "'" + scenario.name + "'",
-                         "a non-empty name without '/' (it names the results folder)");
-  }
+  // Any other name is made a safe folder name where it names the results folder.
+  if (scenario.name.empty()) scenario.root.FailAt("name", "''", "a non-empty name");
   // Build the model once so that every error surfaces at load time.
   const auto model = scenario.MakeModel();
   if (scenario.root.Has("excitation")) {

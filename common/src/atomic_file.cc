@@ -1,12 +1,15 @@
 #include "mbid/common/atomic_file.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
 
+#include "internal.h"
 #include "mbid/common/error.h"
 
 namespace mbid {
@@ -22,7 +25,47 @@ std::string MakeTempPath(const std::string& path) {
 
 }  // namespace
 
-AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+namespace internal {
+
+void WriteWholeFile(const std::string& path, const std::vector<char>& bytes) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  int error = fd < 0 ? errno : 0;
+  size_t written = 0;
+  while (error == 0 && written < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+    if (n > 0) {
+      written += static_cast<size_t>(n);
+    } else if (n == 0 || errno != EINTR) {
+      error = n == 0 ? EIO : errno;
+    }
+  }
+  if (fd >= 0 && ::close(fd) != 0 && error == 0) error = errno;
+  if (error != 0) {
+    throw std::runtime_error("cannot write " + path + ": " +
+                             std::error_code(error, std::generic_category()).message());
+  }
+}
+
+void SyncFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::fsync(fd) != 0) {
+    const std::error_code error(errno, std::generic_category());
+    if (fd >= 0) ::close(fd);
+    throw std::runtime_error("cannot write " + path + " to disk: " + error.message());
+  }
+  ::close(fd);
+}
+
+void SyncFolder(const std::string& path) {
+  const int fd = ::open(path.empty() ? "." : path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace internal
+
+AtomicFile::AtomicFile(std::string path, bool sync) : path_(std::move(path)), sync_(sync) {
   if (path_.empty()) {
     throw InputError("(output)", "", "empty output path", "a file name");
   }
@@ -32,10 +75,16 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
     throw InputError(path_, "", "directory '" + parent.string() + "' does not exist",
                      "an output path in an existing directory");
   }
-  if (fs::is_directory(path_, ec)) {
+  const fs::file_status status = fs::status(path_, ec);
+  if (fs::is_directory(status)) {
     throw InputError(path_, "", "is a directory", "an output file name");
   }
+  // Renaming over a device or a pipe would replace it with a plain file.
+  if (fs::exists(status) && !fs::is_regular_file(status)) {
+    throw InputError(path_, "", "exists and is not a regular file", "an output file name");
+  }
   temp_path_ = MakeTempPath(path_);
+  interrupt_cleanup_ = std::make_unique<RemoveOnInterrupt>(temp_path_);
 }
 
 AtomicFile::~AtomicFile() {
@@ -51,11 +100,17 @@ void AtomicFile::Commit() {
   if (!fs::exists(temp_path_, ec)) {
     throw std::runtime_error("cannot commit " + path_ + ": nothing was written to " + temp_path_);
   }
-  fs::rename(temp_path_, path_, ec);
-  if (ec) {
-    throw std::runtime_error("cannot rename " + temp_path_ + " to " + path_ + ": " + ec.message());
-  }
+  if (sync_) internal::SyncFile(temp_path_);
+  interrupt_cleanup_->Commit([this] {
+    std::error_code error;
+    fs::rename(temp_path_, path_, error);
+    if (error) {
+      throw std::runtime_error("cannot rename " + temp_path_ + " to " + path_ + ": " +
+                               error.message());
+    }
+  });
   committed_ = true;
+  if (sync_) internal::SyncFolder(fs::path(path_).parent_path().string());
 }
 
 }  // namespace mbid

@@ -25,6 +25,7 @@ constexpr int kFormatVersion = 1;
 constexpr hsize_t kChunkThreshold = 4096;
 constexpr hsize_t kChunkSize = 65536;  // 512 KiB of doubles: inside HDF5's default chunk cache.
 constexpr int kDeflateLevel = 4;       // Most of level 9's gain on smooth signals, much faster.
+constexpr size_t kCoreIncrement = 1 << 20;  // in-memory file growth: 1 MiB, few reallocations
 
 // The serial HDF5 library is not thread-safe; every call goes through this lock.
 std::recursive_mutex& H5Mutex() {
@@ -296,13 +297,15 @@ void CheckNumeric(H5T_class_t type_class) {
 // ---- H5Writer -----------------------------------------------------------------------------
 
 struct H5Writer::Impl {
-  explicit Impl(const std::string& path) : atomic(path) {}
+  Impl(const std::string& path, bool sync) : atomic(path, sync) {}
 
   // Runs HDF5 calls for `object`, turning HDF5's exceptions into std::runtime_error.
   template <typename Body>
   void Run(const std::string& object, Body&& body) {
     H5Lock lock(H5Mutex());
-    if (committed) throw std::logic_error("H5Writer: " + atomic.path() + " is already committed");
+    if (committed || !file) {
+      throw std::logic_error("H5Writer: " + atomic.path() + " is already committed or failed");
+    }
     try {
       body(*file);
     } catch (const H5::Exception& e) {
@@ -312,17 +315,24 @@ struct H5Writer::Impl {
   }
 
   AtomicFile atomic;  // declared first: removes the temporary after closing it
-  std::optional<H5::H5File> file;
+  std::unique_ptr<H5::H5File> file;
   bool committed = false;
 };
 
-H5Writer::H5Writer(const std::string& path) {
+H5Writer::H5Writer(const std::string& path, bool sync) {
   H5Lock lock(H5Mutex());
   H5::Exception::dontPrint();
-  impl_ = std::make_unique<Impl>(path);
+  impl_ = std::make_unique<Impl>(path, sync);
   try {
     try {
-      impl_->file.emplace(impl_->atomic.temp_path(), H5F_ACC_TRUNC);
+      // In memory (the core driver without a backing store): HDF5 never meets a disk error.
+      // HDF5 1.10.8 cannot recover from a failed write or close on disk (a full file system):
+      // the file's identifier stays half closed and closing it again, at the latest in
+      // H5close at exit, is a segmentation fault. Commit() writes the image itself.
+      H5::FileAccPropList access;
+      access.setCore(kCoreIncrement, false);
+      impl_->file = std::make_unique<H5::H5File>(impl_->atomic.temp_path(), H5F_ACC_TRUNC,
+                                                 H5::FileCreatPropList::DEFAULT, access);
     } catch (const H5::Exception& e) {
       throw std::runtime_error(
           fmt::format("cannot create HDF5 file {}: {}", impl_->atomic.temp_path(), Describe(e)));
@@ -421,9 +431,22 @@ void H5Writer::WriteDoubleAttribute(const std::string& group, const std::string&
 }
 
 void H5Writer::Commit() {
-  impl_->Run("the file", [](H5::H5File& file) { file.close(); });
-  H5Lock lock(H5Mutex());
-  impl_->file.reset();
+  std::vector<char> image;
+  {
+    H5Lock lock(H5Mutex());
+    impl_->Run("the file", [&image](H5::H5File& file) {
+      file.flush(H5F_SCOPE_GLOBAL);
+      const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
+      if (size < 0) throw H5::FileIException("H5Fget_file_image", "failed");
+      image.resize(static_cast<size_t>(size));
+      if (H5Fget_file_image(file.getId(), image.data(), image.size()) != size) {
+        throw H5::FileIException("H5Fget_file_image", "failed");
+      }
+      file.close();
+    });
+    impl_->file.reset();
+  }
+  internal::WriteWholeFile(impl_->atomic.temp_path(), image);
   impl_->atomic.Commit();
   impl_->committed = true;
 }

@@ -87,4 +87,14 @@ inline void CheckReadable(const std::string& path, const std::string& expected) 
     throw InputError(path, "", std::string("cannot read: ") + std::strerror(error), expected);
 }
 
+// Writes `bytes` as the whole content of `path` (created or truncated); throws
+// std::runtime_error naming the file and the system's reason (ENOSPC, EFBIG, EIO).
+void WriteWholeFile(const std::string& path, const std::vector<char>& bytes);
+// fsync of a written file, so that the rename that commits it cannot reach the disk before its
+// data; throws std::runtime_error naming the file (EIO, ENOSPC: the data is not safe).
+void SyncFile(const std::string& path);
+// fsync of a folder, so that renames and new entries in it survive a crash. Best effort: file
+// systems that cannot sync folders (EINVAL) are not an error.
+void SyncFolder(const std::string& path);
+
 }  // namespace mbid::internal

@@ -116,6 +116,9 @@ const BadRecord kBadRecords[] = {
      "record.synthetic_modes.channels", "outputs"},
     {"DuplicateNames", "record: [{name: t, file: s.yaml.csv}, {name: t, file: s.yaml.csv}]",
      "record", "unique"},
+    // With several tests the name is the folder of the test's figures: ".." was the parent.
+    {"DotDotName", "record: [{name: '..', file: s.yaml.csv}, {name: t, file: s.yaml.csv}]",
+     "record[0].name", "not . or .."},
     {"BothNoiseForms",
      "record: {synthetic_modes: {channels: [psi], noise_std_rad: 1.0e-4, target_correlation: "
      "0.9, modes: [{frequency_hz: 1, decay_rate_per_s: 1, amplitude_rad: 0.01}]}}",

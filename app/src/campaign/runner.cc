@@ -6,6 +6,7 @@
 #include <exception>
 #include <filesystem>
 #include <mutex>
+#include <system_error>
 #include <thread>
 
 #include "cluster.h"
@@ -204,27 +205,42 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
     wakeup.notify_all();
   };
   std::vector<std::thread> workers;
-  for (int w = 0; w < summary.workers; ++w) {
-    workers.emplace_back([&] {
-      try {
-        while (const std::optional<int> index = queue.Pop()) {
-          const CaseOutcome outcome =
-              ComputeCase(campaign, campaign.cases[static_cast<size_t>(*index)]);
-          WriteCaseFile(outcome, folder.CasePath(outcome.id));
-          if (!outcome.ok()) ++tally.failed;
-          ++tally.done;
-          notify_main();
-        }
-      } catch (...) {
-        // Not a case's failure (those are results) but the campaign's: its files cannot be
-        // written. Stop taking cases.
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!worker_error) worker_error = std::current_exception();
-        queue.Close();
+  const auto work = [&] {
+    try {
+      while (const std::optional<int> index = queue.Pop()) {
+        const CaseOutcome outcome =
+            ComputeCase(campaign, campaign.cases[static_cast<size_t>(*index)]);
+        WriteCaseFile(outcome, folder.CasePath(outcome.id));
+        if (!outcome.ok()) ++tally.failed;
+        ++tally.done;
+        notify_main();
       }
-      --running;
-      notify_main();
-    });
+    } catch (...) {
+      // Not a case's failure (those are results) but the campaign's: its files cannot be
+      // written. Stop taking cases.
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!worker_error) worker_error = std::current_exception();
+      queue.Close();
+    }
+    --running;
+    notify_main();
+  };
+  try {
+    for (int w = 0; w < summary.workers; ++w) workers.emplace_back(work);
+  } catch (const std::system_error& error) {
+    // Out of threads or memory for their stacks: stop the ones that started, then fail like any
+    // other campaign error (a joinable std::thread left behind would call std::terminate).
+    const auto started = workers.size();
+    running -= summary.workers - static_cast<int>(started);
+    queue.Close();
+    for (std::thread& worker : workers) worker.join();
+    const std::string message = fmt::format("cannot start worker thread {} of {}: {}", started + 1,
+                                            summary.workers, error.what());
+    if (cluster.size() > 1) {
+      std::fprintf(stderr, "mbid: failure: rank %d: %s\n", cluster.rank(), message.c_str());
+      cluster.Abort(1);
+    }
+    throw std::runtime_error(message);
   }
   const auto cases_start = std::chrono::steady_clock::now();
   size_t cursor = 0;

@@ -9,8 +9,9 @@ namespace mbid::app {
 
 // Options every command shares.
 struct CommonOptions {
-  bool quiet = false;     // no progress on standard error
-  std::string json_path;  // "" = none, "-" = standard output
+  bool quiet = false;      // no progress on standard error
+  std::string json_path;   // "" = none, "-" = standard output
+  bool overwrite = false;  // replace an output folder an earlier run of the command wrote
 };
 
 // `mbid modes SCENARIO [--json FILE]`: the linearized model and its exact modes.

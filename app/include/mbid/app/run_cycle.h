@@ -6,11 +6,18 @@
 
 namespace mbid::app {
 
-// `mbid run [SCENARIO] [-o DIR]`: the validation cycle (simulate the test -> identify ->
-// update -> re-simulate -> compare) with its report. Everything is written into a temporary
-// folder beside DIR and renamed into place at the end: a failed run leaves no partial results.
-// Returns the exit code.
+// `mbid run [SCENARIO] [-o DIR] [--overwrite]`: the validation cycle (simulate the test ->
+// identify -> update -> re-simulate -> compare) with its report. Everything is written into a
+// temporary folder beside DIR and renamed into place at the end: a failed run leaves no partial
+// results. DIR defaults to results/<scenario name, made a safe folder name>; an existing DIR is
+// replaced only if it is empty, or holds an earlier run's results and common.overwrite is set
+// (OutputFolder). Returns the exit code.
 int RunValidationCycle(const std::string& scenario_path, const std::string& output_dir,
                        const CommonOptions& common);
+
+// Whether `folder` holds the results of an earlier `mbid run` and nothing else: run.h5 and
+// summary.json (or the marker file of this version), report.md, PNG figures, and subfolders of
+// figures for several tests.
+bool IsRunFolder(const std::string& folder);
 
 }  // namespace mbid::app

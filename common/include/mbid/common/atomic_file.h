@@ -1,6 +1,9 @@
 #pragma once
 
+#include <memory>
 #include <string>
+
+#include "mbid/common/interrupt_cleanup.h"
 
 namespace mbid {
 
@@ -8,12 +11,18 @@ namespace mbid {
 // Commit() renames it into place; destruction without Commit() removes the temporary, so a
 // failed command leaves nothing behind (docs/interfaces: exit codes).
 //
-// The temporary is "<path>.tmp-<pid>-<n>" beside the target. The constructor throws InputError
-// when the target's directory does not exist or the target is a directory (a bad output flag);
-// Commit() throws std::runtime_error when nothing was written or the rename fails.
+// The temporary is "<path>.tmp-<pid>-<n>" beside the target; SIGINT/SIGTERM remove it
+// (interrupt_cleanup.h). Commit() syncs it to disk before the rename and the folder after it, so
+// that a crash leaves the old file or the new one, complete. An existing regular file is
+// replaced (the user named it). The constructor throws InputError when the target's directory
+// does not exist or the target exists and is not a regular file (a folder, a device: a bad output
+// flag); Commit() throws std::runtime_error when nothing was written, the sync or the rename
+// fails.
 class AtomicFile {
  public:
-  explicit AtomicFile(std::string path);
+  // `sync` false skips the fsyncs, for files whose reader checks them anyway (a campaign's case
+  // files: --resume reads each back and runs a damaged case again).
+  explicit AtomicFile(std::string path, bool sync = true);
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -25,6 +34,8 @@ class AtomicFile {
  private:
   std::string path_;
   std::string temp_path_;
+  std::unique_ptr<RemoveOnInterrupt> interrupt_cleanup_;
+  bool sync_;
   bool committed_ = false;
 };
 

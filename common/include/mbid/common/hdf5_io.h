@@ -23,7 +23,8 @@ namespace mbid {
 // the serial HDF5 library is not thread-safe.
 class H5Writer {
  public:
-  explicit H5Writer(const std::string& path);
+  // `sync`: as for AtomicFile.
+  explicit H5Writer(const std::string& path, bool sync = true);
   ~H5Writer();
   H5Writer(const H5Writer&) = delete;
   H5Writer& operator=(const H5Writer&) = delete;
