@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace mbid::app {
 namespace {
 
@@ -34,9 +36,33 @@ void WriteModelTruth(H5Writer& file, const model::MechanicalModel& model) {
   file.WriteStrings("/truth/linear_model", "coordinates", linear.coordinates);
   file.WriteStrings("/truth/linear_model", "outputs", linear.outputs);
   file.WriteMatrix("/truth/linear_model", "M", linear.M, "kg*m^2");
-  file.WriteMatrix("/truth/linear_model", "D", linear.D, "N*m*s/rad");
-  file.WriteMatrix("/truth/linear_model", "C", linear.C, "N*m/rad");
-  file.WriteMatrix("/truth/linear_model", "H", linear.H, "rad/rad");
+  const std::vector<std::string> coordinate_units = model.coordinate_units();
+  const bool angles = std::all_of(coordinate_units.begin(), coordinate_units.end(),
+                                  [](const std::string& unit) { return unit == "rad"; });
+  file.WriteStrings("/truth/linear_model", "coordinate_units", coordinate_units);
+  file.WriteStrings("/truth/linear_model", "output_units", model.output_units());
+  std::vector<double> orders(linear.outputs.size(), 0.0);
+  for (size_t i = 0; i < linear.output_orders.size() && i < orders.size(); ++i) {
+    orders[i] = linear.output_orders[i];
+  }
+  file.WriteVector(
+      "/truth/linear_model", "output_orders",
+      Eigen::Map<const Eigen::VectorXd>(orders.data(), static_cast<Eigen::Index>(orders.size())),
+      "1");
+  // Mixed machines (angles and slides) have no single unit per matrix.
+  const bool plain_outputs =
+      std::all_of(model.output_units().begin(), model.output_units().end(),
+                  [](const std::string& unit) { return unit == "rad"; }) &&
+      std::all_of(orders.begin(), orders.end(), [](double order) { return order == 0; });
+  file.WriteMatrix("/truth/linear_model", "M", linear.M, angles ? "kg*m^2" : "SI, per coordinate");
+  file.WriteMatrix("/truth/linear_model", "D", linear.D,
+                   model::DampingMatrixUnits(coordinate_units));
+  file.WriteMatrix("/truth/linear_model", "C", linear.C,
+                   model::StiffnessMatrixUnits(coordinate_units));
+  file.WriteMatrix("/truth/linear_model", "H", linear.H,
+                   angles && plain_outputs
+                       ? "rad/rad"
+                       : "output_units per coordinate_units (and output_orders)");
 
   const std::vector<model::Mode> modes = model::CalcModes(linear);
   file.WriteVector("/truth/modes", "frequency_hz", ModeField(modes, &model::Mode::frequency_hz),

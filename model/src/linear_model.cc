@@ -15,6 +15,35 @@ double Mode::undamped_frequency_hz() const { return std::abs(lambda) / (2 * M_PI
 double Mode::log_decrement() const { return 2 * M_PI * decay_rate_per_s() / lambda.imag(); }
 double Mode::half_life_s() const { return std::log(2.0) / decay_rate_per_s(); }
 
+std::string StiffnessUnits(const std::string& coordinate_unit) {
+  return coordinate_unit == "m" ? "N/m" : "N*m/rad";
+}
+
+std::string DampingUnits(const std::string& coordinate_unit) {
+  return coordinate_unit == "m" ? "N*s/m" : "N*m*s/rad";
+}
+
+namespace {
+
+std::string MatrixUnits(const std::vector<std::string>& coordinate_units,
+                        std::string (*units)(const std::string&)) {
+  const std::string first = units(coordinate_units.empty() ? "rad" : coordinate_units[0]);
+  for (const std::string& unit : coordinate_units) {
+    if (units(unit) != first) return "SI, per coordinate (coordinate_units)";
+  }
+  return first;
+}
+
+}  // namespace
+
+std::string StiffnessMatrixUnits(const std::vector<std::string>& coordinate_units) {
+  return MatrixUnits(coordinate_units, &StiffnessUnits);
+}
+
+std::string DampingMatrixUnits(const std::vector<std::string>& coordinate_units) {
+  return MatrixUnits(coordinate_units, &DampingUnits);
+}
+
 std::vector<Mode> CalcModes(const LinearModel& linear) {
   const Eigen::Index n = linear.M.rows();
   if (linear.M.cols() != n || linear.C.rows() != n || linear.C.cols() != n ||

@@ -607,8 +607,8 @@ std::vector<Parameter> MultibodyModel::parameters() const {
       const SpringDescription* spring = machine.FindSpring(impl_->coordinates[i]);
       if (spring == nullptr) continue;
       const bool translational = impl_->coordinate_data[i].translational;
-      const std::string units =
-          stiffness ? (translational ? "N/m" : "N*m/rad") : (translational ? "N*s/m" : "N*m*s/rad");
+      const std::string unit = translational ? "m" : "rad";
+      const std::string units = stiffness ? StiffnessUnits(unit) : DampingUnits(unit);
       result.push_back({(stiffness ? "c_" : "d_") + impl_->coordinates[i], units,
                         stiffness ? spring->stiffness : spring->damping, 0.0, inf});
     }
@@ -821,6 +821,8 @@ LinearModel MultibodyModel::Linearize() const {
   linear.coordinates = impl_->coordinates;
   linear.outputs = impl_->output_names;
   linear.output_orders = impl_->output_orders;
+  linear.coordinate_units = impl_->coordinate_units;
+  linear.output_units = impl_->output_units;
   linear.M = rest.M;
   linear.H = rest.H;
   linear.C = rest.K_g;

@@ -410,6 +410,18 @@ TEST(MultibodyModelTest, MergedMasslessFrameEqualsTheFrameAsABody) {
               1e-9 * std::abs(frame->CalcEnergy(frame->MakeState(q, u))));
 }
 
+// Units follow the coordinates: a machine of angles keeps the crane's units, a mixed one says
+// that its matrices are per coordinate.
+TEST(MultibodyModelTest, MatrixUnitsFollowTheCoordinates) {
+  EXPECT_EQ(StiffnessMatrixUnits({"rad", "rad"}), "N*m/rad");
+  EXPECT_EQ(DampingMatrixUnits({"m"}), "N*s/m");
+  EXPECT_EQ(StiffnessMatrixUnits({"rad", "m"}), "SI, per coordinate (coordinate_units)");
+  const LinearModel linear = FromYaml(kEveryJoint)->Linearize();
+  EXPECT_EQ(linear.coordinate_units, (std::vector<std::string>{"m", "rad", "rad", "rad"}));
+  EXPECT_EQ(linear.output_units, (std::vector<std::string>{"rad", "rad", "m", "m", "m/s", "m/s^2",
+                                                           "rad/s", "rad"}));
+}
+
 struct BadCase {
   const char* name;
   const char* replace;  // text of kEveryJoint to replace

@@ -339,6 +339,7 @@ CharacteristicProblem MakeCharacteristicProblem(
   problem.H = linear.H;
   problem.output_orders = linear.output_orders;
   problem.coordinates = linear.coordinates;
+  problem.coordinate_units = linear.coordinate_units;
   problem.outputs = linear.outputs;
   problem.lambda = lambda;
   problem.record = record;
@@ -396,6 +397,7 @@ CharacteristicResult SolveCharacteristicEquation(const CharacteristicProblem& pr
   CharacteristicResult result;
   result.lambda = problem.lambda;
   result.coordinates = problem.coordinates;
+  result.coordinate_units = problem.coordinate_units;
   result.outputs = problem.outputs;
   result.starts = options.starts;
   result.best_residual = std::numeric_limits<double>::infinity();

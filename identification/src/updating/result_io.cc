@@ -5,6 +5,8 @@
 #include <limits>
 #include <map>
 
+#include "mbid/model/linear_model.h"
+
 namespace mbid::updating {
 namespace {
 
@@ -194,10 +196,13 @@ void WriteCharacteristicGroup(H5Writer& file, const CharacteristicResult& result
     displacement[s] = set.admissible ? set.displacement_mismatch : nan;
     velocity[s] = set.admissible ? set.velocity_mismatch : nan;
   }
-  file.WriteMatrix(group, "c", c, "N*m/rad");
-  file.WriteMatrix(group, "d", d, "N*m*s/rad");
-  file.WriteMatrix(group, "initial_q", q0, "rad");
-  file.WriteMatrix(group, "initial_u", u0, "rad/s");
+  const std::vector<std::string>& units = result.coordinate_units;
+  const bool lengths =
+      std::any_of(units.begin(), units.end(), [](const std::string& unit) { return unit == "m"; });
+  file.WriteMatrix(group, "c", c, model::StiffnessMatrixUnits(units));
+  file.WriteMatrix(group, "d", d, model::DampingMatrixUnits(units));
+  file.WriteMatrix(group, "initial_q", q0, lengths ? "SI, per coordinate" : "rad");
+  file.WriteMatrix(group, "initial_u", u0, lengths ? "SI, per coordinate" : "rad/s");
   file.WriteVector(group, "residual", residual, "1");
   file.WriteVector(group, "admissible", admissible, "1");
   file.WriteVector(group, "mismatch", mismatch, "1");

@@ -21,7 +21,18 @@ struct LinearModel {
   // Per output, the derivative of q that H maps: 0 (y = H q), 1 (y = H q'), 2 (y = H q'').
   // Empty means all 0.
   std::vector<int> output_orders;
+  // Per coordinate "rad" or "m", per output its unit; empty means all "rad".
+  std::vector<std::string> coordinate_units;
+  std::vector<std::string> output_units;
 };
+
+// The unit of a stiffness ("N*m/rad", "N/m") or damping ("N*m*s/rad", "N*s/m") of one
+// coordinate, and of a whole matrix of them ("SI, per coordinate" when the coordinates mix
+// angles and lengths).
+std::string StiffnessUnits(const std::string& coordinate_unit);
+std::string DampingUnits(const std::string& coordinate_unit);
+std::string StiffnessMatrixUnits(const std::vector<std::string>& coordinate_units);
+std::string DampingMatrixUnits(const std::vector<std::string>& coordinate_units);
 
 // One complex pole of the first-order system and its shape. For an underdamped pair only the
 // member with Im(lambda) > 0 is kept.

@@ -32,8 +32,9 @@ struct CharacteristicProblem {
   Eigen::MatrixXd H;    // m x n, rad/rad
   // Per output, the derivative of q that H maps (model::LinearModel::output_orders); empty: 0.
   std::vector<int> output_orders;
-  std::vector<std::string> coordinates;  // n names: parameters are c_<name>, d_<name>
-  std::vector<std::string> outputs;      // m names: the rows of H, matched to record channels
+  std::vector<std::string> coordinate_units;  // "rad" or "m" per coordinate; empty: all "rad"
+  std::vector<std::string> coordinates;       // n names: parameters are c_<name>, d_<name>
+  std::vector<std::string> outputs;           // m names: the rows of H, matched to record channels
   // Identified poles, one per mode (Im > 0), 1/s. n of them.
   std::vector<std::complex<double>> lambda;
   // Typical values (> 0): the multi-start draws around them and the equations are scaled by
@@ -112,6 +113,7 @@ struct CharacteristicResult {
   Status status = Status::kNoSolution;
   std::vector<std::complex<double>> lambda;
   std::vector<std::string> coordinates;
+  std::vector<std::string> coordinate_units;  // "rad" or "m" per coordinate; empty: all "rad"
   std::vector<std::string> outputs;
   // Admissible sets first, by ascending mismatch (or distance to the reference without a
   // record), then the others by residual.
