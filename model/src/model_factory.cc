@@ -112,7 +112,8 @@ std::unique_ptr<MechanicalModel> MakeModel(const YamlReader& model) {
   const std::string type =
       model.Choice("type", {"truck_crane", "multibody", "torsional_oscillator"}, "truck_crane");
   if (type == "torsional_oscillator") {
-    return std::make_unique<TorsionalOscillator>(ReadTorsionalOscillatorParameters(model));
+    return std::make_unique<MultibodyModel>(
+        MakeTorsionalOscillator(ReadTorsionalOscillatorParameters(model)));
   }
   try {
     if (type == "multibody") return std::make_unique<MultibodyModel>(ReadMachineDescription(model));

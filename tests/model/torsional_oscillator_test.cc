@@ -1,4 +1,5 @@
-// The one-joint model against its closed form.
+// The one-joint model (its machine description, as `type: torsional_oscillator` expands)
+// against its closed form.
 #include "mbid/model/torsional_oscillator.h"
 
 #include <gtest/gtest.h>
@@ -14,7 +15,7 @@ namespace {
 
 TEST(TorsionalOscillatorTest, ModesAreTheClosedForm) {
   // J = 2, c = 800, d = 8: lambda = -2 +- i sqrt(400 - 4) (1/s).
-  const TorsionalOscillator oscillator({2.0, 800.0, 8.0});
+  const MultibodyModel oscillator = MakeTorsionalOscillator({2.0, 800.0, 8.0});
   const std::vector<Mode> modes = CalcModes(oscillator.Linearize());
   ASSERT_EQ(modes.size(), 1u);
   EXPECT_NEAR(modes[0].lambda.real(), -2.0, 1e-12);
@@ -25,7 +26,7 @@ TEST(TorsionalOscillatorTest, ModesAreTheClosedForm) {
 
 TEST(TorsionalOscillatorTest, OverdampedPolesAreReal) {
   // d^2 > 4 J c: two real poles -d/2J +- sqrt((d/2J)^2 - c/J) = -5 +- 3.
-  const TorsionalOscillator oscillator({1.0, 16.0, 10.0});
+  const MultibodyModel oscillator = MakeTorsionalOscillator({1.0, 16.0, 10.0});
   const std::vector<Mode> modes = CalcModes(oscillator.Linearize());
   ASSERT_EQ(modes.size(), 2u);
   EXPECT_NEAR(modes[0].lambda.real(), -2.0, 1e-12);
@@ -34,7 +35,7 @@ TEST(TorsionalOscillatorTest, OverdampedPolesAreReal) {
 
 TEST(TorsionalOscillatorTest, RimLoadEquilibriumSolvesTheNonlinearBalance) {
   // c theta = F cos(theta) at the rim (1 m): the residual vanishes to roundoff of c theta.
-  const TorsionalOscillator oscillator({1.0, 100.0, 1.0});
+  const MultibodyModel oscillator = MakeTorsionalOscillator({1.0, 100.0, 1.0});
   const double F = 50.0;
   const double theta = oscillator.SolveStaticEquilibrium({{"rim", {0, F, 0}}})[0];
   EXPECT_NEAR(100.0 * theta, F * std::cos(theta), 1e-13);

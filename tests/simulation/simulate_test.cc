@@ -231,7 +231,7 @@ TEST(SimulateTest, TorsionalOscillatorFollowsItsClosedForm) {
   // J theta'' + d theta' + c theta = 0 from theta0 at rest:
   // theta = theta0 e^{-s t} (cos w t + s/w sin w t), s = d/2J, w = sqrt(c/J - s^2).
   const double J = 2.0, c = 800.0, d = 8.0, theta0 = 0.01;
-  const model::TorsionalOscillator oscillator({J, c, d});
+  const model::MultibodyModel oscillator = model::MakeTorsionalOscillator({J, c, d});
   Excitation excitation;
   excitation.type = Excitation::Type::kInitialDeflection;
   excitation.deflection_rad = {{"angle", theta0}};
