@@ -302,6 +302,46 @@ laws:
   EXPECT_NE(report.find("### truth.c_angle (N*m/rad)"), std::string::npos) << report;
 }
 
+TEST_F(CampaignTest, LawUnitsComeFromTheModel) {
+  // A described machine on a slide: its stiffness is in N/m, which the parameter's name (c_z)
+  // does not say; the law's unit comes from the model. The sweep is over model.parameters.
+  Write("slider.yaml", R"(name: slider
+model:
+  type: multibody
+  parameters: {mass_kg: 100.0}
+  bodies:
+    carriage: {parent: ground, joint: {type: prismatic, coordinates: [z], axis: [0, 0, 1]},
+               mass_kg: mass_kg, inertia_kgm2: [1, 1, 1]}
+  springs:
+    z: {stiffness_N_per_m: 1.0e5, damping_Ns_per_m: 100}
+  outputs:
+    z: {type: coordinate, coordinate: z}
+excitation: {type: initial_deflection, deflection_m: {z: 0.001}}
+sensors: {channels: [z]}
+)");
+  const Campaign campaign = LoadCampaign(Write("laws.yaml", R"(name: laws
+base: slider.yaml
+steps: [modes]
+sweep:
+  - list:
+      model.parameters.mass_kg: [100, 200, 300]
+study: laws
+laws:
+  variables: [model.parameters.mass_kg]
+  quantities: [truth.c_z, truth.d_z]
+  degree: 1
+)"));
+  CampaignRunOptions options;
+  options.quiet = true;
+  const std::string out = (dir_ / "out").string();
+  RunCampaign(campaign, out, options);
+  std::ifstream in(out + "/report.md");
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("### truth.c_z (N/m)"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("### truth.d_z (N*s/m)"), std::string::npos) << text.str();
+}
+
 TEST_F(CampaignTest, IdentificationSettingsAreReadStrictly) {
   Write("oscillator.yaml", kOscillator);
   // The scenario's identification: section reaches the identifier (prony-svd with p = 6 on the

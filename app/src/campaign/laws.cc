@@ -252,7 +252,7 @@ std::vector<PolynomialLaw> FitLaws(const LawsSpec& spec,
 void WriteLaws(H5Writer& file, const std::vector<PolynomialLaw>& laws) {
   for (const PolynomialLaw& law : laws) {
     const std::string group = "/laws/" + law.quantity;
-    const std::string unit = internal::UnitOfColumn(law.quantity);
+    const std::string unit = law.units.empty() ? internal::UnitOfColumn(law.quantity) : law.units;
     file.WriteStringAttribute(group, "status", law.status);
     file.WriteStrings(group, "variables", law.variables);
     std::vector<std::string> terms, units;
@@ -296,7 +296,7 @@ std::string LawsReport(const LawsSpec& spec, const std::vector<PolynomialLaw>& l
   const bool gnuplot = GnuplotAvailable();
   for (size_t q = 0; q < laws.size(); ++q) {
     const PolynomialLaw& law = laws[q];
-    const std::string unit = internal::UnitOfColumn(law.quantity);
+    const std::string unit = law.units.empty() ? internal::UnitOfColumn(law.quantity) : law.units;
     md << "### " << law.quantity << " (" << unit << ")\n\n";
     if (law.status != "ok") {
       md << "Not fitted: " << law.status << ".\n\n";

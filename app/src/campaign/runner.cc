@@ -13,12 +13,15 @@
 #include "h5_merge.h"
 #include "mbid/app/campaign_case.h"
 #include "mbid/app/campaign_runner.h"
+#include "mbid/app/scenario.h"
 #include "mbid/common/atomic_file.h"
 #include "mbid/common/hdf5_io.h"
+#include "mbid/model/mechanical_model.h"
 #include "progress.h"
 #include "report.h"
 #include "results_folder.h"
 #include "summary_table.h"
+#include "units.h"
 
 namespace mbid::app {
 namespace {
@@ -94,7 +97,17 @@ int FinishCampaign(const Campaign& campaign, const internal::ResultsFolder& fold
         DamperSizingReport(campaign.damper_sizing, result, folder.Path(""), &study.figures);
   } else if (campaign.study == CampaignStudy::kLaws) {
     progress.Say("fitting the laws");
-    const std::vector<PolynomialLaw> laws = FitLaws(campaign.laws, rows);
+    std::vector<PolynomialLaw> laws = FitLaws(campaign.laws, rows);
+    // Stiffness and damping units from the base model: N*m/rad on pins, N/m on slides.
+    const std::vector<model::Parameter> parameters =
+        LoadScenarioFromText(YAML::Dump(campaign.base), campaign.base_source)
+            .MakeModel()
+            ->parameters();
+    for (PolynomialLaw& law : laws) {
+      for (const model::Parameter& parameter : parameters) {
+        if (internal::ShortName(law.quantity) == parameter.name) law.units = parameter.units;
+      }
+    }
     H5Writer file(study_path);
     WriteLaws(file, laws);
     file.Commit();

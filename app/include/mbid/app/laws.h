@@ -33,6 +33,7 @@ LawsSpec ReadLaws(const YamlReader& section, const std::vector<std::string>& swe
 // independent errors of equal variance); with N = P the fit is exact and the std is NaN.
 struct PolynomialLaw {
   std::string quantity;
+  std::string units;  // the quantity's unit (the model's, for c_ and d_ parameters)
   std::vector<std::string> variables;
   std::vector<std::vector<int>> exponents;  // per term, per variable; graded order
   Eigen::VectorXd coefficients;             // of the raw variables
