@@ -25,6 +25,7 @@
 
 #include "mbid/common/error.h"
 #include "mbid/identification/identify.h"
+#include "mbid/identification/spectrum.h"
 #include "signals.h"
 
 namespace {
@@ -213,6 +214,41 @@ void BM_Scaling(benchmark::State& state, bool extras) {
   for (auto _ : state) modes = Identify(record.measurement, options).modes.size();
   state.counters["modes"] = static_cast<double>(modes);
 }
+// The spectrum's peak search on a clean 51.2 kHz ring-down (151.6 Hz, decay 3/s): one peak and
+// thousands of side lobes. Arg: samples. The walking definition is the anchor (O(n^2) here).
+Eigen::VectorXd CleanRingDownSpectrum(int samples) {
+  const double tau = 1.0 / 51200;
+  Eigen::MatrixXd y(samples, 1);
+  for (int j = 0; j < samples; ++j) {
+    y(j, 0) = std::exp(-3.0 * j * tau) * std::sin(2 * M_PI * 151.6 * j * tau);
+  }
+  return mbid::identification::CalcSpectrum(y, tau, mbid::identification::SpectrumOptions{})
+      .amplitude.col(0);
+}
+
+void BM_FindPeaks(benchmark::State& state, bool walking) {
+  const Eigen::VectorXd amplitude = CleanRingDownSpectrum(static_cast<int>(state.range(0)));
+  std::vector<int> peaks;
+  for (auto _ : state) {
+    peaks = walking ? mbid::identification::internal::FindPeaksByWalking(amplitude, 0.01)
+                    : mbid::identification::FindPeaks(amplitude, 0.01);
+    benchmark::DoNotOptimize(peaks.data());
+  }
+  state.counters["bins"] = static_cast<double>(amplitude.size());
+  state.counters["peaks"] = static_cast<double>(peaks.size());
+}
+BENCHMARK_CAPTURE(BM_FindPeaks, one_pass, false)
+    ->Arg(1 << 14)
+    ->Arg(1 << 16)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FindPeaks, walking_anchor, true)
+    ->Arg(1 << 14)
+    ->Arg(1 << 16)
+    ->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+
 BENCHMARK_CAPTURE(BM_Scaling, defaults, true)
     ->Arg(1000)
     ->Arg(10000)

@@ -16,6 +16,36 @@ int NextPowerOfTwo(long long n) {
 
 }  // namespace
 
+namespace {
+
+// For each sample, the lowest value between it and the nearest strictly higher sample towards
+// the start (or the start itself), itself included: one pass with a stack of ever higher
+// samples, each carrying the lowest value since the previous one. Every sample is pushed and
+// popped once, so the pass is O(n) where walking from each maximum was O(n^2) on the many small
+// side lobes of a clean spectrum.
+template <typename At>
+std::vector<double> CalcLowestTowardsStart(int n, At at) {
+  struct Entry {
+    double height;
+    double lowest;  // since the entry below it on the stack (exclusive), itself included
+  };
+  std::vector<Entry> stack;
+  std::vector<double> lowest(static_cast<size_t>(n));
+  for (int j = 0; j < n; ++j) {
+    const double height = at(j);
+    double low = height;
+    while (!stack.empty() && stack.back().height <= height) {
+      low = std::min(low, stack.back().lowest);
+      stack.pop_back();
+    }
+    lowest[static_cast<size_t>(j)] = low;
+    stack.push_back({height, low});
+  }
+  return lowest;
+}
+
+}  // namespace
+
 std::vector<int> FindPeaks(const Eigen::VectorXd& amplitude, double min_relative_prominence,
                            std::vector<double>* prominence) {
   std::vector<int> peaks;
@@ -23,12 +53,36 @@ std::vector<int> FindPeaks(const Eigen::VectorXd& amplitude, double min_relative
   const int n = static_cast<int>(amplitude.size());
   if (n < 3) return peaks;
   const double threshold = min_relative_prominence * amplitude.maxCoeff();
+  const std::vector<double> left = CalcLowestTowardsStart(n, [&](int j) { return amplitude(j); });
+  const std::vector<double> right =
+      CalcLowestTowardsStart(n, [&](int j) { return amplitude(n - 1 - j); });
   for (int i = 1; i + 1 < n; ++i) {
     const double height = amplitude(i);
     // A plateau counts once, at its left end.
     if (!(height > amplitude(i - 1) && height >= amplitude(i + 1))) continue;
-    // Lowest point on each side before a strictly higher sample (or the end). Scans stop at
-    // the first higher sample, so only the few tallest peaks walk far.
+    const double p =
+        height - std::max(left[static_cast<size_t>(i)], right[static_cast<size_t>(n - 1 - i)]);
+    if (p > 0 && p >= threshold) {
+      peaks.push_back(i);
+      if (prominence != nullptr) prominence->push_back(p);
+    }
+  }
+  return peaks;
+}
+
+namespace internal {
+
+std::vector<int> FindPeaksByWalking(const Eigen::VectorXd& amplitude,
+                                    double min_relative_prominence,
+                                    std::vector<double>* prominence) {
+  std::vector<int> peaks;
+  if (prominence != nullptr) prominence->clear();
+  const int n = static_cast<int>(amplitude.size());
+  if (n < 3) return peaks;
+  const double threshold = min_relative_prominence * amplitude.maxCoeff();
+  for (int i = 1; i + 1 < n; ++i) {
+    const double height = amplitude(i);
+    if (!(height > amplitude(i - 1) && height >= amplitude(i + 1))) continue;
     double left_min = height;
     for (int j = i - 1; j >= 0 && amplitude(j) <= height; --j) {
       left_min = std::min(left_min, amplitude(j));
@@ -45,6 +99,8 @@ std::vector<int> FindPeaks(const Eigen::VectorXd& amplitude, double min_relative
   }
   return peaks;
 }
+
+}  // namespace internal
 
 Spectrum CalcSpectrum(const Eigen::MatrixXd& values, double sample_interval_s,
                       const SpectrumOptions& options) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 namespace mbid::identification {
 namespace {
@@ -77,6 +78,41 @@ TEST(SpectrumTest, ProminenceByHand) {
   EXPECT_DOUBLE_EQ(prominence[2], 3.0);
   // Relative threshold 0.5 of the largest value (5): 2.5; peak 1 (2) is dropped.
   EXPECT_EQ(FindPeaks(a, 0.5), (std::vector<int>{3, 5}));
+}
+
+// The one-pass FindPeaks against the definition (walking from each maximum to the next higher
+// sample) on spectra of every kind: white noise, quantized values with plateaus and ties, and
+// the clean decaying spectrum with thousands of side lobes where walking was quadratic. Mins
+// and maxes are exact, so the peaks and prominences must be equal to the bit.
+TEST(SpectrumTest, OnePassPeaksEqualTheWalkingDefinition) {
+  std::mt19937_64 random(11);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 30; ++trial) {
+    const int n = 50 + 97 * trial;
+    Eigen::VectorXd a(n);
+    for (int i = 0; i < n; ++i) {
+      a[i] = trial % 3 == 0 ? std::abs(normal(random))
+             : trial % 3 == 1
+                 ? std::round(4 * std::abs(normal(random)))  // ties, plateaus
+                 : std::abs(std::sin(0.37 * i)) / (1 + 0.01 * i) + 1e-3 * normal(random);
+    }
+    for (double threshold : {0.0, 0.01, 0.3}) {
+      std::vector<double> p_fast, p_walk;
+      EXPECT_EQ(FindPeaks(a, threshold, &p_fast),
+                internal::FindPeaksByWalking(a, threshold, &p_walk))
+          << trial;
+      EXPECT_EQ(p_fast, p_walk) << trial;
+    }
+  }
+  // A long clean ring-down's spectrum: one peak, many lobes.
+  const double tau = 1.0 / 51200;
+  Eigen::MatrixXd y(1 << 13, 1);
+  for (int j = 0; j < y.rows(); ++j)
+    y(j, 0) = std::exp(-3.0 * j * tau) * std::sin(2 * M_PI * 151.6 * j * tau);
+  SpectrumOptions options;
+  const Spectrum spectrum = CalcSpectrum(y, tau, options);
+  EXPECT_EQ(FindPeaks(spectrum.amplitude.col(0), 0.0),
+            internal::FindPeaksByWalking(spectrum.amplitude.col(0), 0.0));
 }
 
 }  // namespace

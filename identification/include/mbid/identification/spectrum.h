@@ -33,7 +33,16 @@ Spectrum CalcSpectrum(const Eigen::MatrixXd& values, double sample_interval_s,
 // Indices of the local maxima of `amplitude` (not at either end) whose topographic prominence
 // is at least min_relative_prominence times the largest value; `prominence` (if given) gets
 // each one's prominence. Ascending index.
+// O(n): one pass each way for the lowest value before a higher sample.
 std::vector<int> FindPeaks(const Eigen::VectorXd& amplitude, double min_relative_prominence,
                            std::vector<double>* prominence = nullptr);
+
+namespace internal {
+// The same by walking from every maximum to the next higher sample: O(n^2) on clean spectra.
+// The definition FindPeaks is tested against, and the anchor of its benchmark.
+std::vector<int> FindPeaksByWalking(const Eigen::VectorXd& amplitude,
+                                    double min_relative_prominence,
+                                    std::vector<double>* prominence = nullptr);
+}  // namespace internal
 
 }  // namespace mbid::identification
