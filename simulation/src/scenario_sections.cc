@@ -68,7 +68,7 @@ struct UnitSuffix {
 constexpr UnitSuffix kUnitSuffixes[] = {
     {"rad", "rad"}, {"m", "m"}, {"mps", "m/s"}, {"mps2", "m/s^2"}, {"radps", "rad/s"}};
 
-std::vector<std::string> SensorKeys(const std::string& base) {
+std::vector<std::string> SensorKeysImpl(const std::string& base) {
   std::vector<std::string> keys;
   for (const UnitSuffix& unit : kUnitSuffixes) keys.push_back(base + "_" + unit.suffix);
   return keys;
@@ -116,6 +116,27 @@ std::map<std::string, double> ReadSensorValues(const YamlReader& sensors, const 
 }
 
 }  // namespace
+
+std::vector<std::string> UnitKeys(const std::string& base) { return SensorKeysImpl(base); }
+
+std::map<std::string, double> ReadPerUnitChannelValues(const YamlReader& node,
+                                                       const std::string& base,
+                                                       const std::vector<std::string>& channels,
+                                                       const model::MechanicalModel& model,
+                                                       bool non_negative) {
+  std::map<std::string, std::string> units;
+  for (int i = 0; i < model.output_count(); ++i) {
+    units[model.output_names()[static_cast<size_t>(i)]] =
+        model.output_units()[static_cast<size_t>(i)];
+  }
+  const std::vector<std::string> coordinate_units = model.coordinate_units();
+  for (int i = 0; i < model.coordinate_count(); ++i) {
+    // An output of the same name wins, as in the channel lookup.
+    units.emplace(model.coordinate_names()[static_cast<size_t>(i)],
+                  coordinate_units[static_cast<size_t>(i)]);
+  }
+  return ReadSensorValues(node, base, channels, units, non_negative);
+}
 
 Excitation ReadExcitation(const YamlReader& node, const model::MechanicalModel& model) {
   Excitation excitation;
@@ -201,7 +222,7 @@ SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalM
   SensorOptions options;
   std::vector<std::string> keys{"sample_rate_hz", "channels", "seed"};
   for (const char* base : {"noise_std", "bias", "quantization_step"}) {
-    for (const std::string& key : SensorKeys(base)) keys.push_back(key);
+    for (const std::string& key : UnitKeys(base)) keys.push_back(key);
   }
   node.ExpectMap(keys);
   options.sample_rate_hz = node.PositiveDouble("sample_rate_hz", options.sample_rate_hz);
@@ -220,21 +241,10 @@ SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalM
       node.FailAt("channels", "channel '" + channel + "' listed twice", "unique channel names");
     }
   }
-  std::map<std::string, std::string> units;
-  for (int i = 0; i < model.output_count(); ++i) {
-    units[model.output_names()[static_cast<size_t>(i)]] =
-        model.output_units()[static_cast<size_t>(i)];
-  }
-  const std::vector<std::string> coordinate_units = model.coordinate_units();
-  for (int i = 0; i < model.coordinate_count(); ++i) {
-    // An output of the same name wins, as in the channel lookup.
-    units.emplace(model.coordinate_names()[static_cast<size_t>(i)],
-                  coordinate_units[static_cast<size_t>(i)]);
-  }
-  options.noise_std = ReadSensorValues(node, "noise_std", options.channels, units, true);
-  options.bias = ReadSensorValues(node, "bias", options.channels, units, false);
+  options.noise_std = ReadPerUnitChannelValues(node, "noise_std", options.channels, model, true);
+  options.bias = ReadPerUnitChannelValues(node, "bias", options.channels, model, false);
   options.quantization_step =
-      ReadSensorValues(node, "quantization_step", options.channels, units, true);
+      ReadPerUnitChannelValues(node, "quantization_step", options.channels, model, true);
   const int seed = node.Int("seed", 1);
   if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
   options.seed = static_cast<std::uint64_t>(seed);

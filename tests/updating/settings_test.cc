@@ -100,6 +100,20 @@ updating:
   EXPECT_EQ(Read("updating: {noise_std_rad: 3.0e-5}", *crane.model).noise_std.at("psi"), 3e-5);
 }
 
+TEST(SettingsTest, ResidualNoiseIsGivenInEachChannelsUnit) {
+  // scenarios/excavator-arm.yaml: inclinometers in rad, accelerometers in m/s^2.
+  const Crane machine = LoadCrane(std::string(MBID_SOURCE_DIR) + "/scenarios/excavator-arm.yaml");
+  const UpdatingSettings settings = Read(
+      "updating: {noise_std_rad: 1.0e-5, noise_std_mps2: {a_bucket_z: 2.0e-3}}", *machine.model);
+  EXPECT_EQ(settings.noise_std.at("boom_incl"), 1e-5);
+  EXPECT_EQ(settings.noise_std.at("swing"), 1e-5);  // a coordinate channel, in rad
+  EXPECT_EQ(settings.noise_std.at("a_bucket_z"), 2e-3);
+  EXPECT_EQ(settings.noise_std.count("a_bucket_y"), 0u);  // the identification's estimate
+  EXPECT_NE(ErrorOf("updating: {noise_std_rad: {a_bucket_z: 1.0e-5}}", *machine.model)
+                .find("is in m/s^2, not rad"),
+            std::string::npos);
+}
+
 TEST(SettingsTest, ErrorsNameTheFieldAndWhatWasExpected) {
   const Crane crane = LoadCrane(testing::kReferenceScenario);
   const model::MechanicalModel& m = *crane.model;

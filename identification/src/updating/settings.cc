@@ -93,28 +93,30 @@ UpdatingSettings MakeDefaultUpdatingSettings(const model::MechanicalModel& model
 UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::MechanicalModel& model,
                                       const simulation::IntegratorOptions& integrator) {
   UpdatingSettings settings = MakeDefaultUpdatingSettings(model, integrator);
-  node.ExpectMap({"parameters",
-                  "start",
-                  "bounds",
-                  "log_scale",
-                  "algebraic_start",
-                  "jacobian",
-                  "numeric_step",
-                  "noise_std_rad",
-                  "fit_payload_mass",
-                  "fit_initial_deflection",
-                  "max_iterations",
-                  "function_tolerance",
-                  "gradient_tolerance",
-                  "parameter_tolerance",
-                  "undetermined_relative_std",
-                  "rank_tolerance",
-                  "threads",
-                  "initial_trust_region_radius",
-                  "continuation_fractions",
-                  "integrator",
-                  "sensitivity",
-                  "algebraic"});
+  std::vector<std::string> keys{"parameters",
+                                "start",
+                                "bounds",
+                                "log_scale",
+                                "algebraic_start",
+                                "jacobian",
+                                "numeric_step",
+                                "fit_payload_mass",
+                                "fit_initial_deflection",
+                                "max_iterations",
+                                "function_tolerance",
+                                "gradient_tolerance",
+                                "parameter_tolerance",
+                                "undetermined_relative_std",
+                                "rank_tolerance",
+                                "threads",
+                                "initial_trust_region_radius",
+                                "continuation_fractions",
+                                "integrator",
+                                "sensitivity",
+                                "algebraic"};
+  // Residual weights in each channel's unit: noise_std_rad, noise_std_mps2, ...
+  for (const std::string& key : simulation::UnitKeys("noise_std")) keys.push_back(key);
+  node.ExpectMap(keys);
   UpdateOptions& options = settings.options;
   const std::vector<std::string> known = ParameterNames(model);
   if (node.Has("parameters")) {
@@ -178,23 +180,14 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
           ? UpdateOptions::Jacobian::kNumeric
           : UpdateOptions::Jacobian::kSensitivities;
   options.numeric_step = node.PositiveDouble("numeric_step", options.numeric_step);
-  if (node.Has("noise_std_rad")) {
-    const YamlReader noise = node.Child("noise_std_rad");
-    if (noise.IsMap()) {
-      std::vector<std::string> channels = model.output_names();
-      channels.insert(channels.end(), model.coordinate_names().begin(),
-                      model.coordinate_names().end());
-      noise.ExpectMap(channels);
-      for (const std::string& channel : noise.Keys()) {
-        settings.noise_std[channel] = noise.PositiveDouble(channel);
-      }
-    } else {
-      const double value = node.PositiveDouble("noise_std_rad");
-      for (const std::string& channel : model.output_names()) settings.noise_std[channel] = value;
-      for (const std::string& channel : model.coordinate_names()) {
-        settings.noise_std[channel] = value;
-      }
+  std::vector<std::string> channels = model.output_names();
+  channels.insert(channels.end(), model.coordinate_names().begin(), model.coordinate_names().end());
+  for (const auto& [channel, value] :
+       simulation::ReadPerUnitChannelValues(node, "noise_std", channels, model, true)) {
+    if (!(value > 0)) {
+      node.Fail("noise std of '" + channel + "' is 0", "a positive residual weight per channel");
     }
+    settings.noise_std[channel] = value;
   }
   settings.fit_payload_mass = node.Bool("fit_payload_mass", false);
   settings.fit_initial_deflection = node.Bool("fit_initial_deflection", false);

@@ -20,6 +20,16 @@ Excitation ReadExcitation(const YamlReader& excitation, const model::MechanicalM
 std::map<std::string, double> ReadChannelValues(const YamlReader& node, const std::string& key,
                                                 const std::vector<std::string>& channels,
                                                 bool non_negative);
+// Per-channel values whose keys say their unit: `<base>_rad`, `_m`, `_mps`, `_mps2`, `_radps`
+// for channels in rad, m, m/s, m/s^2, rad/s (outputs and coordinates of `model`; an output
+// wins over a coordinate of the same name). A number applies to every channel of that unit, a
+// map names channels of it. `UnitKeys(base)` lists the keys for ExpectMap.
+std::map<std::string, double> ReadPerUnitChannelValues(const YamlReader& node,
+                                                       const std::string& base,
+                                                       const std::vector<std::string>& channels,
+                                                       const model::MechanicalModel& model,
+                                                       bool non_negative);
+std::vector<std::string> UnitKeys(const std::string& base);
 SimulationOptions ReadSimulationOptions(const YamlReader& simulation);
 // An `integrator:` block; keys it leaves out keep their values in `defaults`.
 IntegratorOptions ReadIntegratorOptions(const YamlReader& integrator, IntegratorOptions defaults);
