@@ -2,8 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -17,6 +19,19 @@ namespace mbid {
 namespace {
 
 constexpr char kExpectedFile[] = "a CSV measurement file (docs/interfaces)";
+
+// The place value of a decimal number's last printed digit: "0.0123" -> 1e-4, "1.5e-3" ->
+// 1e-4, "12" -> 1. A time printed with few digits is uniform only to this resolution.
+double PrintedResolution(const std::string& text) {
+  const size_t exponent_at = text.find_first_of("eE");
+  const std::string mantissa = text.substr(0, exponent_at);
+  int exponent = 0;
+  if (exponent_at != std::string::npos) exponent = std::atoi(text.c_str() + exponent_at + 1);
+  const size_t point = mantissa.find('.');
+  const int decimals =
+      point == std::string::npos ? 0 : static_cast<int>(mantissa.size() - point - 1);
+  return std::pow(10.0, exponent - decimals);
+}
 
 std::vector<std::string> SplitFields(const std::string& line) {
   std::vector<std::string> fields;
@@ -78,7 +93,8 @@ Measurement ReadMeasurementCsv(const std::string& path) {
   std::vector<std::string> header;
   int header_line = 0;
   std::vector<int> row_lines;
-  std::vector<double> cells;  // row-major, header.size() per row
+  double time_resolution_s = 0;  // place value of the time column's last printed digit
+  std::vector<double> cells;     // row-major, header.size() per row
 
   while (std::getline(stream, line)) {
     ++line_number;
@@ -120,6 +136,9 @@ Measurement ReadMeasurementCsv(const std::string& path) {
                        fmt::format("{} fields as in the header ({})", header.size(),
                                    internal::Join(header, ",")));
     }
+    // The finest digit any row prints: writers drop trailing zeros ("0.02" beside "0.025").
+    time_resolution_s = row_lines.empty() ? PrintedResolution(fields[0])
+                                          : std::min(time_resolution_s, PrintedResolution(fields[0]));
     for (size_t c = 0; c < fields.size(); ++c) {
       double value = 0;
       const auto status = internal::ParseDouble(fields[c], &value);
@@ -167,10 +186,12 @@ Measurement ReadMeasurementCsv(const std::string& path) {
   if (!metadata.source.empty()) m.source = metadata.source;
 
   const Eigen::VectorXd time = table.col(0);
-  const double tau = CheckUniformTime(time, path, [&row_lines](Eigen::Index j) {
-    return LineField(row_lines[static_cast<size_t>(j)]);
-  });
-  m.start_time_s = time[0];
+  double start_s = time[0];
+  const double tau = CheckUniformTime(
+      time, path,
+      [&row_lines](Eigen::Index j) { return LineField(row_lines[static_cast<size_t>(j)]); },
+      time_resolution_s, &start_s);
+  m.start_time_s = start_s;
   m.sample_interval_s = tau;
   if (metadata.sample_interval_line > 0) {
     // The exact interval, when it agrees with the time column, makes the round trip exact.

@@ -95,7 +95,8 @@ void Measurement::Validate(const std::string& origin) const {
 }
 
 double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin,
-                        const std::function<std::string(Eigen::Index)>& field_of_sample) {
+                        const std::function<std::string(Eigen::Index)>& field_of_sample,
+                        double printed_resolution_s, double* fitted_start_s) {
   const Eigen::Index n = time_s.size();
   if (n < 2) {
     throw InputError(origin, field_of_sample(0), fmt::format("{} time samples", n),
@@ -124,6 +125,29 @@ double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin
     max_deviation =
         std::max(max_deviation, std::abs(time_s[j] - (t0 + static_cast<double>(j) * tau)));
   }
+  if (fitted_start_s != nullptr) *fitted_start_s = t0;
+  if (max_deviation >= kTimeUniformityTolerance * tau && printed_resolution_s > 0) {
+    // Least squares t_j = a + j b over j = 0..n-1 (centred, so the sums stay exact enough).
+    const double mean_j = 0.5 * static_cast<double>(n - 1);
+    const double mean_t = time_s.mean();
+    double sjt = 0, sjj = 0;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double dj = static_cast<double>(j) - mean_j;
+      sjt += dj * (time_s[j] - mean_t);
+      sjj += dj * dj;
+    }
+    const double b = sjt / sjj;
+    const double a = mean_t - b * mean_j;
+    double worst = 0;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      worst = std::max(worst, std::abs(time_s[j] - (a + static_cast<double>(j) * b)));
+    }
+    // Rounding to the printed digit moves a time by half its place value; allow the whole.
+    if (b > 0 && worst <= printed_resolution_s) {
+      if (fitted_start_s != nullptr) *fitted_start_s = a;
+      return b;
+    }
+  }
   if (max_deviation >= kTimeUniformityTolerance * tau) {
     // The grid test decides; the step furthest from tau locates the gap or jump for the user.
     Eigen::Index worst = 1;
@@ -141,7 +165,12 @@ double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin
                     "step {:.9g} s (relative deviation {:.3g})",
                     time_s[worst] - time_s[worst - 1], worst - 1, worst, tau,
                     worst_step_deviation / tau),
-        fmt::format("uniform sampling (relative deviation under {:g})", kTimeUniformityTolerance));
+        printed_resolution_s > 0
+            ? fmt::format("uniform sampling (times within the printed resolution {:g} s of a "
+                          "uniform grid)",
+                          printed_resolution_s)
+            : fmt::format("uniform sampling (relative deviation under {:g})",
+                          kTimeUniformityTolerance));
   }
   return tau;
 }

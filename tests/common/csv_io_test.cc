@@ -2,9 +2,11 @@
 // naming the file and the line (and column).
 #include "mbid/common/csv_io.h"
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 #include "mbid/common/hdf5_io.h"
@@ -85,6 +87,33 @@ TEST(CsvBadInputTest, NonUniformTimeNamesTheLine) {
   EXPECT_EQ(e.source(), c.path);
   EXPECT_THAT(e.field(), ::testing::AnyOf("line 5", "line 6"));  // either step touching it
   EXPECT_THAT(e.problem(), HasSubstr("non-uniform time"));
+}
+
+// A logger that prints time with five decimals at 3 kHz rounds each time by up to 5e-6 s, 1.5%
+// of the step: uniform within the printed resolution, so accepted, and the least-squares grid
+// gives the step far better than any printed value (error ~ 1e-5 / N^1.5 ~ 3e-11 s here). A
+// missing sample is still a step off the grid, far beyond the resolution.
+TEST(CsvTest, TimePrintedWithFewDigitsIsUniformWithinItsResolution) {
+  const double tau = 1.0 / 3000;
+  std::string text = "time,psi\n";
+  for (int j = 0; j < 3000; ++j)
+    text += fmt::format("{:.5f},{}\n", 0.1 + j * tau, std::sin(0.01 * j));
+  TempDir dir;
+  const std::string path = dir.File("logger.csv");
+  WriteText(path, text);
+  const Measurement m = ReadMeasurementCsv(path);
+  EXPECT_NEAR(m.sample_interval_s, tau, 1e-7 * tau);
+  EXPECT_NEAR(m.start_time_s, 0.1, 1e-8);
+  EXPECT_EQ(m.samples(), 3000);
+
+  std::string gap = "time,psi\n";
+  for (int j = 0; j < 3000; ++j) {
+    if (j != 1500) gap += fmt::format("{:.5f},{}\n", 0.1 + j * tau, std::sin(0.01 * j));
+  }
+  const CsvCase c(gap);
+  const InputError e = c.Read();
+  EXPECT_THAT(e.problem(), HasSubstr("non-uniform time"));
+  EXPECT_THAT(e.expected(), HasSubstr("printed resolution 1e-05 s"));
 }
 
 TEST(CsvBadInputTest, DecreasingTimeNamesTheLine) {

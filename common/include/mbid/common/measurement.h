@@ -38,7 +38,12 @@ inline constexpr double kTimeUniformityTolerance = 1e-6;
 // uniform: |t_j - (t_0 + j * tau)| < kTimeUniformityTolerance * tau for tau = (t_{N-1} - t_0) /
 // (N - 1). Returns tau. Errors are InputErrors with source `origin` and the field
 // `field_of_sample(j)` of the offending sample j (e.g. "line 12" or "/measurement/time").
+// A time column printed with few digits (`printed_resolution_s`, the place value of its last
+// digit, > 0) is accepted when every time lies within that resolution of a uniform grid; tau
+// and the start time (`fitted_start_s`, if given) are then the grid's least-squares fit, far
+// more accurate than any one printed value.
 double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin,
-                        const std::function<std::string(Eigen::Index)>& field_of_sample);
+                        const std::function<std::string(Eigen::Index)>& field_of_sample,
+                        double printed_resolution_s = 0.0, double* fitted_start_s = nullptr);
 
 }  // namespace mbid
