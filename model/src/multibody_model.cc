@@ -562,8 +562,29 @@ void MultibodyModel::Impl::CalcRestMatrices(RestMatrices& result) const {
   }
 }
 
-MultibodyModel::MultibodyModel(MachineDescription machine, std::string type)
-    : impl_(std::make_unique<Impl>(std::move(machine), std::move(type))) {}
+namespace {
+
+// Simbody's multi-line exception text reduced to its one line of substance.
+std::string SimbodyReason(const std::exception& error) {
+  const std::string text = error.what();
+  const size_t at = text.find("Error detected by Simbody method");
+  std::string line = text.substr(at == std::string::npos ? 0 : at);
+  line = line.substr(0, line.find('\n'));
+  return line;
+}
+
+}  // namespace
+
+MultibodyModel::MultibodyModel(MachineDescription machine, std::string type) {
+  try {
+    impl_ = std::make_unique<Impl>(std::move(machine), std::move(type));
+  } catch (const SimTK::Exception::Base& error) {
+    // Finite but absurd data (a mass of 1e308 kg overflows the inertia shift) reach Simbody.
+    throw InputError("machine description", "bodies",
+                     "Simbody cannot build this machine: " + SimbodyReason(error),
+                     "masses, inertias and positions of a real machine");
+  }
+}
 
 MultibodyModel::~MultibodyModel() = default;
 // The Simbody system refers to the Impl by address; moving the pointer keeps it in place.

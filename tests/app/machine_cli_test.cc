@@ -73,6 +73,30 @@ TEST_F(MachineCliTest, FreeCoordinateIsARigidBodyMotion) {
       << run.err;
 }
 
+// Finite but absurd values stop at load with exit 2 and one line, before anything allocates:
+// a mass that overflows Simbody's inertia shift, a record of 8e12 samples, a record of 1.
+TEST_F(MachineCliTest, AbsurdValuesAreInvalidInputNotCrashes) {
+  const struct {
+    const char* from;
+    const char* to;
+    const char* key_path;
+  } cases[] = {{"mass_kg: 15160.0", "mass_kg: 1.0e308", "model.bodies"},
+               {"sample_rate_hz: 100", "sample_rate_hz: 1.0e12", "simulation.duration_s, sensors"},
+               {"sample_rate_hz: 100", "sample_rate_hz: 1.0e-9", "simulation.duration_s, sensors"},
+               {"duration_s: 8", "duration_s: 1.0e15", "simulation.duration_s, sensors"}};
+  for (const auto& bad : cases) {
+    const fs::path scenario =
+        WriteVariant(kScenarios / "reference-crane.yaml", "absurd.yaml", bad.from, bad.to);
+    const fs::path out = dir_ / "absurd.h5";
+    const CommandResult result = Run("simulate " + scenario.string() + " -o " + out.string());
+    EXPECT_EQ(result.exit_code, 2) << bad.to << ": " << result.err;
+    EXPECT_NE(result.err.find(scenario.string() + ":" + bad.key_path), std::string::npos)
+        << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_FALSE(fs::exists(out)) << bad.to;
+  }
+}
+
 struct BadMachine {
   const char* name;
   const char* from;
