@@ -282,6 +282,17 @@ const BadCampaign kBadCampaigns[] = {
      "study: laws\nlaws:\n  variables: "
      "[model.configuration.boom_elevation_deg]\n  quantities: [updated.c_theta]\n",
      "campaign", "laws.quantities", "update"},
+    // Counted before anything is built: two billion copies would allocate tens of gigabytes.
+    {"RepeatBeyondTheCap", "  - grid:", "  - repeat: 2000000000\n  - grid:", "campaign",
+     "sweep[0].repeat", "1 to 1000000"},
+    {"GridBeyondTheCap", "[10, 40, 95]",
+     "[10, 40, 95]\n      model.configuration.slew_deg: [0, 1, 2, 3, 4, 5, 6, 7, 8, 9]\n"
+     "      model.gravity_mps2: [9.8, 9.81, 9.82, 9.83, 9.84, 9.85, 9.86, 9.87, 9.88, 9.89]\n"
+     "      sensors.seed: [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n"
+     "      sensors.noise_std_rad: [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n"
+     "      excitation.payload_mass_kg: [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n"
+     "      simulation.duration_s: [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]",
+     "campaign", "sweep[0].grid", "at most 1000000 cases"},
     {"DamperSizingWithSweep", "",
      "study: damper_sizing\ndamper_sizing:\n  joints: [theta]\n  "
      "range_Nms_per_rad: [1.0e4, 1.0e6]\n  targets: {min_damping_ratio: 0.1}\n",

@@ -72,6 +72,11 @@ CaseList ReadGrid(const YamlReader& grid) {
   CaseList cases{{}};
   for (const std::string& key : grid.Keys()) {
     const std::vector<YAML::Node> values = ValueList(grid, key);
+    // Counted before the product is built: a typo in a grid must not allocate gigabytes first.
+    if (cases.size() * values.size() > kMaxCases) {
+      grid.Fail(std::to_string(cases.size() * values.size()) + " combinations",
+                "at most 1000000 cases");
+    }
     CaseList next;
     for (const auto& partial : cases) {
       for (const YAML::Node& value : values) {
@@ -80,7 +85,6 @@ CaseList ReadGrid(const YamlReader& grid) {
       }
     }
     cases = std::move(next);
-    if (cases.size() > kMaxCases) grid.Fail("too many combinations", "at most 1000000 cases");
   }
   return cases;
 }
@@ -239,7 +243,9 @@ SweepPlan ReadSweep(const YamlReader& campaign, std::uint64_t seed) {
                                         DeriveSeed(seed, 0x4C48530000000000ULL + f));
     } else {
       const int copies = factor.Int("repeat");
-      if (copies < 1) factor.FailAt("repeat", std::to_string(copies), "an integer >= 1");
+      if (copies < 1 || static_cast<size_t>(copies) > kMaxCases) {
+        factor.FailAt("repeat", std::to_string(copies), "an integer from 1 to 1000000");
+      }
       factor_cases.assign(static_cast<size_t>(copies), {});
     }
     if (factor_cases.empty()) factor.Fail("gives no cases", "at least one key with values");
