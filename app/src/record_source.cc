@@ -106,11 +106,16 @@ LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel
 
 void RequireModelOutputs(const Measurement& record, const std::string& origin,
                          const model::MechanicalModel& model) {
+  const std::vector<std::string>& coordinates = model.coordinate_names();
   for (const std::string& channel : record.channels) {
-    if (!IsOutput(model, channel)) {
-      throw InputError(origin, "channels",
-                       fmt::format("channel '{}' is not an output of the model", channel),
-                       OutputList(model));
+    // Coordinate channels (as `mbid simulate` writes them for `sensors.channels: [theta]`) are
+    // measured joint angles or slides: updating compares them like outputs.
+    if (!IsOutput(model, channel) &&
+        std::find(coordinates.begin(), coordinates.end(), channel) == coordinates.end()) {
+      throw InputError(
+          origin, "channels",
+          fmt::format("channel '{}' is neither an output nor a coordinate of the model", channel),
+          fmt::format("{}, or coordinates ({})", OutputList(model), fmt::join(coordinates, ", ")));
     }
   }
 }

@@ -97,6 +97,22 @@ TEST_F(MachineCliTest, AbsurdValuesAreInvalidInputNotCrashes) {
   }
 }
 
+// A coordinate channel that `mbid simulate` writes (a joint encoder) is accepted by `mbid
+// update`, which fits it like an output: the luffing stiffness comes back within 4 std.
+TEST_F(MachineCliTest, UpdateTakesTheCoordinateChannelsSimulateWrites) {
+  const fs::path scenario = WriteVariant(kScenarios / "reference-crane.yaml", "encoder.yaml",
+                                         "channels: [psi, phi]", "channels: [psi, phi, theta]");
+  const fs::path record = dir_ / "encoder.h5";
+  ASSERT_EQ(Run("simulate " + scenario.string() + " -o " + record.string()).exit_code, 0);
+  const fs::path json = dir_ / "update.json";
+  const CommandResult result = Run("update " + (kScenarios / "reference-crane.yaml").string() +
+                                   " " + record.string() + " --json " + json.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("theta) ="), std::string::npos) << result.out;
+  const nlohmann::json c_theta = nlohmann::json::parse(ReadText(json))["parameters"]["c_theta"];
+  EXPECT_LT(std::abs(c_theta["value"].get<double>() - 9.4e6), 4 * c_theta["std"].get<double>());
+}
+
 struct BadMachine {
   const char* name;
   const char* from;
