@@ -48,15 +48,11 @@ std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
     return nullptr;
   }
   const size_t n = static_cast<size_t>(model.coordinate_count());
-  for (const std::string& coordinate : model.coordinate_names()) {
-    const std::vector<model::Parameter> parameters = model.parameters();
-    if (std::none_of(parameters.begin(), parameters.end(),
-                     [&](const model::Parameter& p) { return p.name == "c_" + coordinate; })) {
-      // Eq. 7 has c and d of every coordinate as unknowns; a free one has none.
-      *note = fmt::format("coordinate '{}' has no spring (eq. 7 needs one on every coordinate)",
-                          coordinate);
-      return nullptr;
-    }
+  const std::string free = updating::FindFreeCoordinate(model);
+  if (!free.empty()) {
+    *note =
+        fmt::format("coordinate '{}' has no spring (eq. 7 needs one on every coordinate)", free);
+    return nullptr;
   }
   if (identified.modes.size() < n) {
     *note = fmt::format("{} identified modes for {} coordinates", identified.modes.size(), n);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -20,17 +21,14 @@ namespace {
 
 constexpr char kExpectedFile[] = "a CSV measurement file (docs/interfaces)";
 
-// The place value of a decimal number's last printed digit: "0.0123" -> 1e-4, "1.5e-3" ->
-// 1e-4, "12" -> 1. A time printed with few digits is uniform only to this resolution.
-double PrintedResolution(const std::string& text) {
-  const size_t exponent_at = text.find_first_of("eE");
-  const std::string mantissa = text.substr(0, exponent_at);
-  int exponent = 0;
-  if (exponent_at != std::string::npos) exponent = std::atoi(text.c_str() + exponent_at + 1);
-  const size_t point = mantissa.find('.');
-  const int decimals =
-      point == std::string::npos ? 0 : static_cast<int>(mantissa.size() - point - 1);
-  return std::pow(10.0, exponent - decimals);
+// The decimal place of a number's last printed digit, as a power of ten: "0.0123" -> -4,
+// "1.5e-3" -> -4, "12" -> 0. A time printed with few digits is uniform only to 10^place.
+int PrintedPlace(const std::string& text) {
+  const size_t exponent_at = std::min(text.find_first_of("eE"), text.size());
+  const int exponent = exponent_at < text.size() ? std::atoi(text.c_str() + exponent_at + 1) : 0;
+  const size_t point = text.find('.');
+  const int decimals = point < exponent_at ? static_cast<int>(exponent_at - point - 1) : 0;
+  return exponent - decimals;
 }
 
 std::vector<std::string> SplitFields(const std::string& line) {
@@ -93,8 +91,10 @@ Measurement ReadMeasurementCsv(const std::string& path) {
   std::vector<std::string> header;
   int header_line = 0;
   std::vector<int> row_lines;
-  double time_resolution_s = 0;  // place value of the time column's last printed digit
-  std::vector<double> cells;     // row-major, header.size() per row
+  // The finest decimal place any time prints: writers drop trailing zeros ("0.02" beside
+  // "0.025").
+  int time_place = std::numeric_limits<int>::max();
+  std::vector<double> cells;  // row-major, header.size() per row
 
   while (std::getline(stream, line)) {
     ++line_number;
@@ -136,9 +136,7 @@ Measurement ReadMeasurementCsv(const std::string& path) {
                        fmt::format("{} fields as in the header ({})", header.size(),
                                    internal::Join(header, ",")));
     }
-    // The finest digit any row prints: writers drop trailing zeros ("0.02" beside "0.025").
-    time_resolution_s = row_lines.empty() ? PrintedResolution(fields[0])
-                                          : std::min(time_resolution_s, PrintedResolution(fields[0]));
+    time_place = std::min(time_place, PrintedPlace(fields[0]));
     for (size_t c = 0; c < fields.size(); ++c) {
       double value = 0;
       const auto status = internal::ParseDouble(fields[c], &value);
@@ -190,7 +188,7 @@ Measurement ReadMeasurementCsv(const std::string& path) {
   const double tau = CheckUniformTime(
       time, path,
       [&row_lines](Eigen::Index j) { return LineField(row_lines[static_cast<size_t>(j)]); },
-      time_resolution_s, &start_s);
+      std::pow(10.0, time_place), &start_s);
   m.start_time_s = start_s;
   m.sample_interval_s = tau;
   if (metadata.sample_interval_line > 0) {

@@ -35,25 +35,29 @@ double Number(const YamlReader& parent, const std::string& key, const Expression
   return parent.Has(key) ? Number(parent, key, context) : fallback;
 }
 
+// Entry i of a list, named `field[i]` in errors.
+YamlReader Element(const YamlReader& list, size_t i) {
+  return YamlReader(list.node()[i], list.source(), list.field() + "[" + std::to_string(i) + "]");
+}
+
 std::vector<double> Numbers(const YamlReader& list, const ExpressionContext& context) {
   if (!list.node().IsSequence()) list.Fail("is not a list", "a list of numbers");
   std::vector<double> values;
   for (size_t i = 0; i < list.node().size(); ++i) {
-    values.push_back(Number(
-        YamlReader(list.node()[i], list.source(), list.field() + "[" + std::to_string(i) + "]"),
-        context));
+    values.push_back(Number(Element(list, i), context));
   }
   return values;
 }
 
+Eigen::Vector3d Vector3(const YamlReader& list, const ExpressionContext& context) {
+  const std::vector<double> v = Numbers(list, context);
+  if (v.size() != 3) list.Fail(std::to_string(v.size()) + " entries", "three numbers [x, y, z]");
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
 Eigen::Vector3d Vector3(const YamlReader& parent, const std::string& key,
                         const ExpressionContext& context) {
-  const YamlReader list = parent.Child(key);
-  const std::vector<double> v = Numbers(list, context);
-  if (v.size() != 3) {
-    list.Fail(std::to_string(v.size()) + " entries", "three numbers [x, y, z]");
-  }
-  return Eigen::Vector3d(v[0], v[1], v[2]);
+  return Vector3(parent.Child(key), context);
 }
 
 Eigen::Vector3d Vector3(const YamlReader& parent, const std::string& key,
@@ -70,8 +74,7 @@ Eigen::Matrix3d Rotation(const YamlReader& parent, const std::string& key,
     list.Fail("is not a list", "a list of turns like [{z: -30}, {y: 16}]");
   std::vector<std::pair<char, double>> turns;
   for (size_t i = 0; i < list.node().size(); ++i) {
-    const YamlReader turn(list.node()[i], list.source(),
-                          list.field() + "[" + std::to_string(i) + "]");
+    const YamlReader turn = Element(list, i);
     turn.ExpectMap({"x", "y", "z"});
     const std::vector<std::string> keys = turn.Keys();
     if (keys.size() != 1)
@@ -126,14 +129,7 @@ JointDescription ReadJoint(const YamlReader& joint, const ExpressionContext& con
       if (!axes.node().IsSequence() || axes.node().size() != 2) {
         axes.Fail("is not a list of two axes", "axes: [[x, y, z], [x, y, z]]");
       }
-      for (size_t i = 0; i < 2; ++i) {
-        const YamlReader axis(axes.node()[i], axes.source(),
-                              axes.field() + "[" + std::to_string(i) + "]");
-        const std::vector<double> v = Numbers(axis, context);
-        if (v.size() != 3)
-          axis.Fail(std::to_string(v.size()) + " entries", "three numbers [x, y, z]");
-        result.axes.emplace_back(v[0], v[1], v[2]);
-      }
+      for (size_t i = 0; i < 2; ++i) result.axes.push_back(Vector3(Element(axes, i), context));
     } else {
       if (joint.Has("axes")) joint.FailAt("axes", "'axes' on a one-axis joint", "axis: [x, y, z]");
       result.axes.push_back(Vector3(joint, "axis", context));

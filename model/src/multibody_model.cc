@@ -80,10 +80,8 @@ SimTK::MassProperties CalcMassProperties(const BodyDescription& body, double poi
 }  // namespace
 
 struct MultibodyModel::Impl {
-  // Where a coordinate lives: its body, the mobility within the mobilizer, its spring slot.
+  // What a coordinate carries: its spring slot, and whether it slides (m) or turns (rad).
   struct Coordinate {
-    int body = 0;
-    int which = 0;
     int spring = -1;  // index into springs/dampers, -1 for a free coordinate
     bool translational = false;
   };
@@ -252,8 +250,6 @@ struct MultibodyModel::Impl {
   void AddCoordinate(const BodyDescription& body, size_t which, const MobilizedBody& mobod,
                      int mobility) {
     Coordinate coordinate;
-    coordinate.body = body_index.at(body.name);
-    coordinate.which = mobility;
     coordinate.translational = body.joint.type == JointType::kPrismatic;
     const SpringDescription* spring = machine.FindSpring(body.joint.coordinates[which]);
     if (spring != nullptr) {
@@ -299,6 +295,7 @@ struct MultibodyModel::Impl {
       output_names.push_back(description.name);
       output_units.push_back(OutputUnits(machine, description));
       output_orders.push_back(OutputDerivativeOrder(description.type));
+      highest_output_order = std::max(highest_output_order, output_orders.back());
       if (output.body >= 0 && OutputDerivativeOrder(output.type) == 0) {
         pose_count = std::max(pose_count, static_cast<size_t>(output.body) + 1);
       }
@@ -482,7 +479,8 @@ struct MultibodyModel::Impl {
   std::vector<SimTK::Force::MobilityLinearSpring> springs;
   std::vector<SimTK::Force::MobilityLinearDamper> dampers;
   std::vector<JointKinematics> kinematics;
-  size_t pose_count = 0;  // bodies up to the last one a position output needs
+  size_t pose_count = 0;         // bodies up to the last one a position output needs
+  int highest_output_order = 0;  // how far CalcOutputs realizes: 1 Velocity, 2 Acceleration
   std::vector<Output> outputs;
   std::vector<std::string> output_names;
   std::vector<std::string> output_units;
@@ -723,8 +721,7 @@ Eigen::VectorXd MultibodyModel::CalcOutputs(const SimTK::State& state) const {
   Eigen::VectorXd q(q_simtk.size());
   for (int i = 0; i < q_simtk.size(); ++i) q[i] = q_simtk[i];
   // Positions from the description's kinematics; rates from Simbody, realized as far as needed.
-  int highest_order = 0;
-  for (int order : m.output_orders) highest_order = std::max(highest_order, order);
+  const int highest_order = m.highest_output_order;
   const std::vector<Impl::Pose> poses = m.CalcPoses(q, m.pose_count);
   if (highest_order > 0) {
     m.system.realize(state,

@@ -60,7 +60,7 @@ std::map<std::string, double> ReadChannelValues(const YamlReader& sensors, const
 namespace {
 
 // Sensor keys say their unit: `<base>_rad`, `_m`, `_mps`, `_mps2`, `_radps` for channels in rad,
-// m, m/s, m/s^2 and rad/s. A number applies to every channel of that unit; a map names channels.
+// m, m/s, m/s^2 and rad/s.
 struct UnitSuffix {
   const char* suffix;
   const char* units;
@@ -68,56 +68,13 @@ struct UnitSuffix {
 constexpr UnitSuffix kUnitSuffixes[] = {
     {"rad", "rad"}, {"m", "m"}, {"mps", "m/s"}, {"mps2", "m/s^2"}, {"radps", "rad/s"}};
 
-std::vector<std::string> SensorKeysImpl(const std::string& base) {
+}  // namespace
+
+std::vector<std::string> UnitKeys(const std::string& base) {
   std::vector<std::string> keys;
   for (const UnitSuffix& unit : kUnitSuffixes) keys.push_back(base + "_" + unit.suffix);
   return keys;
 }
-
-std::map<std::string, double> ReadSensorValues(const YamlReader& sensors, const std::string& base,
-                                               const std::vector<std::string>& channels,
-                                               const std::map<std::string, std::string>& units,
-                                               bool non_negative) {
-  std::map<std::string, double> values;
-  for (const UnitSuffix& unit : kUnitSuffixes) {
-    const std::string key = base + "_" + unit.suffix;
-    if (!sensors.Has(key)) continue;
-    std::vector<std::string> matching;
-    for (const std::string& channel : channels) {
-      if (units.at(channel) == unit.units) matching.push_back(channel);
-    }
-    const YamlReader node = sensors.Child(key);
-    if (node.IsMap()) {
-      for (const std::string& channel : node.Keys()) {
-        const auto found = units.find(channel);
-        if (found != units.end() && found->second != unit.units) {
-          node.FailAt(channel,
-                      "channel '" + channel + "' is in " + found->second + ", not " + unit.units,
-                      "the key of the channel's unit");
-        }
-      }
-      node.ExpectMap(matching);
-      for (const std::string& channel : node.Keys()) values[channel] = node.Double(channel);
-    } else {
-      if (matching.empty()) {
-        sensors.FailAt(key, "no channel is in " + std::string(unit.units),
-                       "a key whose unit some channel has");
-      }
-      const double value = sensors.Double(key);
-      for (const std::string& channel : matching) values[channel] = value;
-    }
-    for (const auto& [channel, value] : values) {
-      if (non_negative && value < 0) {
-        sensors.FailAt(key, "negative value for " + channel, "a value >= 0 in the channel's unit");
-      }
-    }
-  }
-  return values;
-}
-
-}  // namespace
-
-std::vector<std::string> UnitKeys(const std::string& base) { return SensorKeysImpl(base); }
 
 std::map<std::string, double> ReadPerUnitChannelValues(const YamlReader& node,
                                                        const std::string& base,
@@ -135,7 +92,33 @@ std::map<std::string, double> ReadPerUnitChannelValues(const YamlReader& node,
     units.emplace(model.coordinate_names()[static_cast<size_t>(i)],
                   coordinate_units[static_cast<size_t>(i)]);
   }
-  return ReadSensorValues(node, base, channels, units, non_negative);
+  // Each unit's key read as ReadChannelValues reads one, over that unit's channels; first the
+  // two mistakes its generic errors would describe poorly.
+  std::map<std::string, double> values;
+  for (const UnitSuffix& unit : kUnitSuffixes) {
+    const std::string key = base + "_" + unit.suffix;
+    if (!node.Has(key)) continue;
+    std::vector<std::string> matching;
+    for (const std::string& channel : channels) {
+      if (units.at(channel) == unit.units) matching.push_back(channel);
+    }
+    const YamlReader values_node = node.Child(key);
+    if (values_node.IsMap()) {
+      for (const std::string& channel : values_node.Keys()) {
+        const auto found = units.find(channel);
+        if (found != units.end() && found->second != unit.units) {
+          values_node.FailAt(
+              channel, "channel '" + channel + "' is in " + found->second + ", not " + unit.units,
+              "the key of the channel's unit");
+        }
+      }
+    } else if (matching.empty()) {
+      node.FailAt(key, "no channel is in " + std::string(unit.units),
+                  "a key whose unit some channel has");
+    }
+    values.merge(ReadChannelValues(node, key, matching, non_negative));
+  }
+  return values;
 }
 
 Excitation ReadExcitation(const YamlReader& node, const model::MechanicalModel& model) {

@@ -328,6 +328,17 @@ Eigen::VectorXd CalcCharacteristicResiduals(const CharacteristicProblem& problem
   return residuals;
 }
 
+std::string FindFreeCoordinate(const model::MechanicalModel& model) {
+  const std::vector<model::Parameter> parameters = model.parameters();
+  for (const std::string& name : model.coordinate_names()) {
+    if (std::none_of(parameters.begin(), parameters.end(),
+                     [&](const model::Parameter& p) { return p.name == "c_" + name; })) {
+      return name;
+    }
+  }
+  return "";
+}
+
 CharacteristicProblem MakeCharacteristicProblem(
     const model::MechanicalModel& model, const std::vector<std::complex<double>>& lambda,
     const std::optional<Measurement>& record,
@@ -346,18 +357,12 @@ CharacteristicProblem MakeCharacteristicProblem(
   problem.c_reference.resize(n);
   problem.d_reference.resize(n);
   problem.K_g = linear.C;
-  const std::vector<model::Parameter> parameters = model.parameters();
-  for (const std::string& name : linear.coordinates) {
-    const bool sprung =
-        std::any_of(parameters.begin(), parameters.end(),
-                    [&](const model::Parameter& p) { return p.name == "c_" + name; });
-    if (!sprung) {
-      throw InputError("characteristic equation", "coordinates",
-                       "coordinate '" + name +
-                           "' has no spring, and eq. 7 solves for c and d of every "
-                           "coordinate",
-                       "a spring on every coordinate for Route 1 (Route 2 tunes the sprung ones)");
-    }
+  const std::string free = FindFreeCoordinate(model);
+  if (!free.empty()) {
+    throw InputError(
+        "characteristic equation", "coordinates",
+        "coordinate '" + free + "' has no spring, and eq. 7 solves for c and d of every coordinate",
+        "a spring on every coordinate for Route 1 (Route 2 tunes the sprung ones)");
   }
   for (int i = 0; i < n; ++i) {
     const std::string& name = linear.coordinates[static_cast<size_t>(i)];

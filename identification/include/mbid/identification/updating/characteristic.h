@@ -50,6 +50,10 @@ struct CharacteristicProblem {
       expected_initial_q;
 };
 
+// The first coordinate of `model` without a spring (no c_<coordinate> parameter), or "" when
+// every one has one: eq. 7 solves for c and d of every coordinate, so a free one rules it out.
+std::string FindFreeCoordinate(const model::MechanicalModel& model);
+
 // The problem for `model` (its linearization and current parameters c_<coordinate>,
 // d_<coordinate> as reference) and poles `lambda`; with a record, and with the excitation giving
 // the expected initial state through CalcInitialCoordinates on a copy of the model carrying the
