@@ -151,7 +151,9 @@ INSTANTIATE_TEST_SUITE_P(
                    "sensors.noise_std_m"},
         BadMachine{"SensorUnitOfAnotherChannel", "noise_std_rad: 1.0e-05",
                    "noise_std_rad: {a_bucket_z: 1.0e-3}", "sensors.noise_std_rad.a_bucket_z"}),
-    [](const ::testing::TestParamInfo<BadMachine>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<BadMachine>& param_info) {
+      return std::string(param_info.param.name);
+    });
 
 }  // namespace
 }  // namespace mbid::testing

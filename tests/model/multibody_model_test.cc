@@ -247,8 +247,12 @@ TEST(MultibodyModelTest, OutputMatrixMatchesDifferences) {
                                (2 * h);
     const Eigen::VectorXd du = machine->CalcOutputs(machine->MakeState(zero, e)) / h;
     for (int i = 0; i < 8; ++i) {
-      if (linear.output_orders[i] == 0) EXPECT_NEAR(linear.H(i, j), dq[i], 1e-8) << i << "," << j;
-      if (linear.output_orders[i] == 1) EXPECT_NEAR(linear.H(i, j), du[i], 1e-8) << i << "," << j;
+      if (linear.output_orders[i] == 0) {
+        EXPECT_NEAR(linear.H(i, j), dq[i], 1e-8) << i << "," << j;
+      }
+      if (linear.output_orders[i] == 1) {
+        EXPECT_NEAR(linear.H(i, j), du[i], 1e-8) << i << "," << j;
+      }
     }
   }
   // Accelerations: at rest with q = 0 a generalized force f gives q'' = M^-1 f, y = H q''.
@@ -418,8 +422,8 @@ TEST(MultibodyModelTest, MatrixUnitsFollowTheCoordinates) {
   EXPECT_EQ(StiffnessMatrixUnits({"rad", "m"}), "SI, per coordinate (coordinate_units)");
   const LinearModel linear = FromYaml(kEveryJoint)->Linearize();
   EXPECT_EQ(linear.coordinate_units, (std::vector<std::string>{"m", "rad", "rad", "rad"}));
-  EXPECT_EQ(linear.output_units, (std::vector<std::string>{"rad", "rad", "m", "m", "m/s", "m/s^2",
-                                                           "rad/s", "rad"}));
+  EXPECT_EQ(linear.output_units,
+            (std::vector<std::string>{"rad", "rad", "m", "m", "m/s", "m/s^2", "rad/s", "rad"}));
 }
 
 struct BadCase {
@@ -494,8 +498,8 @@ INSTANTIATE_TEST_SUITE_P(
                 "model.payload_point", "unknown point"},
         BadCase{"unknown output type", "type: angular_velocity", "type: angular_rate",
                 "model.outputs.jib_rate.type", "angular_rate"}),
-    [](const ::testing::TestParamInfo<BadCase>& info) {
-      std::string name = info.param.name;
+    [](const ::testing::TestParamInfo<BadCase>& param_info) {
+      std::string name = param_info.param.name;
       for (char& c : name) {
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
       }
