@@ -1,0 +1,51 @@
+#pragma once
+
+// Measured records in: mbid's own CSV and HDF5, logger CSV dialects, UFF58 (ASCII and binary),
+// LabVIEW .lvm and MATLAB .mat, converted to SI with udunits2; records out as UFF58 and .mat.
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mbid/common/measurement.h"
+
+namespace mbid::records {
+
+// What to do with empty or NaN cells.
+enum class GapFill { kRefuse, kLinear };
+
+// Everything a scenario's `record:` entry or the command line can say about how a file's columns
+// become a record (docs/records.md).
+struct ImportOptions {
+  // Record channel -> file column (the column's name, or its 1-based number among the data
+  // columns). Empty: every data column, under its own name.
+  std::vector<std::pair<std::string, std::string>> channel_columns;
+  // File column or record channel -> unit, completing or overriding the units in the file.
+  std::map<std::string, std::string> units;
+  std::string time_unit;  // overrides the time column's unit from the file when not empty
+  GapFill fill_gaps = GapFill::kRefuse;
+  // Record channel -> the SI unit its consumer needs ("rad", "m/s^2"), from the model. A
+  // channel listed here must come with a unit convertible to it; others go to the SI unit of
+  // their own dimension.
+  std::map<std::string, std::string> target_units;
+};
+
+// What the import did, for the user to check.
+struct ImportReport {
+  std::string format;                    // "mbid-csv", "csv", "uff58", "lvm", "mat", "hdf5"
+  int filled_samples = 0;                // cells interpolated by GapFill::kLinear
+  std::vector<std::string> conversions;  // e.g. "theta: deg -> rad (x 0.0174533)"
+};
+
+// Reads any supported file (chosen by its extension and contents), converts it to SI and
+// checks it (Measurement::Validate). Invalid input is an InputError naming the file and the
+// line, column, key or object.
+Measurement ImportMeasurement(const std::string& path, const ImportOptions& options = {},
+                              ImportReport* report = nullptr);
+
+// Writers for other tools. Both write atomically (a temporary name renamed when complete).
+void WriteUff58(const Measurement& measurement, const std::string& path, bool binary = false);
+void WriteMat(const Measurement& measurement, const std::string& path);
+
+}  // namespace mbid::records

@@ -1,0 +1,39 @@
+#pragma once
+
+// The common shape every file reader produces before conversion to SI (import.cc): named
+// columns with the units the file states, a time base, and NaN where a cell is empty.
+
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mbid::records::internal {
+
+struct RawColumn {
+  std::string name;            // as in the file (trimmed); "" when the file has none
+  std::string unit;            // as in the file ("deg", "m/s^2"); "" when the file states none
+  std::string where;           // for messages: "column 3", "dataset 2 (line 40)", "variable theta"
+  std::vector<double> values;  // one per sample; NaN marks a gap (empty or NaN cell)
+};
+
+struct RawTable {
+  std::string format;  // as ImportReport::format
+  // Time base: either a time column (`time`, in `time_unit`, NaN for a gap) or, when
+  // `time` is empty, a uniform grid start + j * interval in `time_unit`.
+  std::vector<double> time;
+  std::string time_unit;   // "" when the file states none
+  std::string time_where;  // "column 1", ...
+  double start = 0.0;
+  double interval = 0.0;
+  // Place value of the last printed digit of the time column in `time_unit` (text files), or 0.
+  double printed_resolution = 0.0;
+  // Line number of each sample for messages (text formats), else empty.
+  std::vector<int> sample_lines;
+  std::vector<RawColumn> columns;
+  // True for mbid's own SI formats (CSV with a `time` header and HDF5): values without a stated
+  // unit are SI by contract (docs/interfaces.md), not a missing unit.
+  bool si_by_contract = false;
+};
+
+}  // namespace mbid::records::internal
