@@ -58,8 +58,10 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
   options.compute_uncertainty = section.Bool("compute_uncertainty", options.compute_uncertainty);
   if (section.Has("prony")) {
     const YamlReader prony = section.Child("prony");
-    prony.ExpectMap({"order", "rank_tolerance"});
+    prony.ExpectMap({"order", "rank_tolerance", "noise_floor_factor"});
     options.prony.order = prony.Int("order", options.prony.order);
+    options.prony.noise_floor_factor =
+        prony.Double("noise_floor_factor", options.prony.noise_floor_factor);
     options.prony.rank_tolerance = prony.Double("rank_tolerance", options.prony.rank_tolerance);
   }
   std::string why;

@@ -86,6 +86,25 @@ double SignificanceThreshold(const AnalysisRecord& record, const IdentificationO
                                    options.significance_false_alarm);
 }
 
+// A noiseless record's residual is round-off, against which any component is "significant":
+// poles found to 1e-10 leave components of about that relative size. A mode smaller than
+// kRoundOffAmplitude of every channel's RMS carries nothing and gets significance 0.
+constexpr double kRoundOffAmplitude = 1e-8;
+
+void ZeroRoundOffModes(const AnalysisRecord& record, const AmplitudeFit& fit,
+                       Eigen::VectorXd* significance) {
+  const Eigen::VectorXd rms =
+      (record.decimated.colwise().squaredNorm().transpose() / record.decimated.rows()).cwiseSqrt();
+  for (Eigen::Index k = 0; k < significance->size(); ++k) {
+    bool round_off = true;
+    for (Eigen::Index c = 0; c < rms.size(); ++c) {
+      round_off = round_off && fit.Amplitude(static_cast<int>(k), static_cast<int>(c)) <=
+                                   kRoundOffAmplitude * rms(c);
+    }
+    if (round_off) (*significance)(k) = 0;
+  }
+}
+
 // Significance on the record the poles come from (the decimated one: the band where the modes
 // are, and one fit per dropped mode stays cheap on long records); drops insignificant modes (when
 // asked) until every remaining mode is significant. `refit` re-estimates the poles of a reduced
@@ -108,7 +127,8 @@ void SelectSignificant(const AnalysisRecord& record, const IdentificationOptions
   for (;;) {
     estimate->fit =
         FitAmplitudes(record.decimated, record.decimated_interval_s, estimate->lambda, with_offset);
-    const Eigen::VectorXd significance = CalcSignificance(estimate->fit);
+    Eigen::VectorXd significance = CalcSignificance(estimate->fit);
+    ZeroRoundOffModes(record, estimate->fit, &significance);
     estimate->significance.assign(significance.data(), significance.data() + significance.size());
     if (!options.drop_insignificant) {
       const int weak = static_cast<int>((significance.array() < threshold).count());
@@ -354,9 +374,19 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
 Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOptions& options) {
   const Eigen::MatrixXd& values = record.decimated;
   const double tau = record.decimated_interval_s;
+  // Each channel's noise level sets the scale of step 3's threshold.
+  Eigen::VectorXd noise;
+  if (options.prony.noise_floor_factor > 0) {
+    const int samples = static_cast<int>(values.rows());
+    const int columns = std::max(8, std::min(samples / 3, options.hankel.max_columns));
+    noise = HankelSvd(values, columns, 2 * options.max_modes + 1).channel_noise_std();
+  }
+  const auto solve = [&](int p) {
+    return SolvePronySvd(values, tau, p, options.prony.rank_tolerance,
+                         options.prony.noise_floor_factor, noise);
+  };
   // Steps 2-4.
-  const PronySvdSolution solution =
-      SolvePronySvd(values, tau, options.prony.order, options.prony.rank_tolerance);
+  const PronySvdSolution solution = solve(options.prony.order);
   Estimate estimate;
   estimate.model_order = solution.order;
   estimate.effective_rank = solution.effective_rank;
@@ -367,9 +397,7 @@ Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOpti
     // At most about 20 orders: each is an SVD of the whole record.
     const int step = std::max(1, (highest + 19) / 20);
     for (int p = step; p <= highest; p += step) {
-      const PronySvdSolution at_order =
-          p == solution.order ? solution
-                              : SolvePronySvd(values, tau, p, options.prony.rank_tolerance);
+      const PronySvdSolution at_order = p == solution.order ? solution : solve(p);
       estimate.stabilization.push_back(UpperHalf(p, at_order.lambda));
     }
     MarkStable(&estimate.stabilization, options.hankel.stability_tolerance);
@@ -387,20 +415,22 @@ Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOpti
                     solution.lambda.size(), solution.order));
   }
   if (static_cast<int>(estimate.lambda.size()) > options.max_modes) {
-    // Keep the max_modes most significant candidates.
+    // Keep exactly the max_modes most significant candidates (ties broken by frequency order).
     const bool with_offset = options.offset == OffsetRemoval::kFit;
     const AmplitudeFit fit =
         FitAmplitudes(record.decimated, record.decimated_interval_s, estimate.lambda, with_offset);
     const Eigen::VectorXd significance = CalcSignificance(fit);
-    std::vector<double> sorted(significance.data(), significance.data() + significance.size());
-    std::nth_element(sorted.begin(), sorted.begin() + options.max_modes - 1, sorted.end(),
-                     std::greater<double>());
-    const double cut = sorted[options.max_modes - 1];
-    const int dropped =
-        DropModes(&estimate.lambda, [&](size_t k) { return significance(k) >= cut; });
+    std::vector<size_t> rank(estimate.lambda.size());
+    std::iota(rank.begin(), rank.end(), 0);
+    std::stable_sort(rank.begin(), rank.end(),
+                     [&](size_t a, size_t b) { return significance(a) > significance(b); });
+    std::vector<bool> keep(rank.size(), false);
+    for (int i = 0; i < options.max_modes; ++i) keep[rank[i]] = true;
+    const int candidates = static_cast<int>(estimate.lambda.size());
+    DropModes(&estimate.lambda, [&](size_t k) { return keep[k]; });
     estimate.warnings.push_back(
         fmt::format("kept the {} most significant of {} candidate poles (max_modes)",
-                    options.max_modes, options.max_modes + dropped));
+                    options.max_modes, candidates));
   }
   SelectSignificant(record, options, &estimate, [](Estimate*) {});
   // Maximum-likelihood weights for the covariance: each channel's residual level.

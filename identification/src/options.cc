@@ -82,6 +82,9 @@ std::optional<OptionProblem> FindOptionProblem(const IdentificationOptions& o) {
   c.Require(std::isfinite(o.prony.rank_tolerance) && o.prony.rank_tolerance > 0 &&
                 o.prony.rank_tolerance < 1,
             "prony.rank_tolerance", o.prony.rank_tolerance, "a fraction in (0, 1)");
+  c.Require(std::isfinite(o.prony.noise_floor_factor) && o.prony.noise_floor_factor >= 0,
+            "prony.noise_floor_factor", o.prony.noise_floor_factor,
+            "a factor >= 0 (0: no noise rule)");
   c.Require(o.hankel.max_columns >= 8, "hankel.max_columns", o.hankel.max_columns,
             "an integer >= 8");
   c.Require(std::isfinite(o.hankel.noise_floor_factor) && o.hankel.noise_floor_factor >= 1,

@@ -5,21 +5,36 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace mbid::identification {
 
 PronySvdSolution SolvePronySvd(const Eigen::MatrixXd& values, double sample_interval_s, int order,
-                               double rank_tolerance) {
+                               double rank_tolerance, double noise_floor_factor,
+                               const Eigen::VectorXd& channel_noise_std) {
   const int m = static_cast<int>(values.cols());
   const int p = order;
   const int rows = static_cast<int>(values.rows()) - p;  // j = 0..s-p
   const int unknowns = m * p + 1;
 
+  // Channels in units of their noise: z = y D^-1.
+  Eigen::VectorXd noise = Eigen::VectorXd::Ones(m);
+  if (channel_noise_std.size() == m) {
+    for (int c = 0; c < m; ++c) {
+      // A noiseless channel has a round-off noise level; keep the scaling finite.
+      const double rms = std::sqrt(values.col(c).squaredNorm() / values.rows());
+      noise(c) = std::max(channel_noise_std(c), 1e-14 * std::max(rms, 1e-300));
+    }
+  }
+  const Eigen::MatrixXd z = values * noise.cwiseInverse().asDiagonal();
+  const double ones_scale = std::max(std::sqrt(z.squaredNorm() / static_cast<double>(z.size())),
+                                     std::numeric_limits<double>::min());
+
   // Eq. 3 as X [B1 ... Bp B0]^T = -[y_(j+p)]^T, one column per channel.
   Eigen::MatrixXd X(rows, unknowns);
-  for (int i = 1; i <= p; ++i) X.middleCols(m * (i - 1), m) = values.middleRows(p - i, rows);
-  X.col(unknowns - 1).setOnes();
-  const Eigen::MatrixXd rhs = -values.bottomRows(rows);
+  for (int i = 1; i <= p; ++i) X.middleCols(m * (i - 1), m) = z.middleRows(p - i, rows);
+  X.col(unknowns - 1).setConstant(ones_scale);
+  const Eigen::MatrixXd rhs = -z.bottomRows(rows);
 
   // Step 3: minimum-norm solution through the SVD truncated at the effective rank.
   Eigen::BDCSVD<Eigen::MatrixXd> svd(X, Eigen::ComputeThinU | Eigen::ComputeThinV);
@@ -27,13 +42,23 @@ PronySvdSolution SolvePronySvd(const Eigen::MatrixXd& values, double sample_inte
   solution.order = p;
   solution.singular_values = svd.singularValues();
   const Eigen::VectorXd& s = solution.singular_values;
+  if (noise_floor_factor > 0) {
+    const double aspect = static_cast<double>(m * p) / rows;
+    solution.noise_threshold = std::sqrt(noise_floor_factor * rows) * (1 + std::sqrt(aspect));
+  }
+  const double threshold = std::max(rank_tolerance * s(0), solution.noise_threshold);
   int k = 0;
-  while (k < s.size() && s(k) > rank_tolerance * s(0)) ++k;
+  while (k < s.size() && s(k) > threshold) ++k;
   solution.effective_rank = k;
   const Eigen::MatrixXd theta = svd.matrixV().leftCols(k) * s.head(k).cwiseInverse().asDiagonal() *
                                 (svd.matrixU().leftCols(k).transpose() * rhs);  // unknowns x m
-  solution.B = theta.topRows(m * p).transpose();
-  solution.B0 = theta.row(unknowns - 1).transpose();
+  // Back to the channels' own units: B_i = D B'_i D^-1, B0 = D B'0 ones_scale.
+  solution.B = noise.asDiagonal() * theta.topRows(m * p).transpose();
+  for (int i = 0; i < p; ++i) {
+    solution.B.middleCols(m * i, m) =
+        solution.B.middleCols(m * i, m) * noise.cwiseInverse().asDiagonal();
+  }
+  solution.B0 = ones_scale * noise.asDiagonal() * theta.row(unknowns - 1).transpose();
 
   // Step 4: roots of the matrix polynomial = eigenvalues of the block companion matrix.
   Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(m * p, m * p);

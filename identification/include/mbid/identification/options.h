@@ -44,10 +44,14 @@ struct SpectrumOptions {
 // Steps 2-4 of method.md.
 struct PronySvdOptions {
   int order = 40;  // p of eq. 3, chosen generously (more poles than spectral peaks)
-  // Effective rank k of step 3: singular values of the regression matrix above this fraction
-  // of the largest are kept. The default keeps every singular value above round-off, i.e.
-  // plain least squares on noisy data (the paper's method as usually applied, biased under
-  // noise); noiseless data need it to drop the exactly zero directions.
+  // Effective rank k of step 3, "a threshold that reflects the data's accuracy": singular
+  // values of the regression matrix (channels scaled to unit noise, prony_svd.h) whose square is
+  // above noise_floor_factor times the largest that white noise gives count; so do only those
+  // above rank_tolerance times the largest (round-off, for noiseless records). The rank then
+  // indicates the model order (2 x modes + 1), and the truncated solution is Kumaresan and
+  // Tufts' low-bias predictor. noise_floor_factor = 0 keeps every singular value above
+  // round-off: plain least squares, the method as usually applied (biased under noise).
+  double noise_floor_factor = 1.5;
   double rank_tolerance = 1e-9;
 };
 
