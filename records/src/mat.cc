@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 #include <matio.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -36,6 +37,13 @@ constexpr char kMbidLayout[] = "mbid measurement 1";
 const char* const kMbidVariables[] = {
     "mbid_layout",       "source",       "channels",         "units", "time",
     "channel_variables", "start_time_s", "sample_interval_s"};
+
+// Text from a file for a message: printable ASCII only, at most 64 characters.
+std::string Printable(const std::string& text) {
+  std::string out;
+  for (char ch : text.substr(0, 64)) out += (ch >= 32 && ch < 127) ? ch : '?';
+  return text.size() > 64 ? out + "..." : out;
+}
 
 // matio reports problems through a log function that prints to stderr; mbid reports them as
 // InputErrors instead.
@@ -115,6 +123,160 @@ const char* ClassName(matio_classes c) {
   return "unknown";
 }
 
+// A structural check of a v5 file before matio reads it: every array's dimensions must fit the
+// bytes its element holds (matio trusts them, and a damaged cell of 2e9 elements makes it loop
+// for minutes). Compressed elements are inflated for the check (up to kMaxInflated bytes).
+constexpr double kMaxInflated = 4.0e9;
+constexpr int kMiInt8 = 1, kMiInt32 = 5, kMiUint32 = 6, kMiMatrix = 14, kMiCompressed = 15;
+
+class V5Check {
+ public:
+  V5Check(const std::string& path, bool swap) : path_(path), swap_(swap) {}
+
+  // The data elements after the 128-byte header.
+  void TopLevel(const unsigned char* p, size_t n) {
+    size_t at = 0;
+    int index = 0;
+    while (n - at >= 8) {
+      ++index;
+      Element e = Tag(p + at, n - at, fmt::format("data element {}", index));
+      const std::string where = fmt::format("data element {} (byte {})", index, 128 + at);
+      if (e.type == kMiCompressed) {
+        const std::string inflated = Inflate(e.data, e.bytes, where);
+        const auto* q = reinterpret_cast<const unsigned char*>(inflated.data());
+        Element inner = Tag(q, inflated.size(), where);
+        if (inner.type == kMiMatrix) Matrix(inner, where, 0);
+        at += 8 + e.bytes;  // compressed elements are not padded
+      } else {
+        if (e.type == kMiMatrix) Matrix(e, where, 0);
+        at += e.total;
+      }
+    }
+  }
+
+ private:
+  struct Element {
+    std::uint32_t type = 0;
+    size_t bytes = 0;  // of data
+    size_t total = 0;  // tag, data and padding to 8 bytes
+    const unsigned char* data = nullptr;
+  };
+
+  std::uint32_t U32(const unsigned char* p) const {
+    unsigned char b[4];
+    std::memcpy(b, p, 4);
+    if (swap_) std::reverse(b, b + 4);
+    std::uint32_t v = 0;
+    std::memcpy(&v, b, 4);
+    return v;
+  }
+
+  [[noreturn]] void Fail(const std::string& where, const std::string& problem) const {
+    throw InputError(path_, where, problem, "a complete MAT v5 file (docs/records-formats.md)");
+  }
+
+  Element Tag(const unsigned char* p, size_t n, const std::string& where) const {
+    if (n < 8) Fail(where, "a data element cut short");
+    Element e;
+    const std::uint32_t first = U32(p);
+    if ((first >> 16) != 0) {  // small element: type and size in 4 bytes, data in the next 4
+      e.type = first & 0xffff;
+      e.bytes = first >> 16;
+      if (e.bytes > 4) Fail(where, "a small data element of more than 4 bytes");
+      e.total = 8;
+      e.data = p + 4;
+      return e;
+    }
+    e.type = first;
+    e.bytes = U32(p + 4);
+    if (e.bytes > n - 8) {
+      Fail(where, fmt::format("a data element of {} bytes with {} left", e.bytes, n - 8));
+    }
+    e.data = p + 8;
+    e.total = std::min(n, 8 + ((e.bytes + 7) / 8) * 8);
+    return e;
+  }
+
+  // An array: flags, dimensions, name, then contents that must hold every element.
+  void Matrix(const Element& e, const std::string& where, int depth) {
+    if (depth > 16) Fail(where, "arrays nested more than 16 deep");
+    if (e.bytes == 0) return;  // an empty cell element
+    const unsigned char* p = e.data;
+    size_t n = e.bytes, at = 0;
+    const auto next = [&]() {
+      Element sub = Tag(p + at, n - at, where);
+      at += sub.total;
+      return sub;
+    };
+    const Element flags = next();
+    if (flags.type != kMiUint32 || flags.bytes < 8) Fail(where, "no array flags");
+    const std::uint32_t array_class = U32(flags.data) & 0xff;
+    const Element dims = next();
+    if (dims.type != kMiInt32 || dims.bytes < 8 || dims.bytes % 4 != 0) {
+      Fail(where, "no dimensions");
+    }
+    double elements = 1;
+    for (size_t k = 0; k < dims.bytes / 4; ++k) {
+      elements *= static_cast<double>(static_cast<std::int32_t>(U32(dims.data + 4 * k)));
+    }
+    if (elements < 0) Fail(where, "negative dimensions");
+    const Element name = next();
+    if (name.type != kMiInt8) Fail(where, "no array name");
+    const std::string var = std::string(reinterpret_cast<const char*>(name.data), name.bytes);
+    const std::string here = var.empty() ? where : fmt::format("variable {}", Printable(var));
+    const double rest = static_cast<double>(n - std::min(n, at));
+    if (array_class == MAT_C_CELL || array_class == MAT_C_STRUCT) {
+      double fields = 1;
+      if (array_class == MAT_C_STRUCT) {
+        const Element length = next();
+        const Element names = next();
+        const double width = length.bytes >= 4 ? U32(length.data) : 0;
+        fields = width > 0 ? std::floor(static_cast<double>(names.bytes) / width) : 0;
+      }
+      // Each element (cell, or field of a struct element) is an array with an 8-byte tag.
+      if (elements * fields * 8 > rest) {
+        Fail(here, fmt::format("{} elements declared in {} bytes", elements * fields, rest));
+      }
+      for (double k = 0; k < elements * fields; ++k) {
+        const Element sub = next();
+        if (sub.type != kMiMatrix) Fail(here, "a cell or field that is not an array");
+        Matrix(sub, here, depth + 1);
+      }
+    } else if (array_class != MAT_C_OBJECT && array_class != MAT_C_SPARSE &&
+               array_class != MAT_C_OPAQUE && array_class != MAT_C_FUNCTION) {
+      // Numbers and characters: at least one byte each (MATLAB may store them narrower).
+      if (elements > rest) {
+        Fail(here, fmt::format("{} elements declared in {} bytes", elements, rest));
+      }
+      while (n - std::min(n, at) >= 8) next();  // real and imaginary parts within the array
+    }
+  }
+
+  std::string Inflate(const unsigned char* p, size_t n, const std::string& where) const {
+    z_stream z{};
+    if (inflateInit(&z) != Z_OK) Fail(where, "zlib cannot start");
+    z.next_in = const_cast<unsigned char*>(p);
+    z.avail_in = static_cast<uInt>(std::min<size_t>(n, 0xffffffffu));
+    std::string out;
+    unsigned char buffer[65536];
+    int status = Z_OK;
+    while (status == Z_OK) {
+      z.next_out = buffer;
+      z.avail_out = sizeof(buffer);
+      status = inflate(&z, Z_NO_FLUSH);
+      out.append(reinterpret_cast<const char*>(buffer), sizeof(buffer) - z.avail_out);
+      if (static_cast<double>(out.size()) > kMaxInflated) status = Z_MEM_ERROR;
+      if (status == Z_BUF_ERROR && z.avail_in == 0) break;
+    }
+    inflateEnd(&z);
+    if (status != Z_STREAM_END) Fail(where, "a compressed variable that does not inflate");
+    return out;
+  }
+
+  const std::string& path_;
+  bool swap_;
+};
+
 // What a variable's header says, before any of its data is read.
 struct VarInfo {
   std::string name;
@@ -170,6 +332,7 @@ class MatReader {
   RawTable Read() {
     SilenceMatio();
     ReadHead();
+    CheckV5Structure();
     mat_.reset(Mat_Open(path_.c_str(), MAT_ACC_RDONLY));
     if (!mat_) {
       throw InputError(path_, "", "not a MAT file matio can open", kExpectedFile);
@@ -185,7 +348,7 @@ class MatReader {
  private:
   InputError VarError(const std::string& name, const std::string& problem,
                       const std::string& expected) const {
-    return InputError(path_, "variable " + name, problem, expected);
+    return InputError(path_, "variable " + Printable(name), problem, expected);
   }
 
   // The first bytes, read plainly, so that a missing or unreadable file is an InputError
@@ -214,6 +377,32 @@ class MatReader {
     file_size_ = size > 0 ? static_cast<double>(size) : 0.0;
   }
 
+  // A v5 file (version 0x0100 at byte 124, endian mark "IM" or "MI" at 126): its arrays'
+  // dimensions against their bytes, before matio trusts them.
+  void CheckV5Structure() {
+    const std::string bytes = ReadWholeFile(path_, kExpectedFile);
+    if (bytes.size() < 128) return;
+    const bool little_mark = bytes[126] == 'I' && bytes[127] == 'M';
+    const bool big_mark = bytes[126] == 'M' && bytes[127] == 'I';
+    if (!little_mark && !big_mark) return;  // not v5 (matio decides)
+    const bool swap = little_mark != HostIsLittle();
+    unsigned char version[2] = {static_cast<unsigned char>(bytes[124]),
+                                static_cast<unsigned char>(bytes[125])};
+    if (swap) std::swap(version[0], version[1]);
+    std::uint16_t v = 0;
+    std::memcpy(&v, version, 2);
+    if (v != 0x0100) return;  // 0x0200: v7.3, an HDF5 file
+    V5Check(path_, swap)
+        .TopLevel(reinterpret_cast<const unsigned char*>(bytes.data()) + 128, bytes.size() - 128);
+  }
+
+  static bool HostIsLittle() {
+    const std::uint16_t probe = 1;
+    unsigned char first = 0;
+    std::memcpy(&first, &probe, 1);
+    return first == 1;
+  }
+
   // Every variable's header (class, dimensions), without data.
   void ReadDirectory() {
     while (true) {
@@ -240,10 +429,13 @@ class MatReader {
 
   // A whole variable; its size is checked against the file before matio allocates it.
   MatVar Load(const VarInfo& info) {
-    const double bytes = info.elements * static_cast<double>(Mat_SizeOfClass(info.class_type));
+    // Every element of an uncompressed v5 variable takes at least a byte of the file (a cell's
+    // or struct's at least an 8-byte tag).
+    const bool container = info.class_type == MAT_C_CELL || info.class_type == MAT_C_STRUCT;
+    const double bytes =
+        info.elements * (container ? 8.0 : std::max<double>(1, Mat_SizeOfClass(info.class_type)));
     if (info.elements > static_cast<double>(kMaxSamples) * 16 ||
-        (!info.compressed && Mat_GetVersion(mat_.get()) == MAT_FT_MAT5 &&
-         IsNumericClass(info.class_type) && bytes > file_size_)) {
+        (!info.compressed && Mat_GetVersion(mat_.get()) == MAT_FT_MAT5 && bytes > file_size_)) {
       throw VarError(info.name,
                      fmt::format("{} elements declared ({}) in a file of {} bytes", info.elements,
                                  info.Shape(), file_size_),
@@ -328,13 +520,14 @@ class MatReader {
       throw VarError(name, fmt::format("a {}", info.Shape()), "text (a char array)");
     }
     const size_t rows = info.dims[0], cols = info.dims[1];
-    std::vector<std::string> out(rows);
-    if (info.elements == 0) return out;
+    if (info.elements == 0) return std::vector<std::string>(rows == 1 ? 1 : 0);  // '' or none
     const size_t width = var.data_type == MAT_T_UINT16 || var.data_type == MAT_T_UTF16 ? 2 : 1;
+    // The characters matio holds bound the rows and columns (hostile dims otherwise).
     if (var.data == nullptr || var.data_type == MAT_T_UTF32 ||
-        var.nbytes < static_cast<size_t>(info.elements) * width) {
+        static_cast<double>(var.nbytes) < info.elements * static_cast<double>(width)) {
       throw VarError(name, "unreadable characters", "text in ASCII or UTF-8/16");
     }
+    std::vector<std::string> out(rows);
     for (size_t r = 0; r < rows; ++r) {
       for (size_t k = 0; k < cols; ++k) {
         const size_t i = r + k * rows;
@@ -398,7 +591,7 @@ class MatReader {
   RawTable ReadMbidLayout() {
     const std::vector<std::string> tag = StringsVar("mbid_layout");
     if (tag.size() != 1 || tag[0] != kMbidLayout) {
-      throw VarError("mbid_layout", fmt::format("'{}'", tag.empty() ? "" : tag[0]),
+      throw VarError("mbid_layout", fmt::format("'{}'", tag.empty() ? "" : Printable(tag[0])),
                      fmt::format("'{}'", kMbidLayout));
     }
     for (const char* required :
