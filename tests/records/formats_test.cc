@@ -350,6 +350,20 @@ TEST(Mat, RoundTripIsExact) {
   }
 }
 
+TEST(Mat, ChannelVariablesAvoidMbidNamesAndEachOther) {
+  TempDir dir;
+  Measurement m = MakeDecays();
+  m.channels = {"units", "2nd mode"};  // a name of the layout itself; a leading digit
+  const std::string path = dir.File("names.mat");
+  WriteMat(m, path);
+  const RawTable table = ReadMat(path);
+  ASSERT_EQ(table.columns.size(), 2u);
+  EXPECT_EQ(table.columns[0].name, "units");
+  EXPECT_EQ(table.columns[0].where, "variable units_2");
+  EXPECT_EQ(table.columns[1].name, "2nd mode");
+  EXPECT_EQ(table.columns[1].where, "variable ch_2nd_mode");
+}
+
 matvar_t* CellOfNames(const char* name, const std::vector<std::string>& names) {
   size_t dims[2] = {1, names.size()};
   matvar_t* cell = Mat_VarCreate(name, MAT_C_CELL, MAT_T_CELL, 2, dims, nullptr, 0);
@@ -426,6 +440,37 @@ TEST(Mat, ReadsVectorsWithSampleRate) {
   EXPECT_EQ(table.columns[0].values, (std::vector<double>{1.5, 2.5, 3.5}));
   EXPECT_EQ(table.columns[1].name, "y");
   EXPECT_EQ(table.columns[1].values, y);
+}
+
+TEST(Mat, ReadsCompressedStructWithNames) {
+  TempDir dir;
+  const std::string path = dir.File("struct.mat");
+  mat_t* mat = Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5);
+  ASSERT_NE(mat, nullptr);
+  const size_t n = 4;                           // a handful of samples suffices for the layout
+  std::vector<double> time = {0, 0.5, 1, 1.5};  // 2 Hz
+  // Stored channels x samples (2 x 4): the dimension of length 4 holds the samples.
+  std::vector<double> data = {1, -1, 2, -2, 3, -3, 4, -4};
+  size_t time_dims[2] = {n, 1}, data_dims[2] = {2, n}, one[2] = {1, 1};
+  const char* fields[] = {"time", "data", "names"};
+  matvar_t* record = Mat_VarCreateStruct("rec", 2, one, fields, 3);
+  Mat_VarSetStructFieldByName(
+      record, "time", 0,
+      Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, time_dims, time.data(), 0));
+  Mat_VarSetStructFieldByName(
+      record, "data", 0,
+      Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, data_dims, data.data(), 0));
+  Mat_VarSetStructFieldByName(record, "names", 0, CellOfNames(nullptr, {"left", "right"}));
+  EXPECT_EQ(Mat_VarWrite(mat, record, MAT_COMPRESSION_ZLIB), 0);  // as MATLAB's save -v7
+  Mat_VarFree(record);
+  Mat_Close(mat);
+  const RawTable table = ReadMat(path);
+  EXPECT_EQ(table.time, time);
+  ASSERT_EQ(table.columns.size(), 2u);
+  EXPECT_EQ(table.columns[0].name, "left");
+  EXPECT_EQ(table.columns[0].values, (std::vector<double>{1, 2, 3, 4}));
+  EXPECT_EQ(table.columns[1].name, "right");
+  EXPECT_EQ(table.columns[1].values, (std::vector<double>{-1, -2, -3, -4}));
 }
 
 TEST(Mat, ThreeDimensionalArrayNamesTheVariable) {
