@@ -2,6 +2,8 @@
 // docs/interfaces.md (2 invalid input, 3 numerical failure, 1 anything else).
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "mbid/app/commands.h"
 #include "mbid/app/run_cycle.h"
@@ -36,6 +38,10 @@ int Main(int argc, char** argv) {
   simulate->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
   simulate->add_option("-o,--output", output_path, "Measurement file to write (.h5)")->required();
   simulate->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
+  std::vector<std::string> export_paths;
+  simulate->add_option("--export", export_paths,
+                       "Also write the measured record as FILE (repeatable): .uff/.unv UFF58 "
+                       "ASCII, .uffb UFF58 binary, .mat MATLAB v5");
 
   std::string output_dir;
   CLI::App* run = app.add_subcommand(
@@ -134,7 +140,7 @@ int Main(int argc, char** argv) {
   }
   if (modes->parsed()) return mbid::app::RunModesCommand(scenario_path, common);
   if (simulate->parsed()) {
-    return mbid::app::RunSimulateCommand(scenario_path, output_path, common);
+    return mbid::app::RunSimulateCommand(scenario_path, output_path, common, export_paths);
   }
   return static_cast<int>(mbid::ExitCode::kOther);
 }

@@ -1,16 +1,59 @@
+#include <algorithm>
+#include <cctype>
 #include <iostream>
+#include <vector>
 
 #include "mbid/app/commands.h"
 #include "mbid/app/json_summaries.h"
 #include "mbid/app/result_writers.h"
 #include "mbid/app/scenario.h"
+#include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
+#include "mbid/records/records.h"
 
 namespace mbid::app {
+namespace {
+
+enum class ExportFormat { kUff, kUffBinary, kMat };
+
+// The format an `--export` file asks for by its extension (case-insensitive).
+ExportFormat ExportFormatOf(const std::string& path) {
+  const size_t dot = path.rfind('.');
+  const size_t slash = path.rfind('/');
+  std::string extension = dot == std::string::npos || (slash != std::string::npos && dot < slash)
+                              ? ""
+                              : path.substr(dot);
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  if (extension == ".uff" || extension == ".unv") return ExportFormat::kUff;
+  if (extension == ".uffb") return ExportFormat::kUffBinary;
+  if (extension == ".mat") return ExportFormat::kMat;
+  throw InputError(
+      "--export", path,
+      extension.empty() ? "no file extension" : "unknown file extension '" + extension + "'",
+      ".uff or .unv (UFF58 ASCII), .uffb (UFF58b binary) or .mat (MATLAB v5)");
+}
+
+void Export(const Measurement& measured, const std::string& path) {
+  switch (ExportFormatOf(path)) {
+    case ExportFormat::kUff:
+      records::WriteUff58(measured, path, /*binary=*/false);
+      break;
+    case ExportFormat::kUffBinary:
+      records::WriteUff58(measured, path, /*binary=*/true);
+      break;
+    case ExportFormat::kMat:
+      records::WriteMat(measured, path);
+      break;
+  }
+}
+
+}  // namespace
 
 int RunSimulateCommand(const std::string& scenario_path, const std::string& output_path,
-                       const CommonOptions& common) {
+                       const CommonOptions& common, const std::vector<std::string>& export_paths) {
+  for (const std::string& path : export_paths) ExportFormatOf(path);  // before the simulation
   const Scenario scenario = LoadScenario(scenario_path);
   const auto model = scenario.MakeModel();
   const simulation::Excitation& excitation = scenario.RequireExcitation();
@@ -45,12 +88,15 @@ int RunSimulateCommand(const std::string& scenario_path, const std::string& outp
     summary["modes"] = LinearModelToJson(linear, model::CalcModes(linear))["modes"];
     WriteJson(summary, common.json_path);
   }
-  // The HDF5 file appears only when everything else has succeeded.
+  // Each export appears complete or not at all; the HDF5 file only when everything else has
+  // succeeded.
+  for (const std::string& path : export_paths) Export(result.measured, path);
   file.Commit();
   if (!common.quiet && common.json_path != "-") {
     std::cerr << "mbid: wrote " << output_path << " (" << result.measured.samples() << " samples x "
               << result.measured.channel_count() << " channels, " << result.statistics.steps
               << " CVODES " << simulation::MethodName(result.statistics.method) << " steps)\n";
+    for (const std::string& path : export_paths) std::cerr << "mbid: wrote " << path << "\n";
   }
   return 0;
 }

@@ -36,4 +36,11 @@ struct RawTable {
   bool si_by_contract = false;
 };
 
+// Readers of the formats other tools write (docs/records-formats.md). Each reads `path` whole,
+// checks it and returns its columns as the file states them; a file that breaks its format is an
+// InputError naming `path` and the line, dataset or variable.
+RawTable ReadUff58(const std::string& path);  // UFF dataset 58, ASCII and binary (58b)
+RawTable ReadLvm(const std::string& path);    // LabVIEW Measurement (.lvm)
+RawTable ReadMat(const std::string& path);    // MATLAB .mat, v5 and v7.3
+
 }  // namespace mbid::records::internal

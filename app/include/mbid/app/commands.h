@@ -17,9 +17,12 @@ struct CommonOptions {
 // `mbid modes SCENARIO [--json FILE]`: the linearized model and its exact modes.
 int RunModesCommand(const std::string& scenario_path, const CommonOptions& common);
 
-// `mbid simulate SCENARIO -o FILE.h5 [--json FILE]`: a synthetic measurement from the model.
+// `mbid simulate SCENARIO -o FILE.h5 [--json FILE] [--export FILE]...`: a synthetic
+// measurement from the model; each `--export` also writes the measured record for other tools,
+// by extension: .uff/.unv (UFF58 ASCII), .uffb (UFF58b binary), .mat (MATLAB v5).
 int RunSimulateCommand(const std::string& scenario_path, const std::string& output_path,
-                       const CommonOptions& common);
+                       const CommonOptions& common,
+                       const std::vector<std::string>& export_paths = {});
 
 // `mbid campaign CAMPAIGN.yaml -o DIR [--workers N] [--resume]`: runs a campaign of virtual
 // tests (or a design study) into DIR (docs/campaigns.md); under `mpirun -n K` the cases are
