@@ -15,6 +15,7 @@
 #include "mbid/identification/modal_fit.h"
 #include "mbid/identification/prony_svd.h"
 #include "mbid/identification/refinement.h"
+#include "mbid/identification/release.h"
 #include "mbid/identification/significance.h"
 #include "mbid/identification/spectrum.h"
 #include "record.h"
@@ -59,7 +60,9 @@ struct Estimate {
   int model_order = 0;
   int effective_rank = 0;
   Eigen::VectorXd weights;  // per channel, for the covariance on the decimated record
-  AmplitudeFit fit;         // on the decimated record, for the poles in `lambda`
+  // Per channel noise level of the decimated record, independent of the fit (hankel_svd.h).
+  Eigen::VectorXd noise_std;
+  AmplitudeFit fit;  // on the decimated record, for the poles in `lambda`
   std::string termination = "converged";
   std::string termination_message;
   int iterations = 0;
@@ -214,6 +217,7 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
   };
 
   Estimate estimate;
+  estimate.noise_std = hankel.channel_noise_std();
   estimate.model_order = columns - 1;
   const int order = hankel.CountSignal(options.hankel.noise_floor_factor,
                                        options.hankel.min_relative_singular_value, max_order);
@@ -375,19 +379,19 @@ Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOpti
   const Eigen::MatrixXd& values = record.decimated;
   const double tau = record.decimated_interval_s;
   // Each channel's noise level sets the scale of step 3's threshold.
-  Eigen::VectorXd noise;
-  if (options.prony.noise_floor_factor > 0) {
-    const int samples = static_cast<int>(values.rows());
-    const int columns = std::max(8, std::min(samples / 3, options.hankel.max_columns));
-    noise = HankelSvd(values, columns, 2 * options.max_modes + 1).channel_noise_std();
-  }
+  const int samples = static_cast<int>(values.rows());
+  const int columns = std::max(8, std::min(samples / 3, options.hankel.max_columns));
+  const Eigen::VectorXd noise =
+      HankelSvd(values, columns, 2 * options.max_modes + 1).channel_noise_std();
   const auto solve = [&](int p) {
     return SolvePronySvd(values, tau, p, options.prony.rank_tolerance,
-                         options.prony.noise_floor_factor, noise);
+                         options.prony.noise_floor_factor,
+                         options.prony.noise_floor_factor > 0 ? noise : Eigen::VectorXd());
   };
   // Steps 2-4.
   const PronySvdSolution solution = solve(options.prony.order);
   Estimate estimate;
+  estimate.noise_std = noise;
   estimate.model_order = solution.order;
   estimate.effective_rank = solution.effective_rank;
   if (options.compute_stabilization) {
@@ -438,18 +442,124 @@ Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOpti
   return estimate;
 }
 
+// Where the free decay starts, and the options with the analysis window starting there.
+IdentificationOptions ApplyRelease(const Measurement& measurement,
+                                   const IdentificationOptions& options, ModalResult* result) {
+  IdentificationOptions applied = options;
+  result->release_time_s = measurement.start_time_s;
+  switch (options.release) {
+    case ReleaseMode::kNone:
+      result->release = "none";
+      return applied;
+    case ReleaseMode::kGiven:
+      result->release = "given";
+      result->release_time_s = options.release_time_s;
+      break;
+    case ReleaseMode::kDetect: {
+      const ReleaseDetection detection = DetectRelease(measurement);
+      result->release = detection.detected ? "detected" : "record start";
+      result->release_time_s = detection.release_time_s;
+      if (detection.detected) {
+        result->warnings.push_back(fmt::format(
+            "{}; the analysis starts there (--release none to analyse the whole record)",
+            detection.description));
+      }
+      break;
+    }
+  }
+  // Samples at or after the release: PrepareRecord keeps t >= window_start_s - tau / 2.
+  applied.window_start_s =
+      std::max(options.window_start_s,
+               result->release_time_s + 0.5 * measurement.sample_interval_s * (1 - 1e-9));
+  return applied;
+}
+
+// Reasons the data do not support the result (ModalResult::reliable).
+void AssessReliability(const AnalysisRecord& record, const IdentificationOptions& options,
+                       const Estimate& estimate, ModalResult* result) {
+  std::vector<std::string>& reasons = result->reasons;
+  // The fit's residual against the record's own noise level: a record the modes explain leaves
+  // noise (ratio about 1; coloured noise a little more). 3 x the noise, or a residual above a
+  // millionth of the signal when the record is noiseless, means something in the record is not
+  // in the modes (a start before the free decay, a nonlinearity, a missed mode).
+  const Eigen::VectorXd& residual = estimate.fit.residual_variance;
+  for (Eigen::Index c = 0; c < residual.size() && c < estimate.noise_std.size(); ++c) {
+    const double rms = std::sqrt(record.decimated.col(c).squaredNorm() / record.decimated.rows());
+    const double level = std::max(estimate.noise_std(c), 1e-6 * rms);
+    const double ratio = std::sqrt(residual(c)) / level;
+    if (ratio > 3) {
+      reasons.push_back(fmt::format(
+          "the residual in channel {} is {:.3g} times the record's noise level: the modes do not "
+          "explain the record",
+          result->channels[static_cast<size_t>(c)], ratio));
+    }
+  }
+  for (Eigen::Index c = 0; c < result->correlation.size(); ++c) {
+    if (!(result->correlation(c) >= options.min_correlation)) {
+      reasons.push_back(fmt::format(
+          "K = {:.3f} in channel {} is below min_correlation {}: the modes do not explain the "
+          "record in the analysed band",
+          result->correlation(c), result->channels[static_cast<size_t>(c)],
+          options.min_correlation));
+    }
+  }
+  const double top_hz = std::min(record.max_frequency_hz, record.flat_frequency_hz);
+  for (const IdentifiedMode& mode : result->modes) {
+    if (mode.frequency_hz > 0.95 * top_hz) {
+      reasons.push_back(fmt::format(
+          "the mode at {:.4g} Hz is at the top of the analysed band ({:.4g} Hz{}): it may be "
+          "cut by the band or the decimation filter",
+          mode.frequency_hz, top_hz,
+          record.decimation > 1 ? fmt::format(", decimation {}", record.decimation) : ""));
+    }
+    if (options.min_frequency_hz > 0 && mode.frequency_hz < 1.05 * options.min_frequency_hz) {
+      reasons.push_back(fmt::format("the mode at {:.4g} Hz is at the bottom of the band ({} Hz)",
+                                    mode.frequency_hz, options.min_frequency_hz));
+    }
+    if (mode.std_frequency_hz > 0.1 * mode.frequency_hz ||
+        (mode.decay_rate_per_s > 0 && mode.std_decay_rate_per_s > mode.decay_rate_per_s)) {
+      reasons.push_back(fmt::format(
+          "the mode at {:.4g} Hz is undetermined (std of frequency {:.3g} Hz, of decay {:.3g} "
+          "1/s)",
+          mode.frequency_hz, mode.std_frequency_hz, mode.std_decay_rate_per_s));
+    }
+  }
+  // Modes within 3 % of each other: one mode whose frequency drifts with amplitude, or two the
+  // record cannot tell apart; either way not two modes to size dampers on.
+  for (size_t k = 1; k < result->modes.size(); ++k) {
+    const double low = result->modes[k - 1].frequency_hz;
+    const double high = result->modes[k].frequency_hz;
+    if (high - low < 0.03 * high) {
+      reasons.push_back(fmt::format(
+          "modes at {:.4g} and {:.4g} Hz are {:.2g} % apart: one mode drifting with amplitude "
+          "or two the record cannot separate",
+          low, high, 100 * (high - low) / high));
+    }
+  }
+  if (result->termination != "converged") {
+    reasons.push_back("the refinement did not converge (" + result->termination + ")");
+  }
+  result->reliable = reasons.empty();
+}
+
 }  // namespace
 
 ModalResult Identify(const Measurement& measurement, const IdentificationOptions& options,
                      const std::string& origin) {
-  const AnalysisRecord record = PrepareRecord(measurement, options, origin);
   ModalResult result;
+  if (const auto problem = FindOptionProblem(options)) {
+    throw InputError("identification options", problem->field, problem->problem, problem->expected);
+  }
+  const IdentificationOptions applied = ApplyRelease(measurement, options, &result);
+  const AnalysisRecord record = PrepareRecord(measurement, applied, origin);
   result.channels = record.channels;
   result.units = record.units;
   result.sample_interval_s = record.sample_interval_s;
   result.samples = static_cast<int>(record.values.rows());
   result.start_time_s = record.start_time_s;
-  result.decimation = options.decimation;
+  result.decimation = record.decimation;
+  result.max_frequency_hz = record.max_frequency_hz;
+  result.min_correlation = options.min_correlation;
   result.method = MethodName(options.method);
   result.significance_threshold = SignificanceThreshold(record, options);
   if (options.compute_spectrum) {
@@ -464,16 +574,17 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   result.termination = estimate.termination;
   result.iterations = estimate.iterations;
   result.stabilization = std::move(estimate.stabilization);
-  result.warnings = std::move(estimate.warnings);
+  result.warnings.insert(result.warnings.end(), estimate.warnings.begin(), estimate.warnings.end());
 
   // Amplitudes, phases, reconstruction and correlation on the full-rate record.
   const bool with_offset = options.offset == OffsetRemoval::kFit;
   const AmplitudeFit fit =
-      options.decimation == 1
+      record.decimation == 1
           ? estimate.fit
           : FitAmplitudes(record.centered, record.sample_interval_s, estimate.lambda, with_offset);
   result.reconstruction = fit.reconstruction.rowwise() + record.mean.transpose();
-  result.correlation = CalcCorrelation(record.values, result.reconstruction);
+  // K in the analysed band: the filtered record the poles came from against the fit on it.
+  result.correlation = CalcCorrelation(record.decimated, estimate.fit.reconstruction);
   result.noise_std = fit.residual_variance.cwiseSqrt();
   result.offset = record.mean;
   if (with_offset) result.offset += fit.coefficients.row(fit.coefficients.rows() - 1).transpose();
@@ -519,6 +630,7 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   std::vector<IdentifiedMode> sorted;
   for (size_t i : order) sorted.push_back(result.modes[i]);
   result.modes = std::move(sorted);
+  AssessReliability(record, options, estimate, &result);
   return result;
 }
 

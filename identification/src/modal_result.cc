@@ -72,8 +72,14 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
   json["modes"] = modes;
   json["correlation"] = PerChannel(result.channels, result.correlation);
 
+  json["reliable"] = result.reliable;
+  json["reasons"] = result.reasons;
+  json["min_correlation"] = result.min_correlation;
+  json["release_time_s"] = result.release_time_s;
+  json["release"] = result.release;
   json["start_time_s"] = result.start_time_s;
   json["decimation"] = result.decimation;
+  json["max_frequency_hz"] = Number(result.max_frequency_hz);
   json["significance_threshold"] = Number(result.significance_threshold);
   json["offset"] = PerChannel(result.channels, result.offset);
   json["noise_std"] = PerChannel(result.channels, result.noise_std);
@@ -130,6 +136,11 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result, const std::st
   writer.WriteScalar(group, "effective_rank", result.effective_rank, "1");
   writer.WriteScalar(group, "start_time_s", result.start_time_s, "s");
   writer.WriteScalar(group, "decimation", result.decimation, "1");
+  writer.WriteScalar(group, "max_frequency_hz", result.max_frequency_hz, "Hz");
+  writer.WriteScalar(group, "release_time_s", result.release_time_s, "s");
+  writer.WriteStringAttribute(group, "release", result.release);
+  writer.WriteStringAttribute(group, "reliable", result.reliable ? "true" : "false");
+  writer.WriteStrings(group, "reasons", result.reasons);
   writer.WriteScalar(group, "significance_threshold", result.significance_threshold, "1");
   writer.WriteScalar(group, "iterations", result.iterations, "1");
   writer.WriteStringAttribute(group, "termination", result.termination);

@@ -52,7 +52,11 @@ std::optional<OptionProblem> FindOptionProblem(const IdentificationOptions& o) {
             o.window_start_s, "a number below +inf (-inf: from the first sample)");
   c.Require(!std::isnan(o.window_end_s) && o.window_end_s > o.window_start_s, "window_end_s",
             o.window_end_s, "a number above window_start_s (+inf: to the last sample)");
-  c.Require(o.decimation >= 1, "decimation", o.decimation, "an integer >= 1");
+  c.Require(o.decimation >= 0, "decimation", o.decimation, "0 (automatic) or an integer >= 1");
+  c.Require(std::isfinite(o.release_time_s), "release_time_s", o.release_time_s,
+            "a finite time in s");
+  c.Require(std::isfinite(o.min_correlation) && o.min_correlation >= 0 && o.min_correlation <= 1,
+            "min_correlation", o.min_correlation, "a correlation in [0, 1]");
   c.Require(std::isfinite(o.min_frequency_hz) && o.min_frequency_hz >= 0, "min_frequency_hz",
             o.min_frequency_hz, "a finite number >= 0");
   c.Require(std::isfinite(o.max_frequency_hz) &&

@@ -7,6 +7,7 @@
 
 #include "internal.h"
 #include "mbid/common/error.h"
+#include "mbid/identification/spectrum.h"
 
 namespace mbid::identification {
 namespace {
@@ -51,7 +52,45 @@ Eigen::MatrixXd Decimate(const Eigen::MatrixXd& values, int q) {
   return decimated;
 }
 
+// The decimation filter is flat to this fraction of the new Nyquist frequency (see above).
+constexpr double kFlatFraction = 0.76;
+
 }  // namespace
+
+int ChooseDecimation(const Eigen::MatrixXd& centered, double sample_interval_s,
+                     double max_frequency_hz) {
+  const Eigen::Index samples = centered.rows();
+  // Decimating fewer than 2000 samples would leave under 1000: not worth the filter's edges.
+  if (samples < 2000) return 1;
+  double band_hz = max_frequency_hz;
+  if (band_hz <= 0) {
+    SpectrumOptions options;
+    options.zero_padding_factor = 1;  // the floor and the top, not fine peak positions
+    options.min_peak_prominence = 1;  // no peak list needed
+    const Spectrum spectrum = CalcSpectrum(centered, sample_interval_s, options);
+    double top_hz = 0;
+    for (Eigen::Index c = 0; c < spectrum.amplitude.cols(); ++c) {
+      const Eigen::VectorXd amplitude = spectrum.amplitude.col(c);
+      std::vector<double> sorted(amplitude.data(), amplitude.data() + amplitude.size());
+      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+      // White noise's Hann spectrum is Rayleigh distributed: 10x its median is 12 standard
+      // deviations, which no noise bin reaches (probability e^-69 per bin).
+      const double floor = sorted[sorted.size() / 2];
+      for (Eigen::Index b = amplitude.size() - 1; b > 0; --b) {
+        if (amplitude(b) > 10 * floor) {
+          top_hz = std::max(top_hz, spectrum.frequency_hz(b));
+          break;
+        }
+      }
+    }
+    if (top_hz <= 0) return 1;
+    band_hz = 1.25 * top_hz;
+  }
+  const double nyquist_hz = 0.5 / sample_interval_s;
+  const int by_band = static_cast<int>(std::floor(kFlatFraction * nyquist_hz / band_hz));
+  const int by_length = static_cast<int>(samples / 1000);
+  return std::max(1, std::min(by_band, by_length));
+}
 
 int RequiredSamples(const IdentificationOptions& options, int channels) {
   if (options.method == Method::kPronySvd) {
@@ -114,7 +153,19 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
   const int count = last - first + 1;
   record.sample_interval_s = tau;
   record.start_time_s = t0 + first * tau;
-  const int q = options.decimation;
+  int q = options.decimation;
+  if (q == 0) {
+    // Chosen on the window's channels, offset removed (a constant dominates the lowest bin only).
+    Eigen::MatrixXd window(count, static_cast<Eigen::Index>(columns.size()));
+    for (size_t c = 0; c < columns.size(); ++c) {
+      window.col(c) = measurement.values.col(columns[c]).segment(first, std::max(count, 0));
+    }
+    q = count > 0 && window.allFinite()
+            ? ChooseDecimation(window.rowwise() - window.colwise().mean(), tau,
+                               options.max_frequency_hz)
+            : 1;
+  }
+  record.decimation = q;
   const int required = RequiredSamples(options, static_cast<int>(columns.size()));
   const int decimated_count =
       count > 2 * kFilterHalfLength * q ? (count - 1 - 2 * kFilterHalfLength * q) / q + 1 : 0;
@@ -159,6 +210,7 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
   // Band against the Nyquist frequency of the record the poles are estimated on.
   record.decimated_interval_s = tau * q;
   const double nyquist_hz = 0.5 / record.decimated_interval_s;
+  record.flat_frequency_hz = q == 1 ? nyquist_hz : kFlatFraction * nyquist_hz;
   record.max_frequency_hz = options.max_frequency_hz == 0 ? nyquist_hz : options.max_frequency_hz;
   if (record.max_frequency_hz > nyquist_hz) {
     throw InputError(origin, "max_frequency_hz",

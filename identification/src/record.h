@@ -25,11 +25,22 @@ struct AnalysisRecord {
   Eigen::MatrixXd decimated;
   double decimated_interval_s = 0;
   double max_frequency_hz = 0;  // the band's upper limit (resolved from 0 = Nyquist)
+  int decimation = 1;           // as used (resolved from 0 = automatic)
+  // The highest frequency the low-pass filter passes flat (the Nyquist frequency without
+  // decimation): modes above it are at the band's edge.
+  double flat_frequency_hz = 0;
 };
 
 // Applies the options to the measurement and checks the input (see Identify for the errors).
 AnalysisRecord PrepareRecord(const Measurement& measurement, const IdentificationOptions& options,
                              const std::string& origin);
+
+// The decimation factor for IdentificationOptions::decimation = 0: the largest that keeps the
+// band (max_frequency_hz if > 0, else 1.25 x the highest frequency where some channel's
+// spectrum stands 10x above its median, the noise floor) inside the filter's flat part and at
+// least 1000 samples; 1 if the record is not oversampled.
+int ChooseDecimation(const Eigen::MatrixXd& centered, double sample_interval_s,
+                     double max_frequency_hz);
 
 // Samples of the decimated record that the method's order needs.
 int RequiredSamples(const IdentificationOptions& options, int channels);

@@ -62,6 +62,8 @@ TEST(IdentifyTest, NoiselessDampedSinusoidsAreExact) {
     options.method = method;
     const ModalResult result = Identify(MakeRecord(spec, Synthesize(spec)), options);
     ExpectModes(result, spec, 1e-8, 1e-6, 1e-6);
+    EXPECT_TRUE(result.reliable) << (result.reasons.empty() ? "" : result.reasons.front());
+    EXPECT_EQ(result.release, "record start");              // the record starts in the decay
     for (int c = 0; c < 2; ++c) {                           // 2 channels
       EXPECT_NEAR(result.offset(c), spec.offset[c], 1e-9);  // round-off of the linear fit
       EXPECT_GT(result.correlation(c), 1 - 1e-12);          // reconstruction is the record
@@ -175,6 +177,8 @@ TEST(IdentifyTest, PaperTableOneAt30Db) {
     }
     // The paper reports K >= 0.88 on its real record; a noise level of 30 dB leaves ~0.999.
     for (int c = 0; c < 2; ++c) EXPECT_GT(result.correlation(c), 0.99);
+    // A record the modes explain: nothing to flag.
+    EXPECT_TRUE(result.reliable) << (result.reasons.empty() ? "" : result.reasons.front());
   }
   for (size_t k = 0; k < 4; ++k) {
     EXPECT_NEAR(mean_frequency[k], spec.modes[k].frequency_hz, 0.01 * spec.modes[k].frequency_hz);

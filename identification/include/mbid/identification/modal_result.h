@@ -52,8 +52,13 @@ struct ModalResult {
   double sample_interval_s = 0;       // of the record (before decimation)
   int samples = 0;                    // analysed (in the time window, full rate)
   double start_time_s = 0;            // time of the first analysed sample: t = 0 of the modes
+  // Where the free decay starts (release.h), in the record's time; `release` says how it was
+  // found: "detected", "record start" (nothing at rest before the decay), "given" or "none".
+  double release_time_s = 0;
+  std::string release = "record start";
   int decimation = 1;
-  std::string method;  // "hankel-nls" | "prony-svd"
+  double max_frequency_hz = 0;  // top of the analysed band
+  std::string method;           // "hankel-nls" | "prony-svd"
   // prony-svd: p of eq. 3 and the effective rank k of step 3. hankel-nls: the largest order the
   // Hankel matrix can represent (columns - 1) and the number of singular values above the
   // noise floor.
@@ -61,10 +66,18 @@ struct ModalResult {
   int effective_rank = 0;
   std::vector<IdentifiedMode> modes;  // ascending frequency
   double significance_threshold = 0;  // IdentificationOptions::significance_false_alarm
-  Eigen::VectorXd correlation;        // per channel: Pearson's K of record and reconstruction
-  Eigen::VectorXd offset;             // per channel constant (0 unless fitted or removed)
-  Eigen::VectorXd noise_std;          // per channel: residual standard deviation
-  Eigen::MatrixXd reconstruction;     // samples x channels, offset included
+  // Per channel: Pearson's K of record and reconstruction in the analysed band (the record low-
+  // pass filtered and decimated as the poles were estimated; the full record when decimation 1).
+  Eigen::VectorXd correlation;
+  // false when the data do not support the result; `reasons` says why (K below
+  // min_correlation, a mode at the band's edge, modes too close to tell apart, a refinement that
+  // did not converge, an undetermined mode).
+  bool reliable = true;
+  std::vector<std::string> reasons;
+  double min_correlation = 0.9;
+  Eigen::VectorXd offset;          // per channel constant (0 unless fitted or removed)
+  Eigen::VectorXd noise_std;       // per channel: residual standard deviation
+  Eigen::MatrixXd reconstruction;  // samples x channels, offset included
   // eq. 5: [A1 ... Ap] of eq. 2 (m x m p) from the modes' poles and output vectors; empty if
   // not computed.
   Eigen::MatrixXd eq2_coefficients;

@@ -96,10 +96,21 @@ struct RefinementOptions {
   bool weight_channels_by_noise = true;
 };
 
+// Where the analysed free decay starts (release.h).
+enum class ReleaseMode {
+  kDetect,  // found in the record: the end of a segment at rest (default)
+  kGiven,   // IdentificationOptions::release_time_s
+  kNone,    // the record's start (the record is the free decay)
+};
+
 // Everything the identification of a free-decay record can be told. Defaults are meant for
 // records like the paper's (a few modes, damping ratio up to 0.8, 10-40 dB SNR).
 struct IdentificationOptions {
   Method method = Method::kHankelNls;
+
+  // The free decay starts at the release; the analysis window never starts before it.
+  ReleaseMode release = ReleaseMode::kDetect;
+  double release_time_s = 0.0;  // kGiven: in the record's own time
 
   // The part of the record that is analysed, in the record's own time (s), inclusive.
   double window_start_s = -std::numeric_limits<double>::infinity();
@@ -109,8 +120,10 @@ struct IdentificationOptions {
   // Poles are estimated on the record low-pass filtered (zero-phase FIR, cutoff 0.9 of the new
   // Nyquist frequency, flat to 0.76 of it) and downsampled by this factor; amplitudes, phases
   // and the reconstruction always use the full-rate record. The filter loses the first and last
-  // 20 * decimation samples for the pole estimate.
-  int decimation = 1;
+  // 20 * decimation samples for the pole estimate. 0 (default): chosen from the spectrum, so
+  // that the highest mode (and max_frequency_hz, if given) lies in the flat part of the filter
+  // with a margin, keeping at least 1000 samples; a record that is not oversampled keeps 1.
+  int decimation = 0;
 
   // Step 5 of method.md: poles outside these limits are dropped. Modes are oscillatory:
   // frequency_hz > min_frequency_hz >= 0.
@@ -134,6 +147,10 @@ struct IdentificationOptions {
   // true: modes below the threshold are dropped (and the fit repeated without them);
   // false: they are kept with significant = false.
   bool drop_insignificant = true;
+
+  // A result whose reconstruction explains less of the analysed band than this (Pearson's K in
+  // any channel) is flagged unreliable.
+  double min_correlation = 0.9;
 
   bool compute_spectrum = true;
   bool compute_stabilization = true;

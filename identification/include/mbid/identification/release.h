@@ -1,0 +1,35 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mbid/common/measurement.h"
+
+namespace mbid::identification {
+
+// Where the free decay of a record starts: the load or pull release, the impact, the end of
+// leading zeros or of a pre-trigger segment. Before it the structure is at rest (a constant per
+// channel plus noise); after it the response sets off from that constant like
+//   c + j H(t - t0) + b (t - t0) + a (t - t0)^2,
+// continuous in position for angles and lengths (at rest at a release, moving off at an impact)
+// and free to jump for rate channels (units ".../s", ".../s^2"), whose step is the release.
+struct ReleaseDetection {
+  double release_time_s = 0;  // in the record's own time
+  // true: a segment at rest precedes the decay and release_time_s is where it ends (to a
+  // fraction of a sample); false: the record starts in the decay, release_time_s is its start.
+  bool detected = false;
+  int rest_samples = 0;     // samples at rest before the release
+  std::string description;  // one line for the user
+};
+
+// Finds the release in `record`'s channels (all of them). Never throws on a valid record.
+ReleaseDetection DetectRelease(const Measurement& record);
+
+// The part of `record` from `release_time_s` on, with the release as time origin: samples at
+// t >= release_time_s (less a millionth of a sample for round-off) keep their values, and
+// start_time_s becomes their time since the release (in [0, tau)). Throws InputError naming
+// `origin` if fewer than 2 samples remain.
+Measurement CutAtRelease(const Measurement& record, double release_time_s,
+                         const std::string& origin);
+
+}  // namespace mbid::identification

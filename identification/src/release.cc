@@ -1,0 +1,202 @@
+#include "mbid/identification/release.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "mbid/common/error.h"
+
+namespace mbid::identification {
+namespace {
+
+// A coarse onset is where some channel has moved this fraction of its range from where the
+// record begins; the onset model is fitted on the samples before it.
+constexpr double kOnsetFraction = 0.25;
+// Samples at rest deviate from their constant by less than this fraction of the range.
+constexpr double kRestFraction = 0.1;
+constexpr int kMinRestSamples = 3;
+
+bool IsRate(const std::string& unit) {
+  const auto ends = [&unit](const char* suffix) {
+    const std::string s(suffix);
+    return unit.size() >= s.size() && unit.compare(unit.size() - s.size(), s.size(), s) == 0;
+  };
+  return ends("/s") || ends("/s^2") || ends("/s2") || ends("s-1") || ends("s-2");
+}
+
+// Least-squares cost of the onset model with the release at t0 (in samples from `first`) over
+// samples [first, last], channels weighted by their range.
+struct OnsetFit {
+  const Eigen::MatrixXd* values;
+  std::vector<bool> rate;
+  Eigen::VectorXd range;
+  int first = 0, last = 0;
+
+  bool jump_everywhere = false;  // a jump in every channel, not only in rate channels
+
+  double Cost(double t0) const {
+    double cost = 0;
+    const int n = last - first + 1;
+    for (Eigen::Index c = 0; c < values->cols(); ++c) {
+      // Unknowns: constant, jump (rate channels), slope, curvature, cubic term.
+      const bool jump = rate[c] || jump_everywhere;
+      const int p = jump ? 5 : 4;
+      Eigen::MatrixXd basis(n, p);
+      for (int i = 0; i < n; ++i) {
+        const double s = std::max(0.0, static_cast<double>(first + i) - t0);
+        const bool after = static_cast<double>(first + i) >= t0;
+        int k = 0;
+        basis(i, k++) = 1;
+        if (jump) basis(i, k++) = after ? 1.0 : 0.0;
+        basis(i, k++) = s;
+        basis(i, k++) = s * s;
+        basis(i, k++) = s * s * s;
+      }
+      const Eigen::VectorXd y = values->col(c).segment(first, n) / range(c);
+      const Eigen::MatrixXd normal = basis.transpose() * basis;
+      const Eigen::VectorXd rhs = basis.transpose() * y;
+      const Eigen::VectorXd x = normal.ldlt().solve(rhs);
+      cost += (y - basis * x).squaredNorm();
+    }
+    return cost;
+  }
+};
+
+// The release instant (in samples) that minimizes fit.Cost: every sample up to `early`, then a
+// golden section between the neighbours of the best.
+double FindOnset(const OnsetFit& fit, int early, double* cost) {
+  int best = fit.first;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int j = fit.first; j <= early; ++j) {
+    const double c = fit.Cost(j);
+    if (c < best_cost) {
+      best_cost = c;
+      best = j;
+    }
+  }
+  double low = std::max<double>(fit.first, best - 1), high = std::min<double>(early, best + 1);
+  const double golden = 0.5 * (std::sqrt(5.0) - 1);
+  double a = high - golden * (high - low), b = low + golden * (high - low);
+  double fa = fit.Cost(a), fb = fit.Cost(b);
+  for (int i = 0; i < 40 && high - low > 1e-4; ++i) {
+    if (fa < fb) {
+      high = b, b = a, fb = fa;
+      a = high - golden * (high - low), fa = fit.Cost(a);
+    } else {
+      low = a, a = b, fa = fb;
+      b = low + golden * (high - low), fb = fit.Cost(b);
+    }
+  }
+  double t0 = fa < fb ? a : b;
+  *cost = std::min(fa, fb);
+  if (best_cost <= *cost) {
+    t0 = best;
+    *cost = best_cost;
+  }
+  // A jump alone places the release only between two samples (a shifted polynomial is still
+  // one): the cost is then flat there, and the middle is the honest answer.
+  const double inside = fit.Cost(best - 0.5);
+  const double tolerance = 1e-9 * std::max(best_cost, 1e-300);
+  if (best > fit.first && std::abs(best_cost - inside) <= tolerance &&
+      std::abs(fit.Cost(best - 0.999) - best_cost) <= tolerance) {
+    t0 = best - 0.5;
+  }
+  return t0;
+}
+
+}  // namespace
+
+ReleaseDetection DetectRelease(const Measurement& record) {
+  ReleaseDetection detection;
+  detection.release_time_s = record.start_time_s;
+  detection.description = "the record starts in the free decay (no segment at rest before it)";
+  const Eigen::MatrixXd& y = record.values;
+  const int n = static_cast<int>(y.rows());
+  const Eigen::Index m = y.cols();
+  if (n < 8 || m == 0) return detection;
+
+  Eigen::VectorXd range = (y.colwise().maxCoeff() - y.colwise().minCoeff()).transpose();
+  Eigen::VectorXd reference(m);
+  for (Eigen::Index c = 0; c < m; ++c) {
+    // The first few samples' median: robust to a noisy first sample.
+    std::vector<double> head(y.col(c).data(), y.col(c).data() + std::min(n, 5));
+    std::nth_element(head.begin(), head.begin() + head.size() / 2, head.end());
+    reference(c) = head[head.size() / 2];
+    if (!(range(c) > 0)) range(c) = 1;  // a constant channel says nothing; keep it harmless
+  }
+  const auto deviation = [&](int j) {
+    return ((y.row(j).transpose() - reference).cwiseAbs().array() / range.array()).maxCoeff();
+  };
+  int onset = 0;
+  while (onset < n && deviation(onset) <= kOnsetFraction) ++onset;
+  if (onset < kMinRestSamples + 2 || onset >= n) return detection;
+  // The noise of the segment before the onset (its first half, safely at rest if anything is):
+  // the motion is "clearly there" kEarlySigmas above it, or 2 % of the range.
+  const int quiet = std::max(2, onset / 2);
+  double early_fraction = 0.02;
+  double noise_variance = 0;  // in the units of OnsetFit::Cost
+  for (Eigen::Index c = 0; c < m; ++c) {
+    const Eigen::VectorXd head = y.col(c).head(quiet);
+    const double std_dev = std::sqrt((head.array() - head.mean()).square().sum() / (quiet - 1));
+    early_fraction = std::max(early_fraction, 6 * std_dev / range(c));
+    noise_variance += std::pow(std_dev / range(c), 2);
+  }
+  int early = 0;
+  while (early < onset && deviation(early) <= early_fraction) ++early;
+  const int first = std::max(0, early - std::max(20, 3 * (onset - early)));
+  // A few samples past the first clear motion: the polynomial holds a fraction of a period, and
+  // a jump (rate channels) needs samples after it to be told from a slope.
+  const int last = std::min(n - 1, early + 3);
+  OnsetFit fit{&y, {}, range, first, last};
+  for (const std::string& unit : record.units) fit.rate.push_back(IsRate(unit));
+  fit.rate.resize(static_cast<size_t>(m), false);
+  double cost = 0;
+  double t0 = FindOnset(fit, early, &cost);
+  // A position that jumps (an impact, a record that starts abruptly after zeros) fits the
+  // jump model better by far more than noise: 25 is a change of 5 noise standard deviations.
+  fit.jump_everywhere = true;
+  double jump_cost = 0;
+  const double jump_t0 = FindOnset(fit, early, &jump_cost);
+  if (cost - jump_cost > 25 * noise_variance) t0 = jump_t0;
+  const int rest = static_cast<int>(std::ceil(t0));  // samples before the release
+  if (rest < kMinRestSamples + 1) return detection;
+  // The segment before must really be at rest: within kRestFraction of its own median.
+  for (Eigen::Index c = 0; c < m; ++c) {
+    std::vector<double> before(y.col(c).data(), y.col(c).data() + rest);
+    std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
+    const double level = before[before.size() / 2];
+    if ((y.col(c).head(rest).array() - level).abs().maxCoeff() > kRestFraction * range(c)) {
+      return detection;
+    }
+  }
+  detection.detected = true;
+  detection.rest_samples = rest;
+  detection.release_time_s = record.start_time_s + t0 * record.sample_interval_s;
+  detection.description = fmt::format("free decay starts at {:.6g} s after {} samples at rest",
+                                      detection.release_time_s, rest);
+  return detection;
+}
+
+Measurement CutAtRelease(const Measurement& record, double release_time_s,
+                         const std::string& origin) {
+  const double tau = record.sample_interval_s;
+  const double position = (release_time_s - record.start_time_s) / tau;
+  const int first = std::max(0, static_cast<int>(std::ceil(position - 1e-6)));
+  if (!std::isfinite(release_time_s) || first > record.samples() - 2) {
+    throw InputError(
+        origin, "release_time_s",
+        fmt::format("{} s leaves {} samples of the record ({} .. {} s)", release_time_s,
+                    std::max(0, record.samples() - first), record.start_time_s,
+                    record.start_time_s + (record.samples() - 1) * tau),
+        "a release time at least two samples before the record's end");
+  }
+  Measurement cut = record;
+  cut.values = record.values.bottomRows(record.samples() - first);
+  cut.start_time_s = std::max(0.0, (first - position) * tau);
+  return cut;
+}
+
+}  // namespace mbid::identification
