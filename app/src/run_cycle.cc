@@ -48,7 +48,7 @@ class Progress {
 // The tests of the run: the scenario's records, or one test simulated from the model.
 std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::MechanicalModel& model,
                                   const simulation::Excitation& excitation,
-                                  const Progress& progress) {
+                                  const Progress& progress, const ImportOverrides& overrides) {
   std::vector<RunTest> tests;
   if (scenario.records.empty()) {
     RunTest test;
@@ -68,7 +68,11 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
     return tests;
   }
   for (const RecordSource& source : scenario.records) {
-    LoadedRecord loaded = LoadRecord(source, model);
+    LoadedRecord loaded = LoadRecord(source, model, overrides);
+    if (loaded.import) {
+      progress.Say(fmt::format("test {}: {}: {}", source.name, loaded.origin,
+                               DescribeImport(*loaded.import)));
+    }
     RunTest test;
     test.name = source.name;
     test.origin = loaded.origin;
@@ -208,7 +212,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   settings.updating.options.quiet = common.quiet;
   settings.min_correlation = scenario.validation_min_correlation;
 
-  std::vector<RunTest> tests = AcquireTests(scenario, *model, excitation, progress);
+  std::vector<RunTest> tests = AcquireTests(scenario, *model, excitation, progress, common.import);
   const bool several = tests.size() > 1;
   for (RunTest& test : tests) {
     const std::string prefix = several ? "test " + test.name + ": " : "";
