@@ -132,6 +132,16 @@ std::string UnknownUnitHint(const std::string& text) {
                      text);
 }
 
+// udunits2 reads a bare `g` as the gram; on a vibration logger it almost always means standard
+// gravity. Neither is guessed: the user writes gn or gram.
+void RefuseBareG(const std::string& text, const std::string& source, const std::string& field) {
+  if (text == "g" || text == "G") {
+    throw InputError(source, field,
+                     fmt::format("unit '{}' is ambiguous (udunits2 reads the gram)", text),
+                     "gn for standard gravity (9.80665 m/s^2), or gram for a mass");
+  }
+}
+
 }  // namespace
 
 bool IsUnit(const std::string& text) {
@@ -141,6 +151,7 @@ bool IsUnit(const std::string& text) {
 
 std::string SiUnitFor(const std::string& unit, const std::string& source,
                       const std::string& field) {
+  RefuseBareG(unit, source, field);
   const std::lock_guard<std::mutex> lock(UnitsMutex());
   const UnitPtr parsed = Parse(unit);
   if (!parsed) {
@@ -155,6 +166,7 @@ std::string SiUnitFor(const std::string& unit, const std::string& source,
 UnitConversion FindConversion(const std::string& from, const std::string& to,
                               const std::string& source, const std::string& field) {
   if (from == to) return {};
+  RefuseBareG(from, source, field);
   const std::lock_guard<std::mutex> lock(UnitsMutex());
   const UnitPtr a = Parse(from);
   if (!a) {

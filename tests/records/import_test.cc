@@ -24,10 +24,10 @@ using mbid::testing::WriteText;
 using ::testing::HasSubstr;
 
 constexpr double kDeg = M_PI / 180;
-// Values are printed with 9 significant digits: relative error <= 5e-10 of the largest value,
-// amplitude + offset; 1e-9 of that leaves a factor 2 for the unit factor's rounding.
+// Values are printed with 9 significant digits: error <= 5e-9 of the largest value, amplitude
+// + offset; 1e-8 of that leaves a factor 2 for the unit factor's and the sum's rounding.
 double PrintTolerance(const Decay& decay, double factor) {
-  return 1e-9 * (std::abs(decay.amplitude) + std::abs(decay.offset)) * factor;
+  return 1e-8 * (std::abs(decay.amplitude) + std::abs(decay.offset)) * std::abs(factor);
 }
 
 void ExpectChannel(const Measurement& m, int c, const Decay& decay, double factor) {
@@ -196,7 +196,11 @@ TEST(ImportTest, GapsFilledLinearlyWithinTheInterpolationBound) {
     EXPECT_NEAR(m.values(j, 0), angle(j * h) * kDeg, bound) << j;
     EXPECT_NE(m.values(j, 0), angle(j * h) * kDeg);  // interpolated, not read
   }
-  ExpectChannel(m, 0, angle, kDeg);  // the rest stays exact; the bound above is wider
+  // The rest as read.
+  for (Eigen::Index j = 0; j < m.samples(); ++j) {
+    if (j == 50 || j == 120) continue;
+    ASSERT_NEAR(m.values(j, 0), angle(j * h) * kDeg, PrintTolerance(angle, kDeg)) << j;
+  }
 }
 
 TEST(ImportTest, NoTimeColumnWithSampleRate) {

@@ -40,7 +40,7 @@ inline std::string MakeExport(const std::string& head, int rows,
   return text;
 }
 
-// A number printed with 9 significant digits (relative rounding error <= 5e-10), with a
+// A number printed with 9 significant digits (relative rounding error <= 5e-9), with a
 // decimal comma when asked (German loggers).
 inline std::string Print(double value, bool decimal_comma = false) {
   std::string text = fmt::format("{:.9g}", value);
