@@ -78,6 +78,7 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
     test.origin = loaded.origin;
     test.measured = std::move(loaded.measured);
     test.exact = std::move(loaded.exact);
+    test.import = std::move(loaded.import);
     progress.Say(fmt::format("test {}: {} ({} samples x {} channels)", test.name, test.origin,
                              test.measured.samples(), test.measured.channel_count()));
     tests.push_back(std::move(test));
@@ -265,6 +266,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
                       {"identification", identification::ModalResultToJson(test.identified)},
                       {"updating", updating::UpdateResultToJson(test.tuned, test.algebraic.get())},
                       {"validation", TestValidationJson(test, threshold)}});
+      if (test.import) list.back()["import"] = ImportReportToJson(*test.import);
       const updating::TestFit& fit = test.tuned.tests.front();
       for (size_t c = 0; c < fit.channels.size(); ++c) {
         const double k = fit.correlation[static_cast<Eigen::Index>(c)];

@@ -131,6 +131,7 @@ TEST_F(RecordsCliTest, RunReadsALoggerFileThroughTheRecordKeys) {
   EXPECT_NE(result.err.find("1 gap sample filled linearly"), std::string::npos) << result.err;
   const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));
   EXPECT_TRUE(summary["validation"]["passed"].get<bool>()) << summary["validation"].dump();
+  EXPECT_EQ(summary["tests"][0]["import"]["filled_samples"], 1);  // the one empty cell
   for (const char* channel : {"psi", "phi"}) {
     // As from the original file: 1e-5 rad noise on ~1e-3 rad outputs gives K > 0.999.
     EXPECT_GT(summary["validation"]["correlation"][channel].get<double>(), 0.999) << channel;
