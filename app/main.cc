@@ -15,6 +15,42 @@
 
 namespace {
 
+// Flags for the measured files of identify, update and run (docs/records.md).
+struct ImportFlags {
+  std::vector<std::string> channels;
+  std::vector<std::string> units;
+  std::string fill_gaps;
+};
+
+void AddImportFlags(CLI::App* command, ImportFlags* flags) {
+  command
+      ->add_option("--channel", flags->channels,
+                   "Record channel from a file column: NAME=COLUMN (column name or number among "
+                   "the data columns); repeatable")
+      ->allow_extra_args(false);
+  command
+      ->add_option("--unit", flags->units,
+                   "Unit of a file column (or record channel): COLUMN=UNIT, e.g. Zeit=ms; "
+                   "repeatable")
+      ->allow_extra_args(false);
+  command
+      ->add_option("--fill-gaps", flags->fill_gaps,
+                   "Empty or NaN cells: linear (interpolate and report) or none (refuse)")
+      ->check(CLI::IsMember({"linear", "none"}));
+}
+
+mbid::app::ImportOverrides MakeOverrides(const ImportFlags& flags) {
+  mbid::app::ImportOverrides overrides;
+  overrides.channel_columns = mbid::app::ParseAssignments(flags.channels, "--channel");
+  for (const auto& [column, unit] : mbid::app::ParseAssignments(flags.units, "--unit")) {
+    overrides.units[column] = unit;
+  }
+  if (!flags.fill_gaps.empty()) {
+    overrides.fill_gaps = mbid::app::ParseGapFill(flags.fill_gaps, "command line", "--fill-gaps");
+  }
+  return overrides;
+}
+
 int Main(int argc, char** argv) {
   CLI::App app{
       "mbid: simulate machine structures, identify their vibration modes from "
@@ -24,6 +60,7 @@ int Main(int argc, char** argv) {
   app.require_subcommand(1);
   app.fallthrough();
   mbid::app::CommonOptions common;
+  ImportFlags import_flags;
   app.add_flag("-q,--quiet", common.quiet, "No progress on standard error");
 
   std::string scenario_path;
@@ -51,6 +88,7 @@ int Main(int argc, char** argv) {
   run->add_option("-o,--output", output_dir, "Results folder (default results/<scenario name>)");
   run->add_flag("--overwrite", common.overwrite,
                 "Replace the results folder if an earlier mbid run wrote it (never other folders)");
+  AddImportFlags(run, &import_flags);
 
   std::string campaign_path;
   int campaign_workers = 0;
@@ -68,8 +106,9 @@ int Main(int argc, char** argv) {
   std::string identify_method = "hankel-nls";
   std::string identify_offset = "fit";
   CLI::App* identify = app.add_subcommand(
-      "identify", "Identify the modes of a free-decay record (HDF5 or CSV measurement file)");
-  identify->add_option("DATA", data_path, "Measurement file (.h5 or .csv)")->required();
+      "identify", "Identify the modes of a free-decay record (HDF5, CSV or logger export)");
+  identify->add_option("DATA", data_path, "Measurement file (.h5, .csv, .txt)")->required();
+  AddImportFlags(identify, &import_flags);
   identify->add_option("-o,--output", output_path, "Write /measurement and /identification (.h5)");
   identify->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
   identify
@@ -107,8 +146,9 @@ int Main(int argc, char** argv) {
   CLI::App* update = app.add_subcommand(
       "update", "Tune the joints' stiffness and damping to measurements (Route 1, then Ceres)");
   update->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
-  update->add_option("DATA", update_data, "Measurement files (.h5 or .csv), one per test")
+  update->add_option("DATA", update_data, "Measurement files (.h5, .csv, .txt), one per test")
       ->required();
+  AddImportFlags(update, &import_flags);
   update->add_option("-o,--output", output_path, "Write /measurement, /scenario, /updating (.h5)");
   update->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
 
@@ -119,6 +159,7 @@ int Main(int argc, char** argv) {
     std::cerr << "mbid: error: command line: " << error.what() << "; expected see mbid --help\n";
     return static_cast<int>(mbid::ExitCode::kInvalidInput);
   }
+  common.import = MakeOverrides(import_flags);
   if (run->parsed()) {
     if (scenario_path.empty()) scenario_path = mbid::app::DefaultScenarioPath();
     return mbid::app::RunValidationCycle(scenario_path, output_dir, common);

@@ -7,6 +7,7 @@
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
 #include "mbid/identification/identify.h"
+#include "mbid/records/records.h"
 
 namespace mbid::app {
 
@@ -17,8 +18,11 @@ int RunIdentifyCommand(const std::string& data_path,
   if (!options.IsValid(&why)) {
     throw InputError("command line", "identification options", why, "see mbid identify --help");
   }
-  const Measurement measurement = ReadMeasurement(data_path);
+  records::ImportReport import;
+  const Measurement measurement = records::ImportMeasurement(
+      data_path, MergeImportOptions({}, common.import, nullptr), &import);
   if (!common.quiet) {
+    std::cerr << fmt::format("mbid: {}: {}\n", data_path, DescribeImport(import));
     std::cerr << fmt::format("mbid: identifying {} ({} samples x {} channels, {} Hz, {})\n",
                              data_path, measurement.samples(), measurement.channel_count(),
                              1.0 / measurement.sample_interval_s,
@@ -38,8 +42,11 @@ int RunIdentifyCommand(const std::string& data_path,
     if (!scenario.empty()) file->WriteScenarioYaml(scenario);
     identification::WriteModalResult(*file, result);
   }
-  if (!common.json_path.empty())
-    WriteJson(identification::ModalResultToJson(result), common.json_path);
+  if (!common.json_path.empty()) {
+    nlohmann::json summary = identification::ModalResultToJson(result);
+    summary["import"] = ImportReportToJson(import);
+    WriteJson(summary, common.json_path);
+  }
   if (file) file->Commit();  // only when everything else succeeded
 
   for (const std::string& warning : result.warnings) {

@@ -8,7 +8,7 @@
 #include <set>
 
 #include "mbid/common/error.h"
-#include "mbid/common/hdf5_io.h"
+#include "mbid/records/records.h"
 
 namespace mbid::app {
 namespace {
@@ -28,7 +28,9 @@ std::string OutputList(const model::MechanicalModel& model) {
 RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
                      const std::string& scenario_dir, const model::MechanicalModel& model) {
   if (!entry.IsMap()) entry.Fail("not a mapping", "{file: PATH} or {synthetic_modes: {...}}");
-  entry.ExpectMap({"name", "file", "synthetic_modes"});
+  std::vector<std::string> keys = {"name", "file", "synthetic_modes"};
+  keys.insert(keys.end(), ImportKeys().begin(), ImportKeys().end());
+  entry.ExpectMap(keys);
   RecordSource source;
   source.name = entry.String("name", default_name);
   // The name is an HDF5 group and, with several tests, the folder of the test's figures.
@@ -44,14 +46,20 @@ RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
   if (has_file) {
     const fs::path file = entry.String("file");
     source.file = (file.is_relative() ? fs::path(scenario_dir) / file : file).string();
-    const std::string extension = file.extension().string();
-    if (extension != ".csv" && extension != ".h5" && extension != ".hdf5") {
-      entry.FailAt("file", "'" + file.string() + "'", "a .csv, .h5 or .hdf5 measurement file");
+    if (!records::IsSupportedFile(file.string())) {
+      entry.FailAt(
+          "file", "'" + file.string() + "'",
+          fmt::format("a measurement file ({})", fmt::join(records::SupportedExtensions(), ", ")));
     }
     if (!fs::is_regular_file(source.file)) {
       entry.FailAt("file", "'" + source.file + "' does not exist", "a readable measurement file");
     }
+    source.import = ReadImportOptions(entry);
   } else {
+    for (const std::string& key : ImportKeys()) {
+      if (entry.Has(key))
+        entry.FailAt(key, "given for synthetic_modes", "import keys only with file: PATH");
+    }
     const YamlReader modes = entry.Child("synthetic_modes");
     source.synthetic = simulation::ReadModalRecordSpec(modes);
     for (const std::string& channel : source.synthetic->channels) {
@@ -89,7 +97,8 @@ std::vector<RecordSource> ReadRecordSources(const YamlReader& record,
   return sources;
 }
 
-LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel& model) {
+LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel& model,
+                        const ImportOverrides& overrides) {
   LoadedRecord loaded;
   if (source.synthetic) {
     Measurement exact;
@@ -98,7 +107,10 @@ LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel
     loaded.origin = "synthetic modes";
     return loaded;
   }
-  loaded.measured = ReadMeasurement(source.file);
+  records::ImportReport report;
+  loaded.measured = records::ImportMeasurement(
+      source.file, MergeImportOptions(source.import, overrides, &model), &report);
+  loaded.import = report;
   loaded.origin = source.file;
   RequireModelOutputs(loaded.measured, source.file, model);
   return loaded;

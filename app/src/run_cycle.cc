@@ -48,7 +48,7 @@ class Progress {
 // The tests of the run: the scenario's records, or one test simulated from the model.
 std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::MechanicalModel& model,
                                   const simulation::Excitation& excitation,
-                                  const Progress& progress) {
+                                  const Progress& progress, const ImportOverrides& overrides) {
   std::vector<RunTest> tests;
   if (scenario.records.empty()) {
     RunTest test;
@@ -68,12 +68,17 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
     return tests;
   }
   for (const RecordSource& source : scenario.records) {
-    LoadedRecord loaded = LoadRecord(source, model);
+    LoadedRecord loaded = LoadRecord(source, model, overrides);
+    if (loaded.import) {
+      progress.Say(fmt::format("test {}: {}: {}", source.name, loaded.origin,
+                               DescribeImport(*loaded.import)));
+    }
     RunTest test;
     test.name = source.name;
     test.origin = loaded.origin;
     test.measured = std::move(loaded.measured);
     test.exact = std::move(loaded.exact);
+    test.import = std::move(loaded.import);
     progress.Say(fmt::format("test {}: {} ({} samples x {} channels)", test.name, test.origin,
                              test.measured.samples(), test.measured.channel_count()));
     tests.push_back(std::move(test));
@@ -208,7 +213,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   settings.updating.options.quiet = common.quiet;
   settings.min_correlation = scenario.validation_min_correlation;
 
-  std::vector<RunTest> tests = AcquireTests(scenario, *model, excitation, progress);
+  std::vector<RunTest> tests = AcquireTests(scenario, *model, excitation, progress, common.import);
   const bool several = tests.size() > 1;
   for (RunTest& test : tests) {
     const std::string prefix = several ? "test " + test.name + ": " : "";
@@ -261,6 +266,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
                       {"identification", identification::ModalResultToJson(test.identified)},
                       {"updating", updating::UpdateResultToJson(test.tuned, test.algebraic.get())},
                       {"validation", TestValidationJson(test, threshold)}});
+      if (test.import) list.back()["import"] = ImportReportToJson(*test.import);
       const updating::TestFit& fit = test.tuned.tests.front();
       for (size_t c = 0; c < fit.channels.size(); ++c) {
         const double k = fit.correlation[static_cast<Eigen::Index>(c)];

@@ -12,6 +12,7 @@
 #include "mbid/identification/updating/output_error.h"
 #include "mbid/identification/updating/settings.h"
 #include "mbid/model/mechanical_model.h"
+#include "mbid/records/records.h"
 #include "mbid/simulation/excitation.h"
 #include "mbid/simulation/simulate.h"
 
@@ -23,6 +24,7 @@ struct RunTest {
   std::string origin;  // "simulation", the record's file, or "synthetic modes"
   Measurement measured;
   std::optional<Measurement> exact;                        // the noise-free record, when known
+  std::optional<records::ImportReport> import;             // what reading the record's file did
   std::optional<simulation::SimulationResult> simulation;  // a simulated test's integration
   identification::ModalResult identified;
   std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, if it ran

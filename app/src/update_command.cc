@@ -24,6 +24,7 @@
 #include "mbid/identification/updating/output_error.h"
 #include "mbid/identification/updating/result_io.h"
 #include "mbid/identification/updating/settings.h"
+#include "mbid/records/records.h"
 
 namespace mbid::app {
 namespace {
@@ -43,14 +44,17 @@ struct LoadedTest {
   simulation::Excitation excitation;
   std::string excitation_source;  // "scenario" or the file whose /scenario gave it
   identification::ModalResult identified;
+  records::ImportReport import;
 };
 
 LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
                     const model::MechanicalModel& model,
-                    const identification::IdentificationOptions& identification_options) {
+                    const identification::IdentificationOptions& identification_options,
+                    const ImportOverrides& overrides) {
   LoadedTest test;
   test.path = path;
-  test.record = ReadMeasurement(path);
+  test.record =
+      records::ImportMeasurement(path, MergeImportOptions({}, overrides, &model), &test.import);
   // Checked here rather than left to the fit: identification would run first on any channels.
   RequireModelOutputs(test.record, path, model);
   // A simulated test carries its own scenario: its excitation is the one of this record (a load
@@ -120,9 +124,10 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   // Every record is read and checked before any long work starts.
   std::vector<LoadedTest> tests;
   for (const std::string& path : data_paths) {
-    tests.push_back(LoadTest(path, scenario, *model, identification_options));
+    tests.push_back(LoadTest(path, scenario, *model, identification_options, common.import));
     if (!common.quiet) {
       const LoadedTest& test = tests.back();
+      std::cerr << fmt::format("mbid: {}: {}\n", path, DescribeImport(test.import));
       std::cerr << fmt::format("mbid: {}: {} samples x {} channels, {} ({}), {} modes identified\n",
                                path, test.record.samples(), test.record.channel_count(),
                                test.excitation.type_name(), test.excitation_source,
@@ -157,6 +162,12 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   const bool converged = result.termination == updating::UpdateResult::Termination::kConverged;
   nlohmann::json summary = updating::UpdateResultToJson(result, algebraic.get());
   summary["start"] = start;
+  summary["import"] = nlohmann::json::array();
+  for (const LoadedTest& test : tests) {
+    nlohmann::json item = ImportReportToJson(test.import);
+    item["file"] = test.path;
+    summary["import"].push_back(item);
+  }
   if (!note.empty()) summary["start_note"] = note;
   // A failed fit leaves no output file (interfaces.md); standard output still gets its JSON.
   if (common.json_path == "-" || (converged && !common.json_path.empty())) {

@@ -18,16 +18,24 @@ struct RawColumn {
 };
 
 struct RawTable {
-  std::string format;  // as ImportReport::format
+  std::string format;   // as ImportReport::format
+  std::string dialect;  // as ImportReport::dialect ("" when there is nothing to say)
+  std::string source;   // Measurement::source when the file states one, else ""
   // Time base: either a time column (`time`, in `time_unit`, NaN for a gap) or, when
   // `time` is empty, a uniform grid start + j * interval in `time_unit`.
   std::vector<double> time;
   std::string time_unit;   // "" when the file states none
+  std::string time_name;   // the time column's name in the file ("Zeit"), or ""
   std::string time_where;  // "column 1", ...
   double start = 0.0;
   double interval = 0.0;
   // Place value of the last printed digit of the time column in `time_unit` (text files), or 0.
   double printed_resolution = 0.0;
+  // The sample interval the file states besides its time column (mbid's
+  // `# sample_interval_s:`), in s, or 0: used exactly when it agrees with the time column, so
+  // that mbid's own files round-trip bit for bit.
+  double stated_interval_s = 0.0;
+  std::string stated_interval_where;
   // Line number of each sample for messages (text formats), else empty.
   std::vector<int> sample_lines;
   std::vector<RawColumn> columns;

@@ -109,7 +109,7 @@ const BadRecord kBadRecords[] = {
      "decay_rate_per_s: 1, amplitude_rad: 0.01}]}}",
      "record", "exactly one of"},
     {"MissingFile", "record: {file: nowhere.csv}", "record.file", "readable"},
-    {"WrongExtension", "record: {file: test.txt}", "record.file", ".csv"},
+    {"WrongExtension", "record: {file: test.xlsx}", "record.file", ".csv"},
     {"ChannelNotAnOutput",
      "record: {synthetic_modes: {channels: [psi, omega], modes: [{frequency_hz: 1, "
      "decay_rate_per_s: 1, amplitude_rad: 0.01}]}}",

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "mbid/app/record_import.h"
 #include "mbid/common/measurement.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/mechanical_model.h"
@@ -15,8 +16,9 @@ namespace mbid::app {
 // section (docs/scenarios.md), one map or a list of maps, each naming a measurement file or the
 // modes of a synthetic record.
 struct RecordSource {
-  std::string name;  // the test's name in reports and result groups
-  std::string file;  // a .csv/.h5 measurement file, resolved against the scenario's folder
+  std::string name;               // the test's name in reports and result groups
+  std::string file;               // a measurement file, resolved against the scenario's folder
+  records::ImportOptions import;  // the entry's channels, units, time_unit, fill_gaps, ...
   std::optional<simulation::ModalRecordSpec> synthetic;
 };
 
@@ -29,15 +31,18 @@ std::vector<RecordSource> ReadRecordSources(const YamlReader& record,
 // A test record ready for identification.
 struct LoadedRecord {
   Measurement measured;
-  std::optional<Measurement> exact;  // the noise-free record of a synthetic one
-  std::string origin;                // the file, or "synthetic modes"
+  std::optional<Measurement> exact;             // the noise-free record of a synthetic one
+  std::string origin;                           // the file, or "synthetic modes"
+  std::optional<records::ImportReport> import;  // what reading the file did
 };
 
 // Throws InputError naming `origin` unless every channel of `record` is an output of `model`.
 void RequireModelOutputs(const Measurement& record, const std::string& origin,
                          const model::MechanicalModel& model);
 
-// Reads the file (every channel must be an output of `model`) or synthesizes the record.
-LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel& model);
+// Reads the file (every channel must be an output or coordinate of `model`; the command line's
+// `overrides` on top of the entry's import keys) or synthesizes the record.
+LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel& model,
+                        const ImportOverrides& overrides = {});
 
 }  // namespace mbid::app

@@ -24,6 +24,8 @@ struct ImportOptions {
   // File column or record channel -> unit, completing or overriding the units in the file.
   std::map<std::string, std::string> units;
   std::string time_unit;  // overrides the time column's unit from the file when not empty
+  // For files without a time column: samples at j / sample_rate_hz (0: such files are refused).
+  double sample_rate_hz = 0.0;
   GapFill fill_gaps = GapFill::kRefuse;
   // Record channel -> the SI unit its consumer needs ("rad", "m/s^2"), from the model. A
   // channel listed here must come with a unit convertible to it; others go to the SI unit of
@@ -34,6 +36,8 @@ struct ImportOptions {
 // What the import did, for the user to check.
 struct ImportReport {
   std::string format;                    // "mbid-csv", "csv", "uff58", "lvm", "mat", "hdf5"
+  std::string dialect;                   // text files: "';'-separated, decimal comma, ..."
+  std::vector<std::string> mapping;      // e.g. "psi <- column 3 (Boom angle)"
   int filled_samples = 0;                // cells interpolated by GapFill::kLinear
   std::vector<std::string> conversions;  // e.g. "theta: deg -> rad (x 0.0174533)"
 };
@@ -43,6 +47,11 @@ struct ImportReport {
 // line, column, key or object.
 Measurement ImportMeasurement(const std::string& path, const ImportOptions& options = {},
                               ImportReport* report = nullptr);
+
+// The file name extensions ImportMeasurement reads (".csv", ".h5", ...), and whether `path`
+// has one of them (case ignored).
+std::vector<std::string> SupportedExtensions();
+bool IsSupportedFile(const std::string& path);
 
 // Writers for other tools. Both write atomically (a temporary name renamed when complete).
 void WriteUff58(const Measurement& measurement, const std::string& path, bool binary = false);

@@ -1,0 +1,148 @@
+#include "csv_dialect.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <limits>
+
+#include "header_cells.h"
+#include "internal.h"
+#include "iso_time.h"
+#include "units.h"
+
+namespace mbid::records::internal {
+namespace {
+
+bool IsDataRow(const std::vector<std::string>& fields, char separator) {
+  bool any_value = false;
+  for (const std::string& cell : fields) {
+    const CellKind kind = ClassifyCell(cell, separator);
+    if (kind == CellKind::kText) return false;
+    any_value = any_value || kind != CellKind::kGap;
+  }
+  return any_value;
+}
+
+bool IsUnitsRow(const std::vector<std::string>& fields) {
+  bool any_unit = false;
+  for (const std::string& cell : fields) {
+    if (cell.empty()) continue;
+    if (!IsUnit(StripUnitBrackets(cell))) return false;
+    any_unit = true;
+  }
+  return any_unit;
+}
+
+}  // namespace
+
+std::vector<TextLine> SplitLines(const std::string& text, bool* bom, bool* crlf) {
+  size_t at = 0;
+  *bom = text.compare(0, 3, "\xEF\xBB\xBF") == 0;
+  if (*bom) at = 3;
+  *crlf = false;
+  std::vector<TextLine> lines;
+  int number = 0;
+  while (at < text.size()) {
+    const size_t end = text.find_first_of("\r\n", at);
+    const size_t stop = end == std::string::npos ? text.size() : end;
+    lines.push_back({++number, text.substr(at, stop - at)});
+    if (end == std::string::npos) break;
+    at = end + 1;
+    if (text[end] == '\r' && at < text.size() && text[at] == '\n') {
+      *crlf = true;
+      ++at;
+    }
+  }
+  return lines;
+}
+
+std::vector<std::string> SplitFields(const std::string& line, char separator) {
+  std::vector<std::string> fields;
+  std::string field;
+  bool quoted = false;
+  for (const char c : line) {
+    if (c == '"') {
+      quoted = !quoted;
+      field += c;
+    } else if (c == separator && !quoted) {
+      fields.push_back(field);
+      field.clear();
+    } else {
+      field += c;
+    }
+  }
+  fields.push_back(field);
+  for (std::string& f : fields) {
+    f = mbid::internal::Trim(f);
+    if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = f.substr(1, f.size() - 2);
+  }
+  return fields;
+}
+
+CellKind ClassifyCell(const std::string& cell, char separator, double* value) {
+  if (value != nullptr) *value = std::numeric_limits<double>::quiet_NaN();
+  if (cell.empty() || cell == "NaN" || cell == "nan" || cell == "NAN") return CellKind::kGap;
+  std::string number = cell;
+  if (separator != ',') std::replace(number.begin(), number.end(), ',', '.');
+  double parsed = 0;
+  if (mbid::internal::ParseDouble(number, &parsed) == mbid::internal::ParseStatus::kOk) {
+    if (value != nullptr) *value = parsed;
+    return CellKind::kNumber;
+  }
+  Timestamp timestamp;
+  if (ParseTimestamp(cell, &timestamp)) return CellKind::kTimestamp;
+  return CellKind::kText;
+}
+
+bool IsCommentOrBlank(const std::string& line) {
+  const std::string trimmed = mbid::internal::Trim(line);
+  return trimmed.empty() || trimmed.front() == '#';
+}
+
+bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
+  std::vector<int> content;  // indices of lines that are neither comments nor blank
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (!IsCommentOrBlank(lines[i].text)) content.push_back(static_cast<int>(i));
+  }
+  bool found = false;
+  for (const char separator : {',', ';', '\t'}) {
+    for (size_t k = 0; k + 1 < content.size(); ++k) {
+      const auto header = SplitFields(lines[content[k]].text, separator);
+      if (header.size() < 2 || IsDataRow(header, separator)) continue;
+      const auto next = SplitFields(lines[content[k + 1]].text, separator);
+      if (next.size() != header.size()) continue;
+      int units_row = -1;
+      if (!IsDataRow(next, separator)) {
+        if (k + 2 >= content.size() || !IsUnitsRow(next)) continue;
+        const auto data = SplitFields(lines[content[k + 2]].text, separator);
+        if (data.size() != header.size() || !IsDataRow(data, separator)) continue;
+        units_row = content[k + 1];
+      }
+      // The most fields wins ("a,b;c" is not a ';' file); ties go to the earlier separator.
+      if (!found || static_cast<int>(header.size()) > dialect->field_count) {
+        found = true;
+        dialect->separator = separator;
+        dialect->header = content[k];
+        dialect->units_row = units_row;
+        dialect->field_count = static_cast<int>(header.size());
+        dialect->preamble_lines = static_cast<int>(k);
+      }
+      break;
+    }
+  }
+  return found;
+}
+
+std::string CsvDialect::Describe(bool decimal_comma) const {
+  std::string text = separator == '\t' ? "tab-separated" : fmt::format("'{}'-separated", separator);
+  if (decimal_comma) text += ", decimal comma";
+  if (crlf) text += ", CRLF";
+  if (bom) text += ", BOM";
+  if (preamble_lines > 0) {
+    text += fmt::format(", {} preamble line{}", preamble_lines, preamble_lines == 1 ? "" : "s");
+  }
+  if (units_row >= 0) text += ", units row";
+  return text;
+}
+
+}  // namespace mbid::records::internal

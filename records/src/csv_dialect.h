@@ -1,0 +1,49 @@
+#pragma once
+
+// How a logger's text export is laid out (docs/records.md, "Dialects"): separator, decimal
+// comma, byte order mark, line ends, preamble lines, header and units row. Found from the text
+// itself, never from the file name.
+
+#include <string>
+#include <vector>
+
+namespace mbid::records::internal {
+
+struct TextLine {
+  int number = 0;  // 1-based, as an editor shows it
+  std::string text;
+};
+
+// The file's lines without a UTF-8 byte order mark and without CR/CRLF line ends.
+std::vector<TextLine> SplitLines(const std::string& text, bool* bom, bool* crlf);
+
+// Fields of one line, trimmed and without surrounding double quotes ("a;b" stays one field).
+std::vector<std::string> SplitFields(const std::string& line, char separator);
+
+enum class CellKind { kNumber, kGap, kTimestamp, kText };
+
+// A data cell: a decimal number (with a decimal comma where the separator is not ','), a gap
+// (empty, NaN, nan), an ISO 8601 timestamp, or text. `value` is set for numbers (NaN for gaps).
+CellKind ClassifyCell(const std::string& cell, char separator, double* value = nullptr);
+
+struct CsvDialect {
+  char separator = ',';
+  bool bom = false;
+  bool crlf = false;
+  int header = -1;     // index into the lines
+  int units_row = -1;  // index into the lines, or -1
+  int field_count = 0;
+  int preamble_lines = 0;  // lines before the header other than comments and blank lines
+  // "';'-separated, decimal comma, CRLF, BOM, 3 preamble lines, units row"
+  std::string Describe(bool decimal_comma) const;
+};
+
+// The header is the first line followed (after an optional units row: every cell empty or a
+// unit) by a data row with as many fields; the separator is the one of ',' ';' tab that finds
+// a header with the most fields. Returns false when no separator finds one.
+bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect);
+
+// Whether the line is a comment ('#') or blank: neither header nor data.
+bool IsCommentOrBlank(const std::string& line);
+
+}  // namespace mbid::records::internal

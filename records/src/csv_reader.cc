@@ -1,0 +1,242 @@
+// Text exports of loggers -> RawTable: the dialect (csv_dialect.h), the header's names and
+// units, mbid's `# units:` comments, the time column (numbers or ISO timestamps) and its
+// printed resolution.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <optional>
+#include <set>
+
+#include "csv_dialect.h"
+#include "header_cells.h"
+#include "internal.h"
+#include "iso_time.h"
+#include "mbid/common/error.h"
+#include "readers.h"
+
+namespace mbid::records::internal {
+namespace {
+
+constexpr char kExpected[] =
+    "a table of numbers with a header line, separated by ',', ';' or tabs (docs/records.md)";
+
+// The decimal place of a number's last printed digit, as a power of ten: "0.0123" -> -4,
+// "1.5e-3" -> -4, "12" -> 0 (as mbid's CSV reader counts it).
+int PrintedPlace(const std::string& text) {
+  const size_t exponent_at = std::min(text.find_first_of("eE"), text.size());
+  const int exponent = exponent_at < text.size() ? std::atoi(text.c_str() + exponent_at + 1) : 0;
+  const size_t point = text.find_first_of(".,");
+  const int decimals = point < exponent_at ? static_cast<int>(exponent_at - point - 1) : 0;
+  return exponent - decimals;
+}
+
+std::string LineField(int line) { return fmt::format("line {}", line); }
+
+// mbid's metadata comments: "# units: s,rad,rad", "# sample_interval_s: 0.01", "# source: x".
+struct Metadata {
+  std::vector<std::string> units;
+  int units_line = 0;
+  std::string interval_text;
+  int interval_line = 0;
+  std::string source;
+};
+
+void ReadComment(const std::string& line, int number, char separator, Metadata* metadata) {
+  const std::string trimmed = mbid::internal::Trim(line);
+  if (trimmed.empty() || trimmed.front() != '#') return;
+  const std::string body = mbid::internal::Trim(trimmed.substr(1));
+  const auto value_of = [&body](const std::string& key) -> std::optional<std::string> {
+    if (body.compare(0, key.size() + 1, key + ":") != 0) return std::nullopt;
+    return mbid::internal::Trim(body.substr(key.size() + 1));
+  };
+  if (auto source = value_of("source")) {
+    metadata->source = *source;
+  } else if (auto interval = value_of("sample_interval_s")) {
+    metadata->interval_text = *interval;
+    metadata->interval_line = number;
+  } else if (auto units = value_of("units")) {
+    const char split = units->find(separator) != std::string::npos ? separator : ',';
+    metadata->units = SplitFields(*units, split);
+    metadata->units_line = number;
+  }
+}
+
+}  // namespace
+
+RawTable ReadCsv(const std::string& path) {
+  const std::string text = mbid::internal::ReadTextFile(path, kExpected);
+  CsvDialect dialect;
+  const std::vector<TextLine> lines = SplitLines(text, &dialect.bom, &dialect.crlf);
+  if (!DetectDialect(lines, &dialect)) {
+    throw InputError(path, "", "no header line followed by rows of numbers with as many fields",
+                     kExpected);
+  }
+  const char separator = dialect.separator;
+  const int header_line = lines[static_cast<size_t>(dialect.header)].number;
+  const std::vector<std::string> header_cells =
+      SplitFields(lines[static_cast<size_t>(dialect.header)].text, separator);
+  std::vector<std::string> unit_cells(header_cells.size());
+  if (dialect.units_row >= 0) {
+    unit_cells = SplitFields(lines[static_cast<size_t>(dialect.units_row)].text, separator);
+  }
+  const auto cell_field = [&](int line, size_t c) {
+    return fmt::format("line {}, column {}", line, c + 1);
+  };
+
+  // Names and units from the header and the units row.
+  std::vector<NameAndUnit> columns;
+  std::set<std::string> seen;
+  for (size_t c = 0; c < header_cells.size(); ++c) {
+    NameAndUnit column = SplitNameUnit(header_cells[c]);
+    const std::string row_unit = StripUnitBrackets(unit_cells[c]);
+    if (!row_unit.empty()) {
+      if (!column.unit.empty() && column.unit != row_unit) {
+        throw InputError(path, cell_field(header_line, c),
+                         fmt::format("column '{}' has unit '{}' in the header and '{}' in the "
+                                     "units row",
+                                     column.name, column.unit, row_unit),
+                         "one unit per column");
+      }
+      column.unit = row_unit;
+    }
+    if (!column.name.empty() && !seen.insert(column.name).second) {
+      throw InputError(path, cell_field(header_line, c),
+                       "column name '" + column.name + "' appears twice", "unique column names");
+    }
+    columns.push_back(column);
+  }
+
+  // The time column: the first with a time name.
+  int time_column = -1;
+  for (size_t c = 0; c < columns.size() && time_column < 0; ++c) {
+    std::string suffix_unit;
+    if (IsTimeColumnName(columns[c].name, &suffix_unit)) {
+      time_column = static_cast<int>(c);
+      if (columns[c].unit.empty()) columns[c].unit = suffix_unit;
+    }
+  }
+
+  // Rows.
+  Metadata metadata;
+  RawTable table;
+  table.columns.resize(columns.size());
+  bool decimal_comma = false;
+  bool timestamps = false;
+  Timestamp first_timestamp;
+  int time_place = std::numeric_limits<int>::max();
+  int timestamp_decimals = 0;
+  const int first_row = (dialect.units_row >= 0 ? dialect.units_row : dialect.header) + 1;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const TextLine& line = lines[i];
+    if (IsCommentOrBlank(line.text)) {
+      ReadComment(line.text, line.number, separator, &metadata);
+      continue;
+    }
+    if (static_cast<int>(i) < first_row) continue;  // preamble, header, units row
+    const std::vector<std::string> fields = SplitFields(line.text, separator);
+    if (fields.size() != columns.size()) {
+      throw InputError(
+          path, LineField(line.number), fmt::format("{} fields", fields.size()),
+          fmt::format("{} fields as in the header (line {})", columns.size(), header_line));
+    }
+    const bool first = table.sample_lines.empty();
+    for (size_t c = 0; c < fields.size(); ++c) {
+      double value = 0;
+      const CellKind kind = ClassifyCell(fields[c], separator, &value);
+      const std::string where = fmt::format("{} ({})", cell_field(line.number, c),
+                                            columns[c].name.empty() ? "unnamed" : columns[c].name);
+      if (static_cast<int>(c) == time_column && first) timestamps = kind == CellKind::kTimestamp;
+      if (static_cast<int>(c) == time_column && timestamps) {
+        Timestamp timestamp;
+        if (!ParseTimestamp(fields[c], &timestamp)) {
+          throw InputError(path, where, "'" + fields[c] + "' is not a timestamp",
+                           "an ISO 8601 timestamp as in the first row (2026-03-01T12:00:00.125)");
+        }
+        if (first) first_timestamp = timestamp;
+        timestamp_decimals = std::max(timestamp_decimals, timestamp.decimals);
+        value = SecondsBetween(first_timestamp, timestamp);
+      } else if (kind == CellKind::kNumber) {
+        if (!std::isfinite(value)) {
+          throw InputError(path, where, "'" + fields[c] + "' is not finite",
+                           "a finite number, or an empty cell or NaN for a gap");
+        }
+        if (separator != ',' && fields[c].find(',') != std::string::npos) decimal_comma = true;
+        if (static_cast<int>(c) == time_column) {
+          time_place = std::min(time_place, PrintedPlace(fields[c]));
+        }
+      } else if (kind != CellKind::kGap) {
+        throw InputError(path, where, "'" + fields[c] + "' is not a number",
+                         "a decimal number, or an empty cell or NaN for a gap");
+      }
+      table.columns[c].values.push_back(value);
+    }
+    table.sample_lines.push_back(line.number);
+  }
+
+  // mbid's own CSV: ',' and a first column named exactly `time`; channels without a unit are
+  // SI by contract (docs/file-formats.md).
+  table.si_by_contract = separator == ',' && dialect.units_row < 0 && !header_cells.empty() &&
+                         header_cells.front() == "time";
+  table.format = table.si_by_contract ? "mbid-csv" : "csv";
+  table.dialect = dialect.Describe(decimal_comma);
+  table.source = metadata.source;
+  if (metadata.units_line > 0) {
+    // "# units: s,rad,rad" may include the time column; "rad,rad" lists the channels.
+    std::vector<std::string> units = metadata.units;
+    const size_t data_columns = columns.size() - (time_column >= 0 ? 1 : 0);
+    if (units.size() == columns.size() && time_column >= 0) {
+      units.erase(units.begin() + time_column);
+      if (columns[static_cast<size_t>(time_column)].unit.empty()) {
+        columns[static_cast<size_t>(time_column)].unit = metadata.units[time_column];
+      }
+    }
+    if (units.size() != data_columns) {
+      throw InputError(
+          path, LineField(metadata.units_line),
+          fmt::format("'# units:' lists {} units for {} channels", units.size(), data_columns),
+          "one unit per channel, in header order");
+    }
+    size_t k = 0;
+    for (size_t c = 0; c < columns.size(); ++c) {
+      if (static_cast<int>(c) == time_column) continue;
+      if (columns[c].unit.empty()) columns[c].unit = units[k];
+      ++k;
+    }
+  }
+  if (metadata.interval_line > 0) {
+    double stated = 0;
+    if (mbid::internal::ParseDouble(metadata.interval_text, &stated) !=
+            mbid::internal::ParseStatus::kOk ||
+        !(stated > 0) || !std::isfinite(stated)) {
+      throw InputError(path, LineField(metadata.interval_line),
+                       "'" + metadata.interval_text + "' is not a sample interval",
+                       "a positive number of seconds");
+    }
+    table.stated_interval_s = stated;
+    table.stated_interval_where = LineField(metadata.interval_line);
+  }
+
+  for (size_t c = 0; c < columns.size(); ++c) {
+    table.columns[c].name = columns[c].name;
+    table.columns[c].unit = columns[c].unit;
+    table.columns[c].where = fmt::format("column {}", c + 1);
+  }
+  if (time_column >= 0) {
+    RawColumn time = std::move(table.columns[static_cast<size_t>(time_column)]);
+    table.columns.erase(table.columns.begin() + time_column);
+    table.time = std::move(time.values);
+    table.time_unit = timestamps ? "s" : time.unit;
+    table.time_name = time.name;
+    table.time_where = time.where;
+    table.printed_resolution = timestamps ? std::pow(10.0, -timestamp_decimals)
+                               : time_place == std::numeric_limits<int>::max()
+                                   ? 0.0
+                                   : std::pow(10.0, time_place);
+  }
+  return table;
+}
+
+}  // namespace mbid::records::internal

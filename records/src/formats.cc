@@ -1,0 +1,74 @@
+// Extension -> reader. A new format is one line in kFormats (and its reader in readers.h).
+#include "formats.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cctype>
+
+#include "mbid/common/error.h"
+#include "mbid/records/records.h"
+#include "readers.h"
+
+namespace mbid::records {
+namespace {
+
+struct Format {
+  std::vector<std::string> extensions;  // lower case, with the dot
+  internal::RawTable (*read)(const std::string& path);
+};
+
+const std::vector<Format>& Formats() {
+  static const std::vector<Format> formats = {
+      {{".csv", ".txt"}, &internal::ReadCsv},
+      {{".h5", ".hdf5"}, &internal::ReadHdf5},
+      {{".uff", ".unv", ".uff58", ".uffb"}, &internal::ReadUff58},
+      {{".lvm"}, &internal::ReadLvm},
+      {{".mat"}, &internal::ReadMat},
+  };
+  return formats;
+}
+
+std::string LowerExtension(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string extension = path.substr(dot);
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+}  // namespace
+
+std::vector<std::string> SupportedExtensions() {
+  std::vector<std::string> extensions;
+  for (const Format& format : Formats()) {
+    extensions.insert(extensions.end(), format.extensions.begin(), format.extensions.end());
+  }
+  return extensions;
+}
+
+bool IsSupportedFile(const std::string& path) {
+  const std::vector<std::string> extensions = SupportedExtensions();
+  return std::find(extensions.begin(), extensions.end(), LowerExtension(path)) != extensions.end();
+}
+
+namespace internal {
+
+RawTable ReadRawTable(const std::string& path) {
+  const std::string extension = LowerExtension(path);
+  for (const Format& format : Formats()) {
+    const auto& extensions = format.extensions;
+    if (std::find(extensions.begin(), extensions.end(), extension) != extensions.end()) {
+      return format.read(path);
+    }
+  }
+  throw InputError(
+      path, "", fmt::format("unsupported file type '{}'", extension.empty() ? "(none)" : extension),
+      fmt::format("a measurement file ({})", fmt::join(SupportedExtensions(), ", ")));
+}
+
+}  // namespace internal
+}  // namespace mbid::records

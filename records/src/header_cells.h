@@ -1,0 +1,26 @@
+#pragma once
+
+// What a header cell says: a column's name and, in "name [unit]" or "name (unit)", its unit;
+// and which names mark the time column.
+
+#include <string>
+
+namespace mbid::records::internal {
+
+// "Boom angle [deg]" -> {"Boom angle", "deg"}; "Boom angle (deg)" -> {"Boom angle", "deg"};
+// "psi" -> {"psi", ""}. A parenthesis that is not a unit ("Sensor (left)") stays in the name.
+struct NameAndUnit {
+  std::string name;
+  std::string unit;
+};
+NameAndUnit SplitNameUnit(const std::string& cell);
+
+// "[deg]" -> "deg", "(deg)" -> "deg", "deg" -> "deg".
+std::string StripUnitBrackets(const std::string& text);
+
+// Whether `name` marks the time column: time, t, Zeit, timestamp, datetime or X_Value (case
+// ignored), optionally with the project's unit suffix _s, _ms or _us (`*unit` is then "s",
+// "ms" or "us", else left as is).
+bool IsTimeColumnName(const std::string& name, std::string* unit);
+
+}  // namespace mbid::records::internal

@@ -1,0 +1,284 @@
+// RawTable -> Measurement in SI: the channel mapping, the time base, gaps, units
+// (docs/records.md).
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <set>
+
+#include "formats.h"
+#include "gaps.h"
+#include "mbid/common/error.h"
+#include "mbid/records/records.h"
+#include "raw_table.h"
+#include "units.h"
+
+namespace mbid::records {
+namespace {
+
+using internal::RawColumn;
+using internal::RawTable;
+
+// A record channel and the file column it comes from.
+struct Selected {
+  std::string channel;
+  const RawColumn* column = nullptr;
+  std::string unit;  // the unit the values are in ("" if nobody states one)
+};
+
+std::string Describe(const RawColumn& column) {
+  return column.name.empty() ? column.where : fmt::format("{} ({})", column.where, column.name);
+}
+
+bool IsNumber(const std::string& text) {
+  return !text.empty() && std::all_of(text.begin(), text.end(),
+                                      [](unsigned char c) { return std::isdigit(c) != 0; });
+}
+
+std::string ColumnList(const RawTable& table) {
+  std::vector<std::string> names;
+  for (size_t c = 0; c < table.columns.size(); ++c) {
+    names.push_back(fmt::format("{} '{}'", c + 1, table.columns[c].name));
+  }
+  return fmt::format("a column of the file by name or number among its data columns: {}",
+                     fmt::join(names, ", "));
+}
+
+std::vector<Selected> SelectColumns(const RawTable& table, const std::string& path,
+                                    const ImportOptions& options, ImportReport* report) {
+  std::vector<Selected> selected;
+  if (options.channel_columns.empty()) {
+    for (const RawColumn& column : table.columns) {
+      if (column.name.empty()) {
+        throw InputError(path, column.where, "the column has no name",
+                         "a name in the header, or a mapping `channels: {NAME: COLUMN}`");
+      }
+      selected.push_back({column.name, &column, column.unit});
+    }
+    return selected;
+  }
+  for (const auto& [channel, spec] : options.channel_columns) {
+    const RawColumn* found = nullptr;
+    for (const RawColumn& column : table.columns) {
+      if (column.name == spec) found = &column;
+    }
+    if (found == nullptr && IsNumber(spec)) {
+      const size_t number = std::stoul(spec);
+      if (number >= 1 && number <= table.columns.size()) found = &table.columns[number - 1];
+    }
+    if (found == nullptr) {
+      const bool is_time = !table.time_name.empty() && spec == table.time_name;
+      throw InputError(path, "channels." + channel,
+                       is_time ? fmt::format("'{}' is the time column", spec)
+                               : fmt::format("no column '{}' in the file", spec),
+                       ColumnList(table));
+    }
+    selected.push_back({channel, found, found->unit});
+    report->mapping.push_back(fmt::format("{} <- {}", channel, Describe(*found)));
+  }
+  return selected;
+}
+
+// Units given by the user complete or override the file's; every key must name something.
+std::string ApplyUserUnits(const RawTable& table, const std::string& path,
+                           const ImportOptions& options, std::vector<Selected>* selected) {
+  std::set<std::string> used;
+  for (Selected& s : *selected) {
+    for (const std::string& key : {s.column->name, s.channel}) {
+      const auto unit = options.units.find(key);
+      if (unit == options.units.end()) continue;
+      s.unit = unit->second;
+      used.insert(key);
+    }
+  }
+  std::string time_unit = options.time_unit;
+  if (!table.time_name.empty()) {
+    const auto unit = options.units.find(table.time_name);
+    if (unit != options.units.end()) {
+      if (time_unit.empty()) time_unit = unit->second;
+      used.insert(table.time_name);
+    }
+  }
+  for (const auto& [key, unit] : options.units) {
+    if (used.count(key) == 0) {
+      throw InputError(
+          path, "units." + key,
+          fmt::format("'{}' is neither a column of the file nor a record channel", key),
+          ColumnList(table));
+    }
+  }
+  return time_unit;
+}
+
+std::string SampleField(const RawTable& table, const std::string& where, Eigen::Index j) {
+  if (static_cast<size_t>(j) < table.sample_lines.size()) {
+    const std::string line = fmt::format("line {}", table.sample_lines[static_cast<size_t>(j)]);
+    return where.empty() ? line : line + ", " + where;
+  }
+  return where.empty() ? fmt::format("sample {}", j) : fmt::format("{}, sample {}", where, j);
+}
+
+// Sets the measurement's start time and interval from the file's time base (in seconds).
+void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOptions& options,
+                  const std::string& user_time_unit, Measurement* m, ImportReport* report) {
+  if (table.time.empty() && table.interval <= 0) {
+    if (!(options.sample_rate_hz > 0) || !std::isfinite(options.sample_rate_hz)) {
+      throw InputError(path, table.sample_lines.empty() ? "" : "header",
+                       "no time column (named time, t, Zeit, timestamp, datetime or X_Value)",
+                       "a time column, or the sample rate of a file without one "
+                       "(`sample_rate_hz:` in the scenario's record entry)");
+    }
+    m->start_time_s = 0.0;
+    m->sample_interval_s = 1.0 / options.sample_rate_hz;
+    report->conversions.push_back(
+        fmt::format("time: samples at j / {} Hz (no time column)", options.sample_rate_hz));
+    return;
+  }
+  std::string unit = user_time_unit.empty() ? table.time_unit : user_time_unit;
+  // mbid's contract: a column named `time` without a unit is in seconds.
+  if (unit.empty() && (table.time_name == "time" || table.si_by_contract)) unit = "s";
+  const std::string field = table.time_name.empty()
+                                ? table.time_where
+                                : Describe({table.time_name, "", table.time_where, {}});
+  if (unit.empty()) {
+    throw InputError(path, field, fmt::format("the time column '{}' has no unit", table.time_name),
+                     fmt::format("a unit: a header '{0} [ms]' or '{0}_ms', a units row, or "
+                                 "`time_unit: ms` in the scenario's record entry",
+                                 table.time_name));
+  }
+  const internal::UnitConversion to_s = internal::FindConversion(unit, "s", path, field);
+  if (!to_s.identity()) {
+    report->conversions.push_back(fmt::format("time: {} -> s (x {:g})", unit, to_s.scale));
+  }
+  if (table.time.empty()) {
+    m->start_time_s = to_s.scale * table.start + to_s.offset;
+    m->sample_interval_s = to_s.scale * table.interval;
+    return;
+  }
+  Eigen::VectorXd time(static_cast<Eigen::Index>(table.time.size()));
+  for (size_t j = 0; j < table.time.size(); ++j) {
+    time[static_cast<Eigen::Index>(j)] =
+        to_s.identity() ? table.time[j] : to_s.scale * table.time[j] + to_s.offset;
+  }
+  double start = 0;
+  const double tau = CheckUniformTime(
+      time, path, [&](Eigen::Index j) { return SampleField(table, "", j); },
+      table.printed_resolution * to_s.scale, &start);
+  m->start_time_s = start;
+  m->sample_interval_s = tau;
+  if (table.stated_interval_s > 0) {
+    // The exact interval, when it agrees with the time column, makes mbid's round trip exact.
+    if (!(std::abs(table.stated_interval_s - tau) < kTimeUniformityTolerance * tau)) {
+      throw InputError(path, table.stated_interval_where,
+                       fmt::format("'# sample_interval_s: {}' disagrees with the time column "
+                                   "(step {} s)",
+                                   table.stated_interval_s, tau),
+                       "the step of the time column");
+    }
+    m->sample_interval_s = table.stated_interval_s;
+  }
+  if (options.sample_rate_hz > 0 &&
+      !(std::abs(options.sample_rate_hz * tau - 1.0) < kTimeUniformityTolerance)) {
+    throw InputError(path, "sample_rate_hz",
+                     fmt::format("{} Hz disagrees with the time column (step {} s)",
+                                 options.sample_rate_hz, tau),
+                     "no sample rate for files with a time column, or the rate of that column");
+  }
+}
+
+// Gaps in the kept columns: refused naming the first, or filled (counted in the report).
+std::vector<std::vector<double>> TakeValues(const RawTable& table, const std::string& path,
+                                            const ImportOptions& options,
+                                            const std::vector<Selected>& selected,
+                                            ImportReport* report) {
+  std::vector<std::vector<double>> values;
+  int first_sample = -1;
+  const Selected* first_column = nullptr;
+  for (const Selected& s : selected) {
+    values.push_back(s.column->values);
+    const int gap = internal::FirstGap(s.column->values);
+    if (gap >= 0 && (first_sample < 0 || gap < first_sample)) {
+      first_sample = gap;
+      first_column = &s;
+    }
+  }
+  if (first_sample < 0) return values;
+  const std::string field = SampleField(table, Describe(*first_column->column), first_sample);
+  if (options.fill_gaps == GapFill::kRefuse) {
+    throw InputError(path, field, "empty cell (a gap in the record)",
+                     "a value in every cell, or gaps filled by `--fill-gaps linear` (record key "
+                     "`fill_gaps: linear`)");
+  }
+  for (size_t c = 0; c < values.size(); ++c) {
+    int unfillable = -1;
+    report->filled_samples += internal::FillGapsLinear(&values[c], &unfillable);
+    if (unfillable >= 0) {
+      throw InputError(
+          path, SampleField(table, Describe(*selected[c].column), unfillable),
+          fmt::format("a gap at the {} sample cannot be interpolated",
+                      unfillable == 0 ? "first" : "last"),
+          "values in the first and last row (linear filling needs a value on both sides)");
+    }
+  }
+  return values;
+}
+
+}  // namespace
+
+Measurement ImportMeasurement(const std::string& path, const ImportOptions& options,
+                              ImportReport* report) {
+  ImportReport local;
+  ImportReport& r = report != nullptr ? *report : local;
+  r = ImportReport();
+  const RawTable table = internal::ReadRawTable(path);
+  r.format = table.format;
+  r.dialect = table.dialect;
+
+  std::vector<Selected> selected = SelectColumns(table, path, options, &r);
+  const std::string time_unit = ApplyUserUnits(table, path, options, &selected);
+  Measurement m;
+  ReadTimeBase(table, path, options, time_unit, &m, &r);
+  std::vector<std::vector<double>> values = TakeValues(table, path, options, selected, &r);
+
+  const Eigen::Index samples =
+      selected.empty() ? 0 : static_cast<Eigen::Index>(values.front().size());
+  m.values.resize(samples, static_cast<Eigen::Index>(selected.size()));
+  for (size_t c = 0; c < selected.size(); ++c) {
+    const Selected& s = selected[c];
+    const auto target_it = options.target_units.find(s.channel);
+    std::string target = target_it == options.target_units.end() ? "" : target_it->second;
+    const std::string field = Describe(*s.column);
+    std::string unit = s.unit;
+    if (unit.empty()) {
+      if (!table.si_by_contract) {
+        throw InputError(path, field, fmt::format("no unit for column '{}'", s.column->name),
+                         fmt::format("a unit: a header '{0} [deg]', a units row, `units: {{{0}: "
+                                     "deg}}` in the scenario's record entry or `--unit {0}=deg`",
+                                     s.column->name));
+      }
+      // SI by contract: the unit the model expects, else radians (mbid's CSV of angles).
+      unit = target.empty() ? "rad" : target;
+    }
+    if (target.empty()) target = internal::SiUnitFor(unit, path, field);
+    const internal::UnitConversion conversion = internal::FindConversion(unit, target, path, field);
+    internal::Convert(conversion, &values[c]);
+    if (!conversion.identity()) {
+      r.conversions.push_back(
+          conversion.offset == 0.0
+              ? fmt::format("{}: {} -> {} (x {:g})", s.channel, unit, target, conversion.scale)
+              : fmt::format("{}: {} -> {} (x {:g} + {:g})", s.channel, unit, target,
+                            conversion.scale, conversion.offset));
+    }
+    m.channels.push_back(s.channel);
+    m.units.push_back(target);
+    for (Eigen::Index j = 0; j < samples; ++j)
+      m.values(j, static_cast<Eigen::Index>(c)) = values[c][static_cast<size_t>(j)];
+  }
+  if (!table.source.empty()) m.source = table.source;
+  m.Validate(path);
+  return m;
+}
+
+}  // namespace mbid::records

@@ -1,0 +1,85 @@
+#include "iso_time.h"
+
+#include <cctype>
+#include <cstdlib>
+
+namespace mbid::records::internal {
+namespace {
+
+// Reads exactly `digits` decimal digits at `*at`.
+bool ReadDigits(const std::string& text, size_t* at, int digits, int* value) {
+  *value = 0;
+  for (int k = 0; k < digits; ++k) {
+    if (*at >= text.size() || std::isdigit(static_cast<unsigned char>(text[*at])) == 0) {
+      return false;
+    }
+    *value = *value * 10 + (text[(*at)++] - '0');
+  }
+  return true;
+}
+
+bool Expect(const std::string& text, size_t* at, char c) {
+  if (*at >= text.size() || text[*at] != c) return false;
+  ++*at;
+  return true;
+}
+
+// Days from 1970-01-01 to the proleptic Gregorian date y-m-d (H. Hinnant's days_from_civil).
+std::int64_t DaysFromCivil(std::int64_t y, int m, int d) {
+  y -= m <= 2 ? 1 : 0;
+  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const std::int64_t yoe = y - era * 400;
+  const std::int64_t doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const std::int64_t doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + doe - 719468;
+}
+
+}  // namespace
+
+bool ParseTimestamp(const std::string& text, Timestamp* timestamp) {
+  size_t at = 0;
+  int year = 0, month = 0, day = 0, hour = 0, minute = 0, second = 0;
+  if (!ReadDigits(text, &at, 4, &year) || !Expect(text, &at, '-') ||
+      !ReadDigits(text, &at, 2, &month) || !Expect(text, &at, '-') ||
+      !ReadDigits(text, &at, 2, &day)) {
+    return false;
+  }
+  if (at >= text.size() || (text[at] != 'T' && text[at] != ' ')) return false;
+  ++at;
+  if (!ReadDigits(text, &at, 2, &hour) || !Expect(text, &at, ':') ||
+      !ReadDigits(text, &at, 2, &minute) || !Expect(text, &at, ':') ||
+      !ReadDigits(text, &at, 2, &second)) {
+    return false;
+  }
+  if (month < 1 || month > 12 || day < 1 || day > 31 || hour > 23 || minute > 59 || second > 60) {
+    return false;
+  }
+  double fraction = 0.0;
+  int decimals = 0;
+  if (at < text.size() && (text[at] == '.' || text[at] == ',')) {
+    const size_t begin = ++at;
+    while (at < text.size() && std::isdigit(static_cast<unsigned char>(text[at])) != 0) ++at;
+    decimals = static_cast<int>(at - begin);
+    if (decimals == 0) return false;
+    fraction = std::strtod(("0." + text.substr(begin, at - begin)).c_str(), nullptr);
+  }
+  int offset_s = 0;
+  if (at < text.size() && text[at] == 'Z') {
+    ++at;
+  } else if (at < text.size() && (text[at] == '+' || text[at] == '-')) {
+    const int sign = text[at++] == '-' ? -1 : 1;
+    int offset_h = 0, offset_m = 0;
+    if (!ReadDigits(text, &at, 2, &offset_h)) return false;
+    if (at < text.size() && text[at] == ':') ++at;
+    if (!ReadDigits(text, &at, 2, &offset_m)) return false;
+    offset_s = sign * (offset_h * 3600 + offset_m * 60);
+  }
+  if (at != text.size()) return false;
+  timestamp->seconds =
+      DaysFromCivil(year, month, day) * 86400 + hour * 3600 + minute * 60 + second - offset_s;
+  timestamp->fraction = fraction;
+  timestamp->decimals = decimals;
+  return true;
+}
+
+}  // namespace mbid::records::internal

@@ -1,0 +1,205 @@
+#include "units.h"
+
+#include <fmt/format.h>
+#include <udunits2.h>
+
+#include <cctype>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+#include "mbid/common/error.h"
+
+namespace mbid::records::internal {
+namespace {
+
+// udunits2 is not thread-safe: one lock around every call, one unit system for the process.
+std::mutex& UnitsMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+// Names udunits2 does not know (or reads otherwise: its `g` is the gram, `g0` is g^0) that
+// loggers write.
+const std::map<std::string, std::string>& Aliases() {
+  static const std::map<std::string, std::string> aliases = {
+      {"deg", "degree"},
+      {"degs", "degree"},
+      {"gn", "standard_free_fall"},
+      {"g0", "standard_free_fall"},
+      {"g_n", "standard_free_fall"},
+  };
+  return aliases;
+}
+
+bool IsNameByte(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  return std::isalpha(u) != 0 || c == '_' || u >= 0x80;
+}
+
+// `text` with every alias replaced where it stands as a whole name ("deg/s" -> "degree/s").
+std::string ApplyAliases(const std::string& text) {
+  std::string out;
+  size_t i = 0;
+  while (i < text.size()) {
+    if (!IsNameByte(text[i])) {
+      out += text[i++];
+      continue;
+    }
+    size_t end = i;
+    while (end < text.size() && IsNameByte(text[end])) ++end;
+    std::string name = text.substr(i, end - i);
+    // "g0": the name and its digit, unless more digits follow (then it is not standard gravity).
+    if (name == "g" && end < text.size() && text[end] == '0' &&
+        (end + 1 == text.size() || std::isdigit(static_cast<unsigned char>(text[end + 1])) == 0)) {
+      name = "g0";
+      ++end;
+    }
+    const auto alias = Aliases().find(name);
+    out += alias == Aliases().end() ? name : alias->second;
+    i = end;
+  }
+  return out;
+}
+
+struct UnitDeleter {
+  void operator()(ut_unit* unit) const { ut_free(unit); }
+};
+using UnitPtr = std::unique_ptr<ut_unit, UnitDeleter>;
+
+ut_system* System() {
+  // Called with the lock held; loaded once (the XML database takes milliseconds to parse).
+  static ut_system* system = [] {
+    ut_set_error_message_handler(ut_ignore);
+    ut_system* loaded = ut_read_xml(nullptr);
+    if (loaded == nullptr) {
+      throw std::runtime_error(fmt::format(
+          "cannot load the udunits2 unit database (status {}; UDUNITS2_XML_PATH may name it)",
+          static_cast<int>(ut_get_status())));
+    }
+    return loaded;
+  }();
+  return system;
+}
+
+UnitPtr Parse(const std::string& text) {
+  if (text.empty()) return nullptr;
+  return UnitPtr(ut_parse(System(), ApplyAliases(text).c_str(), UT_UTF8));
+}
+
+// The unit's base-unit expression without its factor and offset: "0.001 m.s-2" -> "m.s-2",
+// "K @ 273.15" -> "K", "0.0174532925199433 rad" -> "rad". Equal for units of equal dimension,
+// the radian counted as a dimension of its own.
+std::string Dimension(const ut_unit* unit) {
+  char buffer[256] = "";
+  const int length = ut_format(unit, buffer, sizeof(buffer), UT_ASCII | UT_DEFINITION);
+  if (length < 0 || length >= static_cast<int>(sizeof(buffer))) return "?";
+  std::string definition(buffer);
+  const size_t at = definition.find(" @ ");
+  if (at != std::string::npos) definition.erase(at);
+  std::istringstream words(definition);
+  std::string first, rest;
+  words >> first;
+  std::getline(words, rest);
+  char* end = nullptr;
+  std::strtod(first.c_str(), &end);
+  const bool factor = end != first.c_str() && *end == '\0' && !rest.empty();
+  std::string dimension = factor ? rest : definition;
+  const size_t begin = dimension.find_first_not_of(' ');
+  return begin == std::string::npos ? std::string("1") : dimension.substr(begin);
+}
+
+// Dimension -> the SI unit mbid writes for it; the first candidate of a dimension wins (N*m
+// before J: torques are what machines measure).
+const std::map<std::string, std::string>& SiUnits() {
+  static const std::map<std::string, std::string> units = [] {
+    std::map<std::string, std::string> map;
+    for (const char* name : {"rad", "rad/s",   "rad/s^2", "m",         "m/s",    "m/s^2", "s", "Hz",
+                             "kg",  "N",       "N*m",     "Pa",        "V",      "A",     "K", "W",
+                             "N/m", "N*m/rad", "N*s/m",   "N*m*s/rad", "kg*m^2", "1"}) {
+      const UnitPtr unit = Parse(name);
+      if (unit) map.emplace(Dimension(unit.get()), name);
+    }
+    return map;
+  }();
+  return units;
+}
+
+std::string UnknownUnitHint(const std::string& text) {
+  return fmt::format("a unit udunits2 knows (e.g. rad, deg, mm, m/s^2, gn, ms); '{}' is not one",
+                     text);
+}
+
+// udunits2 reads a bare `g` as the gram; on a vibration logger it almost always means standard
+// gravity. Neither is guessed: the user writes gn or gram.
+void RefuseBareG(const std::string& text, const std::string& source, const std::string& field) {
+  if (text == "g" || text == "G") {
+    throw InputError(source, field,
+                     fmt::format("unit '{}' is ambiguous (udunits2 reads the gram)", text),
+                     "gn for standard gravity (9.80665 m/s^2), or gram for a mass");
+  }
+}
+
+}  // namespace
+
+bool IsUnit(const std::string& text) {
+  const std::lock_guard<std::mutex> lock(UnitsMutex());
+  return Parse(text) != nullptr;
+}
+
+std::string SiUnitFor(const std::string& unit, const std::string& source,
+                      const std::string& field) {
+  RefuseBareG(unit, source, field);
+  const std::lock_guard<std::mutex> lock(UnitsMutex());
+  const UnitPtr parsed = Parse(unit);
+  if (!parsed) {
+    throw InputError(source, field, fmt::format("unknown unit '{}'", unit), UnknownUnitHint(unit));
+  }
+  const std::string dimension = Dimension(parsed.get());
+  const auto si = SiUnits().find(dimension);
+  // A dimension without a name of its own keeps udunits' base-unit expression ("m2.kg.s-3.A-1").
+  return si == SiUnits().end() ? dimension : si->second;
+}
+
+UnitConversion FindConversion(const std::string& from, const std::string& to,
+                              const std::string& source, const std::string& field) {
+  if (from == to) return {};
+  RefuseBareG(from, source, field);
+  const std::lock_guard<std::mutex> lock(UnitsMutex());
+  const UnitPtr a = Parse(from);
+  if (!a) {
+    throw InputError(source, field, fmt::format("unknown unit '{}'", from),
+                     fmt::format("a unit convertible to {} ({})", to, UnknownUnitHint(from)));
+  }
+  const UnitPtr b = Parse(to);
+  if (!b) throw std::logic_error("mbid: target unit '" + to + "' unknown to udunits2");
+  if (Dimension(a.get()) != Dimension(b.get()) || ut_are_convertible(a.get(), b.get()) == 0) {
+    // udunits' g is the gram: say how an accelerometer's g is written.
+    const bool gram = ApplyAliases(from) == "g" && Dimension(b.get()) == "m.s-2";
+    throw InputError(
+        source, field,
+        fmt::format("unit '{}' ({}) cannot be converted to {}", from, Dimension(a.get()), to),
+        gram ? std::string("a unit of acceleration; standard gravity is written gn "
+                           "('g' is the gram)")
+             : fmt::format("a unit convertible to {} ({})", to, Dimension(b.get())));
+  }
+  cv_converter* converter = ut_get_converter(a.get(), b.get());
+  if (converter == nullptr) {
+    throw InputError(source, field, fmt::format("no conversion from '{}' to {}", from, to),
+                     fmt::format("a unit convertible to {}", to));
+  }
+  UnitConversion conversion;
+  conversion.offset = cv_convert_double(converter, 0.0);
+  conversion.scale = cv_convert_double(converter, 1.0) - conversion.offset;
+  cv_free(converter);
+  return conversion;
+}
+
+void Convert(const UnitConversion& conversion, std::vector<double>* values) {
+  if (conversion.identity()) return;
+  for (double& v : *values) v = conversion.scale * v + conversion.offset;
+}
+
+}  // namespace mbid::records::internal

@@ -1,0 +1,130 @@
+// Files mbid must refuse: each InputError names the file and the line and/or column, says what
+// is wrong and what is expected.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "mbid/common/error.h"
+#include "mbid/records/records.h"
+#include "test_util.h"
+
+namespace mbid::records {
+namespace {
+
+using mbid::testing::CatchInputError;
+using mbid::testing::TempDir;
+using mbid::testing::WriteText;
+using ::testing::HasSubstr;
+
+struct BadFile {
+  const char* name;
+  const char* text;
+  const char* field;     // the field the error must name exactly
+  const char* problem;   // a phrase of the problem
+  const char* expected;  // a phrase of what is expected
+};
+
+// Header on line 1, data from line 2 unless a preamble says otherwise.
+const BadFile kBadFiles[] = {
+    {"UnknownUnit", "t [s];x [blorp]\n0;1\n1;2\n", "column 2 (x)", "'blorp'", "udunits2"},
+    {"MissingUnit", "t [s];x\n0;1\n1;2\n", "column 2 (x)", "no unit", "units:"},
+    {"GramIsNotGravity", "t [s];acc [g]\n0;1\n1;2\n", "column 2 (acc)", "'g'", "gn"},
+    {"TimeWithoutUnit", "Zeit;x [mm]\n0;1\n1;2\n", "column 1 (Zeit)", "no unit", "Zeit [ms]"},
+    {"UnknownTimeUnit", "Zeit [fortnightz];x [mm]\n0;1\n1;2\n", "column 1 (Zeit)", "'fortnightz'",
+     "s"},
+    {"AngleAsTime", "Zeit [deg];x [mm]\n0;1\n1;2\n", "column 1 (Zeit)", "cannot be converted", "s"},
+    {"FieldCount", "t [s];x [mm]\n0;1\n1;2\n2;3;4\n3;4\n", "line 4", "3 fields", "2 fields"},
+    {"NotANumber", "t [s];x [mm]\n0;1\n1;zwei\n", "line 3, column 2 (x)", "'zwei'", "number"},
+    {"NonUniformTime", "t [s];x [mm]\n0;1\n1;2\n2;3\n3.5;4\n4;5\n", "line 5", "non-uniform",
+     "uniform"},
+    {"DecreasingTime", "t [s];x [mm]\n0;1\n2;2\n1;3\n", "line 4", "decreases", "increasing"},
+    {"GapRefused", "# preamble comment\nt [s];x [mm];y [mm]\n0;1;1\n1;2;\n2;3;3\n",
+     "line 4, column 3 (y)", "gap", "--fill-gaps linear"},
+    {"NoTimeColumn", "a [mm];b [mm]\n0;1\n1;2\n", "header", "no time column", "sample_rate_hz"},
+    {"NoHeader", "0;1\n1;2\n", "", "no header", "header"},
+    {"TwoUnits", "t [s];x [mm]\ns;m\n0;1\n1;2\n", "line 1, column 2", "'mm' in the header",
+     "one unit"},
+};
+
+void PrintTo(const BadFile& bad, std::ostream* os) { *os << bad.name; }
+
+class BadFileTest : public ::testing::TestWithParam<BadFile> {};
+
+TEST_P(BadFileTest, NamesFileAndPlace) {
+  const BadFile& bad = GetParam();
+  TempDir dir;
+  const std::string path = dir.File("bad.csv");
+  WriteText(path, bad.text);
+  const InputError e = CatchInputError([&] { ImportMeasurement(path); });
+  EXPECT_EQ(e.source(), path);
+  EXPECT_EQ(e.field(), bad.field);
+  EXPECT_THAT(e.problem(), HasSubstr(bad.problem));
+  EXPECT_THAT(e.expected(), HasSubstr(bad.expected));
+}
+
+INSTANTIATE_TEST_SUITE_P(Records, BadFileTest, ::testing::ValuesIn(kBadFiles),
+                         [](const ::testing::TestParamInfo<BadFile>& param_info) {
+                           return std::string(param_info.param.name);
+                         });
+
+TEST(BadOptionsTest, UnknownMappedColumnListsTheColumns) {
+  TempDir dir;
+  const std::string path = dir.File("map.csv");
+  WriteText(path, "t [s];Boom angle [deg]\n0;1\n1;2\n");
+  ImportOptions options;
+  options.channel_columns = {{"psi", "Boom angel"}};
+  const InputError e = CatchInputError([&] { ImportMeasurement(path, options); });
+  EXPECT_EQ(e.source(), path);
+  EXPECT_EQ(e.field(), "channels.psi");
+  EXPECT_THAT(e.problem(), HasSubstr("'Boom angel'"));
+  EXPECT_THAT(e.expected(), HasSubstr("1 'Boom angle'"));
+  options.channel_columns = {{"psi", "2"}};  // one data column only
+  EXPECT_EQ(CatchInputError([&] { ImportMeasurement(path, options); }).field(), "channels.psi");
+}
+
+TEST(BadOptionsTest, GapAtTheFirstSampleCannotBeFilled) {
+  TempDir dir;
+  const std::string path = dir.File("gap.csv");
+  WriteText(path, "t [s];x [mm]\n0;\n1;2\n2;3\n");
+  ImportOptions options;
+  options.fill_gaps = GapFill::kLinear;
+  const InputError e = CatchInputError([&] { ImportMeasurement(path, options); });
+  EXPECT_EQ(e.field(), "line 2, column 2 (x)");
+  EXPECT_THAT(e.problem(), HasSubstr("first sample"));
+  // ... and at the last.
+  WriteText(path, "t [s];x [mm]\n0;1\n1;2\n2;NaN\n");
+  EXPECT_EQ(CatchInputError([&] { ImportMeasurement(path, options); }).field(),
+            "line 4, column 2 (x)");
+}
+
+TEST(BadOptionsTest, UnitIncompatibleWithTheModel) {
+  TempDir dir;
+  const std::string path = dir.File("model.csv");
+  WriteText(path, "t [s];psi [mm]\n0;1\n1;2\n");
+  ImportOptions options;
+  options.target_units = {{"psi", "rad"}};  // the model's psi is an angle
+  const InputError e = CatchInputError([&] { ImportMeasurement(path, options); });
+  EXPECT_EQ(e.field(), "column 2 (psi)");
+  EXPECT_THAT(e.problem(), HasSubstr("'mm'"));
+  EXPECT_THAT(e.expected(), HasSubstr("rad"));
+}
+
+TEST(BadOptionsTest, UnitsKeyNamingNothing) {
+  TempDir dir;
+  const std::string path = dir.File("units.csv");
+  WriteText(path, "t [s];x\n0;1\n1;2\n");
+  ImportOptions options;
+  options.units = {{"y", "mm"}};
+  EXPECT_EQ(CatchInputError([&] { ImportMeasurement(path, options); }).field(), "units.y");
+}
+
+TEST(BadOptionsTest, UnsupportedExtension) {
+  TempDir dir;
+  const std::string path = dir.File("data.xlsx");
+  WriteText(path, "");
+  const InputError e = CatchInputError([&] { ImportMeasurement(path); });
+  EXPECT_THAT(e.problem(), HasSubstr(".xlsx"));
+  EXPECT_THAT(e.expected(), HasSubstr(".csv"));
+}
+
+}  // namespace
+}  // namespace mbid::records

@@ -1,0 +1,266 @@
+// Logger exports in each dialect, written from a closed-form decay and read back in SI; mbid's
+// own files through the same door, bit for bit.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "logger_export.h"
+#include "mbid/common/csv_io.h"
+#include "mbid/common/hdf5_io.h"
+#include "mbid/records/records.h"
+#include "test_util.h"
+
+namespace mbid::records {
+namespace {
+
+using mbid::testing::Decay;
+using mbid::testing::MakeExport;
+using mbid::testing::Print;
+using mbid::testing::SameBits;
+using mbid::testing::TempDir;
+using mbid::testing::WriteText;
+using ::testing::HasSubstr;
+
+constexpr double kDeg = M_PI / 180;
+// Values are printed with 9 significant digits: error <= 5e-9 of the largest value, amplitude
+// + offset; 1e-8 of that leaves a factor 2 for the unit factor's and the sum's rounding.
+double PrintTolerance(const Decay& decay, double factor) {
+  return 1e-8 * (std::abs(decay.amplitude) + std::abs(decay.offset)) * std::abs(factor);
+}
+
+void ExpectChannel(const Measurement& m, int c, const Decay& decay, double factor) {
+  const Eigen::VectorXd t = m.CalcTime();
+  for (Eigen::Index j = 0; j < m.samples(); ++j) {
+    ASSERT_NEAR(m.values(j, c), decay(t[j]) * factor, PrintTolerance(decay, factor))
+        << "channel " << c << ", sample " << j;
+  }
+}
+
+TEST(ImportTest, SemicolonDecimalCommaPreambleUnitsRowMilliseconds) {
+  TempDir dir;
+  const std::string path = dir.File("logger.csv");
+  const Decay angle;                        // degrees
+  const Decay acc{1.5, 0.02, 250.0, 20.0};  // mm/s^2
+  const std::string head =
+      "Logger: XYZ-200\nSerial: 12345\nSample rate: 100 Hz\n\nZeit;Boom angle;Acc\nms;deg;mm/s^2\n";
+  // 201 rows at 100 Hz: 2 s, three periods of the 1.5 Hz decay.
+  WriteText(path, MakeExport(head, 201, [&](int j) {
+              const double t = j * 0.01;
+              return fmt::format("{};{};{}", Print(10.0 * j + 0.0, true), Print(angle(t), true),
+                                 Print(acc(t), true));
+            }));
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, {}, &report);
+  EXPECT_EQ(report.format, "csv");
+  EXPECT_THAT(report.dialect, HasSubstr("';'-separated"));
+  EXPECT_THAT(report.dialect, HasSubstr("3 preamble lines"));  // the blank line is not one
+  EXPECT_THAT(report.dialect, HasSubstr("units row"));
+  EXPECT_EQ(m.channels, (std::vector<std::string>{"Boom angle", "Acc"}));
+  EXPECT_EQ(m.units, (std::vector<std::string>{"rad", "m/s^2"}));
+  EXPECT_EQ(m.samples(), 201);
+  EXPECT_EQ(m.start_time_s, 0.0);                 // the first time, 0 ms
+  EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-15);  // 10 ms: a few ulps of the ms -> s factor
+  ExpectChannel(m, 0, angle, kDeg);
+  ExpectChannel(m, 1, acc, 1e-3);
+  ASSERT_EQ(report.conversions.size(), 3u);  // time, angle, acceleration
+  EXPECT_THAT(report.conversions[1], HasSubstr("Boom angle: deg -> rad"));
+}
+
+TEST(ImportTest, DecimalCommaFlaggedWhenUsed) {
+  TempDir dir;
+  const std::string path = dir.File("comma.csv");
+  WriteText(path, "t [s];x [mm]\n0,0;1,5\n0,5;2,5\n1,0;3,5\n");  // three rows, step 0.5 s
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, {}, &report);
+  EXPECT_THAT(report.dialect, HasSubstr("decimal comma"));
+  EXPECT_DOUBLE_EQ(m.values(1, 0), 2.5e-3);  // 2,5 mm
+  EXPECT_EQ(m.sample_interval_s, 0.5);
+}
+
+TEST(ImportTest, TabsBomCrlfAndBracketedUnitsWithStandardGravity) {
+  TempDir dir;
+  const std::string path = dir.File("logger.txt");
+  const Decay angle;                      // degrees
+  const Decay disp{1.5, 0.02, 4.0, 1.0};  // mm
+  const Decay acc{1.5, 0.02, 0.03, 0.0};  // gn
+  const std::string head = "\xEF\xBB\xBFTime [s]\tangle [deg]\tdisp (mm)\tacc [gn]\r\n";
+  WriteText(path, MakeExport(
+                      head, 201,
+                      [&](int j) {
+                        const double t = j * 0.01;
+                        return fmt::format("{:.2f}\t{}\t{}\t{}", t, Print(angle(t)), Print(disp(t)),
+                                           Print(acc(t)));
+                      },
+                      "\r\n"));
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, {}, &report);
+  EXPECT_THAT(report.dialect, HasSubstr("tab-separated"));
+  EXPECT_THAT(report.dialect, HasSubstr("CRLF"));
+  EXPECT_THAT(report.dialect, HasSubstr("BOM"));
+  EXPECT_EQ(m.channels, (std::vector<std::string>{"angle", "disp", "acc"}));
+  EXPECT_EQ(m.units, (std::vector<std::string>{"rad", "m", "m/s^2"}));
+  EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-15);  // printed exactly to 2 decimals
+  ExpectChannel(m, 0, angle, kDeg);
+  ExpectChannel(m, 1, disp, 1e-3);
+  ExpectChannel(m, 2, acc, 9.80665);  // standard gravity (CGPM 1901)
+}
+
+TEST(ImportTest, IsoTimestampsBecomeSecondsFromTheFirstSample) {
+  TempDir dir;
+  const std::string path = dir.File("iso.csv");
+  const Decay angle;
+  // 12:00:00.125 + j * 10 ms, 301 rows (3 s): crosses whole seconds and a minute boundary is
+  // not needed; the offset "Z" is accepted.
+  WriteText(path, MakeExport("timestamp,theta [deg]\n", 301, [&](int j) {
+              const int ms = 125 + 10 * j;
+              return fmt::format("2026-03-01T12:00:{:02d}.{:03d}Z,{}", ms / 1000, ms % 1000,
+                                 Print(angle(j * 0.01)));
+            }));
+  const Measurement m = ImportMeasurement(path);
+  EXPECT_EQ(m.start_time_s, 0.0);                 // seconds from the first sample
+  EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-15);  // integer seconds subtracted first: exact
+  ExpectChannel(m, 0, angle, kDeg);
+}
+
+TEST(ImportTest, TimePrintedWithFewDigitsIsFittedByLeastSquares) {
+  TempDir dir;
+  const std::string path = dir.File("coarse.csv");
+  const Decay psi{1.5, 0.02, 0.02, 0.0};  // radians
+  const int n = 301;                      // 10 s at 30 Hz
+  // 1/30 s printed to 1 ms: each time is off the grid by up to 0.5 ms, 1.5 % of a step.
+  WriteText(path, MakeExport("t [s],psi [rad]\n", n, [&](int j) {
+              return fmt::format("{:.3f},{}", j / 30.0, Print(psi(j / 30.0)));
+            }));
+  const Measurement m = ImportMeasurement(path);
+  // Least squares over j: |slope error| <= 0.5 ms * sum|j - mean| / sum (j - mean)^2 ~ 1.5 ms / n.
+  EXPECT_NEAR(m.sample_interval_s, 1.0 / 30, 1.5e-3 / n);
+  EXPECT_NEAR(m.start_time_s, 0.0, 0.5e-3);  // within the printed resolution
+}
+
+TEST(ImportTest, UnitsFromOptionsAndTimeSuffix) {
+  TempDir dir;
+  const std::string path = dir.File("suffix.csv");
+  const Decay x{1.5, 0.02, 3.0, 0.0};  // mm
+  // time_us: the project's unit suffix; 2000 us = 2 ms steps, 101 rows.
+  WriteText(path, MakeExport("time_us,x\n", 101, [&](int j) {
+              return fmt::format("{},{}", 2000 * j, Print(x(j * 2e-3)));
+            }));
+  ImportOptions options;
+  options.units["x"] = "mm";  // the file states none
+  const Measurement m = ImportMeasurement(path, options);
+  EXPECT_NEAR(m.sample_interval_s, 2e-3, 1e-17);  // us -> s factor's rounding
+  EXPECT_EQ(m.units, std::vector<std::string>{"m"});
+  ExpectChannel(m, 0, x, 1e-3);
+}
+
+TEST(ImportTest, ChannelMappingByNameAndNumberWithModelTargets) {
+  TempDir dir;
+  const std::string path = dir.File("map.csv");
+  const Decay a;
+  WriteText(path, MakeExport("Time [ms];Boom angle [deg];Slew [deg];Spare [V]\n", 101, [&](int j) {
+              const double t = j * 0.01;
+              return fmt::format("{};{};{};0", 10 * j, Print(a(t)), Print(-a(t)));
+            }));
+  ImportOptions options;
+  options.channel_columns = {{"psi", "Boom angle"}, {"phi", "2"}};  // 2: the second data column
+  options.target_units = {{"psi", "rad"}, {"phi", "rad"}};
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, options, &report);
+  EXPECT_EQ(m.channels, (std::vector<std::string>{"psi", "phi"}));  // the spare column dropped
+  ExpectChannel(m, 0, a, kDeg);
+  ExpectChannel(m, 1, a, -kDeg);
+  EXPECT_EQ(report.mapping,
+            (std::vector<std::string>{"psi <- column 2 (Boom angle)", "phi <- column 3 (Slew)"}));
+}
+
+TEST(ImportTest, GapsFilledLinearlyWithinTheInterpolationBound) {
+  TempDir dir;
+  const std::string path = dir.File("gaps.csv");
+  const Decay angle;
+  const double h = 0.01;
+  // Rows 50 and 120 lose a value: an empty cell and a NaN.
+  WriteText(path, MakeExport("time [s],theta [deg]\n", 201, [&](int j) {
+              const std::string value = j == 50 ? "" : j == 120 ? "NaN" : Print(angle(j * h));
+              return fmt::format("{:.2f},{}", j * h, value);
+            }));
+  ImportOptions options;
+  options.fill_gaps = GapFill::kLinear;
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, options, &report);
+  EXPECT_EQ(report.filled_samples, 2);
+  // A chord over 2h misses the curve by at most (2h)^2 / 8 max|y''| (linear interpolation).
+  const double bound = (2 * h) * (2 * h) / 8 * angle.SecondDerivativeBound() * kDeg;
+  for (const int j : {50, 120}) {
+    EXPECT_NEAR(m.values(j, 0), angle(j * h) * kDeg, bound) << j;
+    EXPECT_NE(m.values(j, 0), angle(j * h) * kDeg);  // interpolated, not read
+  }
+  // The rest as read.
+  for (Eigen::Index j = 0; j < m.samples(); ++j) {
+    if (j == 50 || j == 120) continue;
+    ASSERT_NEAR(m.values(j, 0), angle(j * h) * kDeg, PrintTolerance(angle, kDeg)) << j;
+  }
+}
+
+TEST(ImportTest, NoTimeColumnWithSampleRate) {
+  TempDir dir;
+  const std::string path = dir.File("rate.csv");
+  WriteText(path, "a [rad],b [rad]\n1,2\n3,4\n5,6\n");
+  ImportOptions options;
+  options.sample_rate_hz = 200;  // 5 ms steps
+  const Measurement m = ImportMeasurement(path, options);
+  EXPECT_EQ(m.sample_interval_s, 1.0 / 200);
+  EXPECT_EQ(m.start_time_s, 0.0);
+  EXPECT_EQ(m.values(2, 1), 6.0);
+}
+
+TEST(ImportTest, MbidCsvAndHdf5RoundTripsStayBitExact) {
+  TempDir dir;
+  const Measurement written = mbid::testing::MakeMeasurement(300);
+  const std::string csv = dir.File("m.csv");
+  WriteMeasurementCsv(written, csv);
+  const std::string h5 = dir.File("m.h5");
+  H5Writer writer(h5);
+  writer.WriteMeasurement(written);
+  writer.Commit();
+  for (const std::string& path : {csv, h5}) {
+    ImportReport report;
+    const Measurement read = ImportMeasurement(path, {}, &report);
+    EXPECT_EQ(read.channels, written.channels) << path;
+    EXPECT_EQ(read.units, written.units) << path;
+    EXPECT_EQ(read.source, written.source) << path;
+    EXPECT_TRUE(SameBits(read.start_time_s, written.start_time_s)) << path;
+    EXPECT_TRUE(SameBits(read.sample_interval_s, written.sample_interval_s)) << path;
+    EXPECT_TRUE(SameBits(read.values, written.values)) << path;
+    EXPECT_TRUE(report.conversions.empty()) << path;  // SI in, nothing converted
+  }
+}
+
+TEST(ImportTest, MbidCsvUnitsCommentIsConverted) {
+  TempDir dir;
+  const std::string path = dir.File("deg.csv");
+  // Before this change `# units: deg` was stored and the values left in degrees.
+  WriteText(path, "# units: deg,mm\ntime,psi,x\n0,90,1000\n0.5,180,2000\n");
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, {}, &report);
+  EXPECT_EQ(report.format, "mbid-csv");
+  EXPECT_EQ(m.units, (std::vector<std::string>{"rad", "m"}));
+  EXPECT_DOUBLE_EQ(m.values(0, 0), M_PI / 2);
+  EXPECT_DOUBLE_EQ(m.values(1, 0), M_PI);
+  EXPECT_DOUBLE_EQ(m.values(1, 1), 2.0);
+}
+
+TEST(ImportTest, MbidCsvWithoutUnitsTakesTheModelsUnits) {
+  TempDir dir;
+  const std::string path = dir.File("si.csv");
+  WriteText(path, "time,psi,acc\n0,0.1,0.2\n0.5,0.3,0.4\n");
+  ImportOptions options;
+  options.target_units = {{"acc", "m/s^2"}};  // psi: none given, radians (mbid's CSV default)
+  const Measurement m = ImportMeasurement(path, options);
+  EXPECT_EQ(m.units, (std::vector<std::string>{"rad", "m/s^2"}));
+  EXPECT_EQ(m.values(1, 1), 0.4);  // SI by contract: not converted
+}
+
+}  // namespace
+}  // namespace mbid::records

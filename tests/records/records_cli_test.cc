@@ -1,0 +1,141 @@
+// Logger files through the mbid command: --channel, --unit and --fill-gaps on identify, update
+// and run, the scenario's record keys, and exit 2 with one line naming the file and the place.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "command_test.h"
+#include "mbid/common/hdf5_io.h"
+
+namespace {
+
+using mbid::testing::CommandResult;
+using mbid::testing::ReadText;
+namespace fs = std::filesystem;
+
+const std::string kScenarios = std::string(MBID_SOURCE_DIR) + "/scenarios/";
+
+// y = A e^{-zeta w t} cos(w_d t): 1.5 Hz, 2 % damping, 2 deg (a crane's first mode).
+double Decay(double t) {
+  const double w = 2 * M_PI * 1.5;
+  return 2.0 * std::exp(-0.02 * w * t) * std::cos(w * std::sqrt(1 - 0.02 * 0.02) * t);
+}
+
+class RecordsCliTest : public mbid::testing::CommandTest {
+ protected:
+  // A German logger's export: preamble, ';', decimal comma, units row, ms, degrees; 801 rows
+  // at 100 Hz (8 s, 12 periods); the row of `gap_row` (if >= 0) has an empty cell.
+  fs::path WriteLogger(const std::string& name, int gap_row = -1) const {
+    std::string text = "Logger: XYZ-200\nZeit;Boom angle;Slew\nms;deg;deg\n";
+    for (int j = 0; j < 801; ++j) {
+      const double t = j * 0.01;
+      std::string a = j == gap_row ? "" : fmt::format("{:.9g}", Decay(t));
+      std::string b = fmt::format("{:.9g}", 0.5 * Decay(t));
+      for (std::string* s : {&a, &b}) {
+        for (char& c : *s) c = c == '.' ? ',' : c;
+      }
+      text += fmt::format("{};{};{}\n", 10 * j, a, b);
+    }
+    return Write(name, text);
+  }
+
+  void ExpectOneErrorLine(const CommandResult& result, const std::string& phrase) const {
+    EXPECT_EQ(result.exit_code, 2) << result.err;
+    EXPECT_EQ(result.err.rfind("mbid: error: ", 0), 0u) << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_NE(result.err.find(phrase), std::string::npos) << result.err;
+    EXPECT_TRUE(result.out.empty()) << result.out;
+  }
+};
+
+TEST_F(RecordsCliTest, IdentifyRefusesAGapNamingLineAndColumnAndWritesNothing) {
+  const fs::path data = WriteLogger("logger.csv", 100);  // row 100 is file line 104
+  const fs::path out = dir_ / "out.h5";
+  const CommandResult result = Run("identify " + data.string() + " -o " + out.string() +
+                                   " --json " + (dir_ / "s.json").string());
+  ExpectOneErrorLine(result, data.string() + ":line 104, column 2 (Boom angle): empty cell");
+  EXPECT_NE(result.err.find("--fill-gaps linear"), std::string::npos) << result.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir_ / "s.json"));
+}
+
+TEST_F(RecordsCliTest, IdentifyFillsGapsAndReportsTheImport) {
+  const fs::path data = WriteLogger("logger.csv", 100);
+  const CommandResult result = Run("identify " + data.string() +
+                                   " --fill-gaps linear --json - --channel psi=\"Boom "
+                                   "angle\" --channel phi=2");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.err.find("1 gap sample filled linearly"), std::string::npos) << result.err;
+  const nlohmann::json summary = nlohmann::json::parse(result.out);
+  const nlohmann::json& import = summary["import"];
+  EXPECT_EQ(import["format"], "csv");
+  EXPECT_EQ(import["filled_samples"], 1);
+  EXPECT_EQ(import["mapping"][0], "psi <- column 2 (Boom angle)");
+  EXPECT_NE(import["conversions"].dump().find("psi: deg -> rad"), std::string::npos);
+  ASSERT_GE(summary["modes"].size(), 1u) << summary.dump();
+  // One mode in the record: its frequency to 1e-3 Hz (a clean 8 s record gives far better;
+  // the one interpolated sample moves it by less).
+  EXPECT_NEAR(summary["modes"][0]["frequency_hz"].get<double>(), 1.5, 1e-3);
+  EXPECT_EQ(summary["channels"], nlohmann::json({"psi", "phi"}));
+}
+
+TEST_F(RecordsCliTest, BadFlagsAndUnknownColumnsAreInvalidInput) {
+  const fs::path data = WriteLogger("logger.csv");
+  ExpectOneErrorLine(Run("identify " + data.string() + " --channel psi"), "--channel");
+  ExpectOneErrorLine(Run("identify " + data.string() + " --channel psi=Nope"),
+                     data.string() + ":channels.psi: no column 'Nope'");
+  ExpectOneErrorLine(Run("identify " + data.string() + " --unit Slew=blorp"),
+                     data.string() + ":column 3 (Slew): unknown unit 'blorp'");
+  ExpectOneErrorLine(Run("identify " + data.string() + " --fill-gaps cubic"), "--fill-gaps");
+  // update checks the mapping before any work: the model's psi is an angle, mm is not.
+  const fs::path scenario = WriteVariant(kScenarios + "reference-crane.yaml", "s.yaml");
+  ExpectOneErrorLine(Run("update " + scenario.string() + " " + data.string() +
+                         " --channel psi=2 --unit Slew=mm -o " + (dir_ / "u.h5").string()),
+                     data.string() + ":column 3 (Slew): unit 'mm'");
+  EXPECT_FALSE(fs::exists(dir_ / "u.h5"));
+}
+
+TEST_F(RecordsCliTest, RunReadsALoggerFileThroughTheRecordKeys) {
+  // The reference crane's own virtual test (5 s), exported as a logger would: degrees, ms,
+  // ';' and decimal comma, other column names, one gap, the second column's unit left to the
+  // scenario. The run must tune the model to it as to the original.
+  const fs::path base = WriteVariant(kScenarios + "reference-crane.yaml", "base.yaml",
+                                     "  duration_s: 8", "  duration_s: 5");
+  ASSERT_EQ(Run("simulate " + base.string() + " -o " + (dir_ / "sim.h5").string()).exit_code, 0);
+  const mbid::Measurement sim = mbid::ReadMeasurementH5((dir_ / "sim.h5").string());
+  ASSERT_EQ(sim.channels, (std::vector<std::string>{"psi", "phi"}));
+  std::string text = "Exported by XYZ-200\nZeit;Boom angle;Slew\nms;deg;\n";
+  const Eigen::VectorXd t = sim.CalcTime();
+  for (Eigen::Index j = 0; j < sim.samples(); ++j) {
+    // 9 digits of degrees: 1e-9 relative, far below the 1e-5 rad sensor noise.
+    std::string a = j == 200 ? "" : fmt::format("{:.9g}", sim.values(j, 0) * 180 / M_PI);
+    std::string b = fmt::format("{:.9g}", sim.values(j, 1) * 180 / M_PI);
+    for (std::string* s : {&a, &b}) {
+      for (char& c : *s) c = c == '.' ? ',' : c;
+    }
+    text += fmt::format("{:.6g};{};{}\n", t[j] * 1000, a, b);
+  }
+  Write("logger.csv", text);
+  std::ofstream(base, std::ios::app)
+      << "record: {file: logger.csv, channels: {psi: Boom angle, phi: 2}, units: {Slew: deg}, "
+         "fill_gaps: linear}\n";
+  const fs::path out = dir_ / "run";
+  const CommandResult result = Run("run " + base.string() + " -o " + out.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.err.find("psi: deg -> rad"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("1 gap sample filled linearly"), std::string::npos) << result.err;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));
+  EXPECT_TRUE(summary["validation"]["passed"].get<bool>()) << summary["validation"].dump();
+  EXPECT_EQ(summary["tests"][0]["import"]["filled_samples"], 1);  // the one empty cell
+  for (const char* channel : {"psi", "phi"}) {
+    // As from the original file: 1e-5 rad noise on ~1e-3 rad outputs gives K > 0.999.
+    EXPECT_GT(summary["validation"]["correlation"][channel].get<double>(), 0.999) << channel;
+  }
+}
+
+}  // namespace
