@@ -1,7 +1,9 @@
 // The mbid command: parses flags, calls the libraries, maps failures to the exit codes of
 // docs/interfaces.md (2 invalid input, 3 numerical failure, 1 anything else).
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,8 @@ struct ImportFlags {
   std::vector<std::string> channels;
   std::vector<std::string> units;
   std::string fill_gaps;
+  std::string release;
+  std::optional<double> release_time_s;
 };
 
 void AddImportFlags(CLI::App* command, ImportFlags* flags) {
@@ -37,6 +41,15 @@ void AddImportFlags(CLI::App* command, ImportFlags* flags) {
       ->add_option("--fill-gaps", flags->fill_gaps,
                    "Empty or NaN cells: linear (interpolate and report) or none (refuse)")
       ->check(CLI::IsMember({"linear", "none"}));
+  CLI::Option* release =
+      command
+          ->add_option("--release", flags->release,
+                       "none: the record is the free decay (default: find where it starts)")
+          ->check(CLI::IsMember({"none", "detect"}));
+  command
+      ->add_option("--release-time-s", flags->release_time_s,
+                   "The free decay starts at this time of the record, s")
+      ->excludes(release);
 }
 
 mbid::app::ImportOverrides MakeOverrides(const ImportFlags& flags) {
@@ -48,6 +61,12 @@ mbid::app::ImportOverrides MakeOverrides(const ImportFlags& flags) {
   if (!flags.fill_gaps.empty()) {
     overrides.fill_gaps = mbid::app::ParseGapFill(flags.fill_gaps, "command line", "--fill-gaps");
   }
+  overrides.release_none = flags.release == "none";
+  if (flags.release_time_s && !std::isfinite(*flags.release_time_s)) {
+    throw mbid::InputError("command line", "--release-time-s",
+                           std::to_string(*flags.release_time_s), "a finite time in s");
+  }
+  overrides.release_time_s = flags.release_time_s;
   return overrides;
 }
 
@@ -170,6 +189,12 @@ int Main(int argc, char** argv) {
   }
   if (identify->parsed()) {
     mbid::identification::ParseMethod(identify_method, &identify_options.method);
+    if (common.import.release_none) {
+      identify_options.release = mbid::identification::ReleaseMode::kNone;
+    } else if (common.import.release_time_s) {
+      identify_options.release = mbid::identification::ReleaseMode::kGiven;
+      identify_options.release_time_s = *common.import.release_time_s;
+    }
     identify_options.offset = identify_offset == "none" ? mbid::identification::OffsetRemoval::kNone
                               : identify_offset == "mean"
                                   ? mbid::identification::OffsetRemoval::kMean

@@ -52,10 +52,18 @@ int RunIdentifyCommand(const std::string& data_path,
   for (const std::string& warning : result.warnings) {
     if (!common.quiet) std::cerr << "mbid: warning: " << warning << "\n";
   }
+  // Unreliable results are said even with --quiet: dampers get sized on these numbers.
+  for (const std::string& reason : result.reasons) {
+    std::cerr << "mbid: warning: result unreliable: " << reason << "\n";
+  }
   if (common.json_path != "-") {
-    std::cout << fmt::format("{} modes ({}, model order {}, effective rank {})\n",
-                             result.modes.size(), result.method, result.model_order,
-                             result.effective_rank);
+    std::cout << fmt::format(
+        "{} modes ({}, model order {}, effective rank {}{}){}\n", result.modes.size(),
+        result.method, result.model_order, result.effective_rank,
+        result.decimation > 1 ? fmt::format(", decimation {}", result.decimation) : "",
+        result.reliable ? "" : " -- UNRELIABLE, see the warnings");
+    std::cout << fmt::format("free decay from {:.6g} s ({})\n", result.release_time_s,
+                             result.release);
     std::cout << fmt::format("{:>4} {:>13} {:>12} {:>16} {:>12} {:>13}\n", "mode", "frequency_hz",
                              "std_hz", "decay_rate_per_s", "std_per_s", "damping_ratio");
     for (size_t k = 0; k < result.modes.size(); ++k) {
@@ -66,7 +74,8 @@ int RunIdentifyCommand(const std::string& data_path,
                                mode.significant ? "" : "  (not significant)");
     }
     for (size_t c = 0; c < result.channels.size(); ++c) {
-      std::cout << fmt::format("correlation K({}) = {:.4f}\n", result.channels[c],
+      std::cout << fmt::format("correlation K({}) in the analysed band = {:.4f}\n",
+                               result.channels[c],
                                result.correlation[static_cast<Eigen::Index>(c)]);
     }
   }

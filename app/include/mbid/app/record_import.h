@@ -22,6 +22,10 @@ struct ImportOverrides {
   std::vector<std::pair<std::string, std::string>> channel_columns;  // --channel NAME=COLUMN
   std::map<std::string, std::string> units;                          // --unit COLUMN=UNIT
   std::optional<records::GapFill> fill_gaps;                         // --fill-gaps
+  // --release none (the record is the free decay) / --release-time-s T (in the file's time);
+  // unset: the release is found in the record (identification/release.h).
+  bool release_none = false;
+  std::optional<double> release_time_s;
 };
 
 // Parses "NAME=VALUE" items of `flag`; an item without '=' or with an empty side is an
