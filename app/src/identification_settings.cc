@@ -29,6 +29,7 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
                      "compute_stabilization",
                      "compute_uncertainty",
                      "extra_orders",
+                     "min_correlation",
                      "prony"});
   const std::string method = section.Choice("method", {"hankel-nls", "prony-svd"}, "hankel-nls");
   identification::ParseMethod(method, &options.method);
@@ -40,6 +41,7 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
                    : offset == "mean" ? identification::OffsetRemoval::kMean
                                       : identification::OffsetRemoval::kFit;
   options.decimation = section.Int("decimation", options.decimation);
+  options.min_correlation = section.Double("min_correlation", options.min_correlation);
   options.min_frequency_hz = section.Double("min_frequency_hz", options.min_frequency_hz);
   options.max_frequency_hz = section.Double("max_frequency_hz", options.max_frequency_hz);
   options.min_damping_ratio = section.Double("min_damping_ratio", options.min_damping_ratio);

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -102,6 +103,8 @@ void WriteTestGroups(H5Writer& run, const RunTest& test, const std::string& root
   const updating::TestFit& fit = test.tuned.tests.front();
   const std::string validation = root + "/validation";
   run.WriteStringAttribute(validation, "passed", test.passed ? "true" : "false");
+  run.WriteStringAttribute(validation, "verdict", test.verdict);
+  run.WriteStrings(validation, "reasons", test.reasons);
   run.WriteScalar(validation, "threshold", threshold, "1");
   for (size_t c = 0; c < fit.channels.size(); ++c) {
     const auto column = static_cast<Eigen::Index>(c);
@@ -124,10 +127,13 @@ nlohmann::json TestValidationJson(const RunTest& test, double threshold) {
   const updating::TestFit& fit = test.tuned.tests.front();
   return {{"correlation", ChannelValues(fit.channels, fit.correlation)},
           {"threshold", threshold},
+          {"verdict", test.verdict},
+          {"reasons", test.reasons},
           {"passed", test.passed}};
 }
 
-std::string VerdictLine(const std::vector<RunTest>& tests, double threshold, bool passed) {
+std::string VerdictLine(const std::vector<RunTest>& tests, double threshold,
+                        const std::string& verdict) {
   std::vector<std::string> parts;
   for (const RunTest& test : tests) {
     const updating::TestFit& fit = test.tuned.tests.front();
@@ -136,8 +142,10 @@ std::string VerdictLine(const std::vector<RunTest>& tests, double threshold, boo
                                   fit.channels[c], fit.correlation[static_cast<Eigen::Index>(c)]));
     }
   }
+  std::string upper = verdict;
+  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return fmt::format("re-simulation vs record: {}; threshold {} -> {}", fmt::join(parts, ", "),
-                     threshold, passed ? "PASSED" : "FAILED");
+                     threshold, upper);
 }
 
 bool IsHdf5File(const fs::path& path) {
@@ -220,17 +228,32 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
     AnalyseTest(test, *model, excitation, settings,
                 [&](const std::string& message) { progress.Say(prefix + message); });
   }
-  bool passed = true;
-  for (const RunTest& test : tests) passed = passed && test.passed;
+  std::vector<std::string> verdicts;
+  std::vector<std::string> reasons;
+  for (const RunTest& test : tests) {
+    verdicts.push_back(test.verdict);
+    for (const std::string& reason : test.reasons) {
+      reasons.push_back(several ? "test " + test.name + ": " + reason : reason);
+    }
+  }
+  const std::string overall = CombineVerdicts(verdicts);
+  const bool passed = overall == "passed";
   const double threshold = settings.min_correlation;
-  const std::string verdict = VerdictLine(tests, threshold, passed);
+  const std::string verdict = VerdictLine(tests, threshold, overall);
   progress.Say(verdict);
+  for (const std::string& reason : reasons) {
+    // Said even with --quiet: a run that did not pass says why.
+    std::cerr << "mbid: " << (overall == "failed" ? "failed" : "inconclusive") << ": " << reason
+              << "\n";
+  }
 
   H5Writer run(folder / "run.h5");
   run.WriteScenarioYaml(scenario.yaml_text);
   const RunTest& first = tests.front();
   WriteTestGroups(run, first, "", threshold);
   run.WriteStringAttribute("/validation", "passed", passed ? "true" : "false");
+  run.WriteStringAttribute("/validation", "verdict", overall);
+  run.WriteStrings("/validation", "reasons", reasons);
   if (first.simulation) {
     WriteTruth(run, *model, *first.simulation);
     WriteSimulationInfo(run, excitation, scenario.simulation, *first.simulation);
@@ -243,6 +266,8 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   // worst correlation per channel and passes only if every test does.
   nlohmann::json validation = TestValidationJson(first, threshold);
   validation["passed"] = passed;
+  validation["verdict"] = overall;
+  validation["reasons"] = reasons;
   nlohmann::json summary{{"scenario", scenario.name}};
   if (first.simulation) {
     summary["simulation"] = {

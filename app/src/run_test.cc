@@ -45,8 +45,31 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
     throw NumericalError("updating of test " + test.name,
                          test.tuned.termination_name() + ": " + test.tuned.message);
   }
-  const Eigen::VectorXd& k = test.tuned.tests.front().correlation;
-  test.passed = k.size() > 0 && (k.array() >= settings.min_correlation).all();
+  const updating::TestFit& fit = test.tuned.tests.front();
+  const Eigen::VectorXd& k = fit.correlation;
+  test.reasons.clear();
+  for (Eigen::Index c = 0; c < k.size(); ++c) {
+    if (!(k(c) >= settings.min_correlation)) {
+      test.reasons.push_back(fmt::format("K({}) = {:.4f} is below the threshold {}",
+                                         fit.channels[static_cast<size_t>(c)], k(c),
+                                         settings.min_correlation));
+    }
+  }
+  const bool correlates = k.size() > 0 && test.reasons.empty();
+  for (const std::string& reason : test.identified.reasons) {
+    test.reasons.push_back("identification unreliable: " + reason);
+  }
+  test.verdict = !correlates ? "failed" : test.identified.reliable ? "passed" : "inconclusive";
+  test.passed = test.verdict == "passed";
+}
+
+std::string CombineVerdicts(const std::vector<std::string>& verdicts) {
+  std::string combined = "passed";
+  for (const std::string& verdict : verdicts) {
+    if (verdict == "failed") return "failed";
+    if (verdict == "inconclusive") combined = verdict;
+  }
+  return combined;
 }
 
 }  // namespace mbid::app

@@ -4,6 +4,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "mbid/common/measurement.h"
 #include "mbid/identification/modal_result.h"
@@ -30,8 +31,16 @@ struct RunTest {
   std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, if it ran
   std::string start_note;                                           // where Route 2 started
   updating::UpdateResult tuned;
-  bool passed = false;  // re-simulation correlates at least at the threshold on every channel
+  bool passed = false;  // verdict == "passed"
+  // "passed": the re-simulation correlates at least at the threshold on every channel and the
+  // identification is reliable; "failed": some channel below the threshold; "inconclusive": the
+  // correlations pass but the identification is not to be trusted. `reasons` says why.
+  std::string verdict = "failed";
+  std::vector<std::string> reasons;
 };
+
+// The worst of the tests' verdicts: failed before inconclusive before passed.
+std::string CombineVerdicts(const std::vector<std::string>& verdicts);
 
 // What every test of a run shares.
 struct RunSettings {

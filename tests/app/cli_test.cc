@@ -235,6 +235,8 @@ TEST_F(CliTest, RunClosesTheValidationCycle) {
             4u);  // every mode visible (reference-crane.md)
   EXPECT_EQ(summary["updating"]["termination"], "converged");
   EXPECT_TRUE(summary["validation"]["passed"].get<bool>());
+  EXPECT_EQ(summary["validation"]["verdict"], "passed");
+  EXPECT_TRUE(summary["validation"]["reasons"].empty());
   // Issue 5's bounds at this noise (1e-5 rad, ~50 dB): stiffnesses within 1%, dampings within 5%.
   const std::map<std::string, double> truth{
       {"c_alpha", 4.9e7},    {"c_gamma", 1.1e6},    {"c_eta", 5.5e6},   {"c_theta", 9.4e6},
@@ -259,6 +261,31 @@ TEST_F(CliTest, RunClosesTheValidationCycle) {
       figures,
       9);  // 2 records, spectrum, 2 reconstructions, stabilization, 2 re-simulations, convergence
   EXPECT_NE(report.find("PASSED"), std::string::npos);
+}
+
+// A run whose re-simulation correlates but whose identification is not to be trusted cannot
+// pass: the band cut at 3.2 Hz puts the crane's 3.09 Hz mode at its edge (above 0.95 of it), so
+// the verdict is inconclusive, with the reason, in summary.json, run.h5 and on stderr (exit 0:
+// the run itself worked).
+TEST_F(CliTest, UnreliableIdentificationMakesTheRunInconclusive) {
+  const fs::path scenario =
+      WriteVariant("  seed: 1", "  seed: 1\nidentification:\n  max_frequency_hz: 3.2");
+  const fs::path out = dir_ / "results";
+  const CommandResult result = Run("run " + scenario.string() + " -o " + out.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));
+  const nlohmann::json& validation = summary["validation"];
+  EXPECT_EQ(validation["verdict"], "inconclusive");
+  EXPECT_FALSE(validation["passed"].get<bool>());
+  for (const auto& [channel, k] : validation["correlation"].items()) {
+    EXPECT_GE(k.get<double>(), 0.95) << channel;  // the correlations alone would pass
+  }
+  ASSERT_FALSE(validation["reasons"].empty());
+  EXPECT_NE(validation["reasons"][0].get<std::string>().find("top of the analysed band"),
+            std::string::npos);
+  EXPECT_FALSE(summary["identification"]["reliable"].get<bool>());
+  EXPECT_NE(result.err.find("INCONCLUSIVE"), std::string::npos) << result.err;
+  EXPECT_NE(ReadText(out / "report.md").find("INCONCLUSIVE"), std::string::npos);
 }
 
 TEST_F(CliTest, FailedRunLeavesNoResultsFolder) {
