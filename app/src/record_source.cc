@@ -8,7 +8,9 @@
 #include <set>
 
 #include "mbid/common/error.h"
+#include "mbid/common/hdf5_io.h"
 #include "mbid/records/records.h"
+#include "mbid/simulation/scenario_sections.h"
 
 namespace mbid::app {
 namespace {
@@ -28,7 +30,7 @@ std::string OutputList(const model::MechanicalModel& model) {
 RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
                      const std::string& scenario_dir, const model::MechanicalModel& model) {
   if (!entry.IsMap()) entry.Fail("not a mapping", "{file: PATH} or {synthetic_modes: {...}}");
-  std::vector<std::string> keys = {"name", "file", "synthetic_modes"};
+  std::vector<std::string> keys = {"name", "file", "synthetic_modes", "excitation"};
   keys.insert(keys.end(), ImportKeys().begin(), ImportKeys().end());
   entry.ExpectMap(keys);
   RecordSource source;
@@ -55,7 +57,15 @@ RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
       entry.FailAt("file", "'" + source.file + "' does not exist", "a readable measurement file");
     }
     source.import = ReadImportOptions(entry);
+    if (entry.Has("excitation")) {
+      source.excitation = simulation::ReadExcitation(entry.Child("excitation"), model);
+      source.excitation_origin = "record entry";
+    }
   } else {
+    if (entry.Has("excitation")) {
+      entry.FailAt("excitation", "given for synthetic_modes",
+                   "an excitation only with file: PATH (synthetic modes have none)");
+    }
     for (const std::string& key : ImportKeys()) {
       if (entry.Has(key))
         entry.FailAt(key, "given for synthetic_modes", "import keys only with file: PATH");
@@ -113,6 +123,26 @@ LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel
   loaded.import = report;
   loaded.origin = source.file;
   RequireModelOutputs(loaded.measured, source.file, model);
+  loaded.excitation = source.excitation;
+  loaded.excitation_origin = source.excitation_origin;
+  if (!loaded.excitation && report.format == "hdf5") {
+    // A test mbid simulated carries its scenario: its own load, not the run scenario's.
+    const std::string yaml = ReadScenarioYaml(source.file);
+    if (!yaml.empty()) {
+      YAML::Node root;
+      try {
+        root = YAML::Load(yaml);
+      } catch (const YAML::Exception& error) {
+        throw InputError(source.file, "/scenario", "the stored scenario is not YAML",
+                         "the scenario mbid simulate stored");
+      }
+      if (root.IsMap() && root["excitation"]) {
+        const YamlReader stored(root["excitation"], source.file + ":/scenario", "excitation");
+        loaded.excitation = simulation::ReadExcitation(stored, model);
+        loaded.excitation_origin = source.file + ":/scenario";
+      }
+    }
+  }
   return loaded;
 }
 

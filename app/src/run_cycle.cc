@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <filesystem>
@@ -80,6 +81,11 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
     test.measured = std::move(loaded.measured);
     test.exact = std::move(loaded.exact);
     test.import = std::move(loaded.import);
+    test.excitation = std::move(loaded.excitation);
+    if (test.excitation) {
+      progress.Say(fmt::format("test {}: excitation {} from {}", test.name,
+                               test.excitation->type_name(), loaded.excitation_origin));
+    }
     progress.Say(fmt::format("test {}: {} ({} samples x {} channels)", test.name, test.origin,
                              test.measured.samples(), test.measured.channel_count()));
     tests.push_back(std::move(test));
@@ -213,7 +219,14 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   const std::vector<model::Mode> exact_modes = model::CalcModes(linear);
   progress.Say(fmt::format("model {}: {} coordinates, {} exact modes", model->type(),
                            model->coordinate_count(), exact_modes.size()));
-  const simulation::Excitation& excitation = scenario.RequireExcitation();
+  // Recorded tests may each carry their own excitation; the scenario's is needed otherwise.
+  const bool every_test_has_its_own =
+      !scenario.records.empty() &&
+      std::all_of(scenario.records.begin(), scenario.records.end(),
+                  [](const RecordSource& r) { return r.excitation.has_value(); });
+  const simulation::Excitation& excitation = every_test_has_its_own && !scenario.has_excitation
+                                                 ? *scenario.records.front().excitation
+                                                 : scenario.RequireExcitation();
 
   RunSettings settings;
   settings.identification = scenario.ReadIdentification();
@@ -225,7 +238,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   const bool several = tests.size() > 1;
   for (RunTest& test : tests) {
     const std::string prefix = several ? "test " + test.name + ": " : "";
-    AnalyseTest(test, *model, excitation, settings,
+    AnalyseTest(test, *model, test.excitation ? *test.excitation : excitation, settings,
                 [&](const std::string& message) { progress.Say(prefix + message); });
   }
   std::vector<std::string> verdicts;

@@ -24,8 +24,10 @@ struct RunTest {
   std::string name;
   std::string origin;  // "simulation", the record's file, or "synthetic modes"
   Measurement measured;
-  std::optional<Measurement> exact;                        // the noise-free record, when known
-  std::optional<records::ImportReport> import;             // what reading the record's file did
+  std::optional<Measurement> exact;             // the noise-free record, when known
+  std::optional<records::ImportReport> import;  // what reading the record's file did
+  // The test's own excitation (record_source.h); unset: the scenario's.
+  std::optional<simulation::Excitation> excitation;
   std::optional<simulation::SimulationResult> simulation;  // a simulated test's integration
   identification::ModalResult identified;
   std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, if it ran

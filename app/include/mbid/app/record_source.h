@@ -8,6 +8,7 @@
 #include "mbid/common/measurement.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/excitation.h"
 #include "mbid/simulation/modal_record.h"
 
 namespace mbid::app {
@@ -20,6 +21,10 @@ struct RecordSource {
   std::string file;               // a measurement file, resolved against the scenario's folder
   records::ImportOptions import;  // the entry's channels, units, time_unit, fill_gaps, ...
   std::optional<simulation::ModalRecordSpec> synthetic;
+  // The test's own excitation: the entry's `excitation:` (it wins), else, for an HDF5 file mbid
+  // wrote, the excitation of the scenario stored in it; unset: the scenario's excitation.
+  std::optional<simulation::Excitation> excitation;
+  std::string excitation_origin;  // "record entry", "<file>:/scenario"
 };
 
 // Reads the section strictly; `scenario_dir` resolves relative file names. Channels of synthetic
@@ -31,9 +36,11 @@ std::vector<RecordSource> ReadRecordSources(const YamlReader& record,
 // A test record ready for identification.
 struct LoadedRecord {
   Measurement measured;
-  std::optional<Measurement> exact;             // the noise-free record of a synthetic one
-  std::string origin;                           // the file, or "synthetic modes"
-  std::optional<records::ImportReport> import;  // what reading the file did
+  std::optional<Measurement> exact;                  // the noise-free record of a synthetic one
+  std::string origin;                                // the file, or "synthetic modes"
+  std::optional<records::ImportReport> import;       // what reading the file did
+  std::optional<simulation::Excitation> excitation;  // as RecordSource::excitation
+  std::string excitation_origin;
 };
 
 // Throws InputError naming `origin` unless every channel of `record` is an output of `model`.
