@@ -155,8 +155,8 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   Eigen::MatrixXd dy_dY(simulated.output_count(), jacobian_columns);
   Eigen::MatrixXd dy_dp = Eigen::MatrixXd::Zero(simulated.output_count(), model_count);
   bool forcing_done = !(forcing_end_s > 0);
-  for (int i = 0; i < grid.skipped + grid.count; ++i) {
-    const double t = grid.Time(i);
+  for (int row = 0; row < grid.skipped + grid.count; ++row) {
+    const double t = grid.Time(row);
     if (!forcing_done && t >= forcing_end_s) {
       // Restart the multistep history at the kink of the load, sensitivities carried over.
       integrator.AdvanceTo(forcing_end_s, CvodesIntegrator::Realization::kNone);
@@ -169,7 +169,7 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
     // Outputs realize what they need themselves (the crane's: nothing).
     const SimTK::State& state =
         t == 0 ? integrator.state() : integrator.AdvanceTo(t, CvodesIntegrator::Realization::kNone);
-    const int j = i - grid.skipped;
+    const int j = row - grid.skipped;
     if (j < 0) continue;  // visited for the same steps as a record from t = 0
     const Eigen::VectorXd y = simulated.CalcOutputs(state);
     Eigen::VectorXd q(n);

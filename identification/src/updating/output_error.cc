@@ -542,10 +542,11 @@ PreparedTest PrepareTest(const model::MechanicalModel& model, const TestRecord& 
   // The simulation samples at the record's times. A start on the whole-sample grid k tau is
   // sampled as (k + j) tau, bit for bit the rows of a simulation from t = 0 (the duration
   // computed the same way keeps the count); other starts at t0 + j tau.
-  const double k = std::round(record.start_time_s / tau);
-  const bool whole = std::abs(record.start_time_s / tau - k) <= simulation::kWholeSampleTolerance;
-  prepared.simulation.duration_s =
-      whole ? (k + record.samples() - 1) * tau : record.start_time_s + (record.samples() - 1) * tau;
+  const double grid_index = std::round(record.start_time_s / tau);
+  const bool whole =
+      std::abs(record.start_time_s / tau - grid_index) <= simulation::kWholeSampleTolerance;
+  prepared.simulation.duration_s = whole ? (grid_index + record.samples() - 1) * tau
+                                         : record.start_time_s + (record.samples() - 1) * tau;
   prepared.simulation.integrator = options.integrator;
   prepared.sensors.sample_rate_hz = 1.0 / tau;
   prepared.sensors.start_time_s = record.start_time_s;
