@@ -98,7 +98,7 @@ TEST(BaselineTest, OffsetAndDriftOfAnImportedRecordAreFittedAndReported) {
   RecordProperty("worst_deviation_std", Sci(worst));
   // Within a few standard deviations: the stds include the baseline's share (the projected
   // Jacobian), so they are honest about what the offsets and drifts cost.
-  EXPECT_LT(worst, 4.0);
+  EXPECT_LT(worst, 4.0);  // measured 2.0 (c_theta), the others within 1.3 std
   const TestFit& fit = result.tests.front();
   ASSERT_EQ(fit.offset.size(), 2);
   ASSERT_EQ(fit.drift.size(), 2);
@@ -125,7 +125,15 @@ TEST(BaselineTest, OffsetAndDriftOfAnImportedRecordAreFittedAndReported) {
     RecordProperty("without_baseline_" + name,
                    "error " + Sci(biased.Find(name).value / crane.model->GetParameter(name) - 1));
   }
-  EXPECT_GT(biased_worst, 100.0);
+  // Measured: 39 std, d_alpha 21% and d_gamma 11% off (with the baseline: 2 std, all within
+  // 0.6%). 10 std and 5% leave margin while no fit at the truth comes near either.
+  EXPECT_GT(biased_worst, 10.0);
+  double largest_error = 0;
+  for (const std::string& name : kAllParameters) {
+    largest_error = std::max(
+        largest_error, std::abs(biased.Find(name).value / crane.model->GetParameter(name) - 1));
+  }
+  EXPECT_GT(largest_error, 0.05);
 }
 
 // The crane's initial deflection sampled at 50 Hz from 0.37 tau after the release: picked from
@@ -170,7 +178,7 @@ TEST(BaselineTest, RecordStartingBetweenSamplesUpdatesToTheTruth) {
         std::max(worst, std::abs(shifted.Find(name).value / crane.model->GetParameter(name) - 1));
   }
   RecordProperty("misplaced_worst_error", Sci(worst));
-  EXPECT_GT(worst, 1e-3);
+  EXPECT_GT(worst, 1e-3);  // measured 6.3e-2, against 3e-8 with the right start
 }
 
 }  // namespace
