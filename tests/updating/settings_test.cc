@@ -229,6 +229,9 @@ TEST(SettingsTest, OffsetsAreFittedForImportedRecordsByDefault) {
   EXPECT_TRUE(MakeTestRecord("a", imported, crane.excitation, defaults).fit_offsets);
   EXPECT_FALSE(MakeTestRecord("a", imported, crane.excitation, defaults).fit_drift);
   EXPECT_FALSE(MakeTestRecord("a", simulated, crane.excitation, defaults).fit_offsets);
+  Measurement synthetic = simulated;  // mbid's synthetic_modes records: no zero error either
+  synthetic.source = "synthetic";
+  EXPECT_FALSE(MakeTestRecord("a", synthetic, crane.excitation, defaults).fit_offsets);
   // The drift comes with the offsets, wherever they are fitted.
   const UpdatingSettings drift = Read("updating: {fit_drift: true}", *crane.model);
   EXPECT_TRUE(MakeTestRecord("a", imported, crane.excitation, drift).fit_drift);

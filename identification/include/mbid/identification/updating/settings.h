@@ -32,7 +32,7 @@ namespace mbid::updating {
 //     fit_payload_mass: false              # nuisance: each load drop's payload mass
 //     fit_initial_deflection: false        # nuisance: each initial_deflection test's angles
 //     fit_offsets: auto                    # auto | true | false: a constant offset per test and
-//                                          #   channel (auto: records not simulated by mbid)
+//                                          #   channel (auto: records not made by mbid)
 //     fit_drift: false                     # also a linear drift (with the offsets)
 //     max_iterations: 50
 //     function_tolerance: 1.0e-6           # Ceres: relative cost decrease
@@ -75,7 +75,7 @@ struct UpdatingSettings {
   bool fit_payload_mass = false;
   bool fit_initial_deflection = false;
   // Offsets per channel: kAuto fits them for imported records (Measurement::source other than
-  // "simulation"), not for records mbid simulated itself (exact zeros: nothing to fit).
+  // "simulation" and "synthetic"), not for records mbid made itself (no zero error to fit).
   enum class Offsets { kAuto, kAlways, kNever };
   Offsets fit_offsets = Offsets::kAuto;
   bool fit_drift = false;  // a drift too, wherever offsets are fitted
