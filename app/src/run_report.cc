@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "mbid/app/gnuplot.h"
+#include "mbid/identification/updating/result_io.h"
 
 namespace mbid::app {
 namespace {
@@ -287,6 +288,12 @@ std::string TunedParametersMarkdown(const updating::UpdateResult& result,
     out << "\n**The record leaves these parameters undetermined:** "
         << fmt::format("{}", fmt::join(result.undetermined, ", "))
         << " (their values above are not results).\n";
+  }
+  for (const updating::TestFit& fit : result.tests) {
+    const std::vector<std::string> lines = updating::DescribeBaseline(fit);
+    if (lines.empty()) continue;
+    out << "\nFitted baseline of the record (added to the re-simulation below): "
+        << fmt::format("{}", fmt::join(lines, "; ")) << ".\n";
   }
   for (const std::string& warning : result.warnings) out << "\n> " << warning << "\n";
   return out.str();
