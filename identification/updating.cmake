@@ -4,6 +4,7 @@
 # Paths from CMAKE_CURRENT_LIST_DIR: the file works wherever it is included from.
 set(MBID_UPDATING_DIR "${CMAKE_CURRENT_LIST_DIR}")
 add_library(mbid_updating
+  "${MBID_UPDATING_DIR}/src/updating/baseline.cc"
   "${MBID_UPDATING_DIR}/src/updating/characteristic.cc"
   "${MBID_UPDATING_DIR}/src/updating/output_error.cc"
   "${MBID_UPDATING_DIR}/src/updating/result_io.cc"

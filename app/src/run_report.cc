@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "mbid/app/gnuplot.h"
+#include "mbid/identification/updating/result_io.h"
 
 namespace mbid::app {
 namespace {
@@ -229,8 +230,12 @@ std::string DrawResimulationFigure(const std::string& folder, const Measurement&
   figure.y_label = fmt::format("{}, {}", name, fit.simulated.units[channel]);
   figure.series.push_back(
       {"record", measured.CalcTime(), measured.values.col(column), kRecordStyle});
-  figure.series.push_back({"re-simulation (tuned model)", fit.simulated.CalcTime(),
-                           fit.simulated.values.col(channel), "lines lw 1.5 lc rgb '#2ca02c'"});
+  // With a fitted baseline the re-simulation carries it (what the record is compared with).
+  const char* label = fit.drift.size() > 0    ? "re-simulation (tuned model + offset + drift)"
+                      : fit.offset.size() > 0 ? "re-simulation (tuned model + offset)"
+                                              : "re-simulation (tuned model)";
+  figure.series.push_back({label, fit.simulated.CalcTime(), fit.simulated.values.col(channel),
+                           "lines lw 1.5 lc rgb '#2ca02c'"});
   const std::string file = fmt::format("resimulation_{}.png", name);
   DrawFigure(figure, Path(folder, file));
   return file;
@@ -283,6 +288,12 @@ std::string TunedParametersMarkdown(const updating::UpdateResult& result,
     out << "\n**The record leaves these parameters undetermined:** "
         << fmt::format("{}", fmt::join(result.undetermined, ", "))
         << " (their values above are not results).\n";
+  }
+  for (const updating::TestFit& fit : result.tests) {
+    const std::vector<std::string> lines = updating::DescribeBaseline(fit);
+    if (lines.empty()) continue;
+    out << "\nFitted baseline of the record (added to the re-simulation below): "
+        << fmt::format("{}", fmt::join(lines, "; ")) << ".\n";
   }
   for (const std::string& warning : result.warnings) out << "\n> " << warning << "\n";
   return out.str();

@@ -8,6 +8,7 @@
 #include "mbid/app/updating_glue.h"
 #include "mbid/common/error.h"
 #include "mbid/identification/identify.h"
+#include "mbid/identification/updating/result_io.h"
 
 namespace mbid::app {
 
@@ -45,6 +46,7 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
     throw NumericalError("updating of test " + test.name,
                          test.tuned.termination_name() + ": " + test.tuned.message);
   }
+  for (const std::string& line : updating::DescribeBaseline(test.tuned.tests.front())) say(line);
   const updating::TestFit& fit = test.tuned.tests.front();
   const Eigen::VectorXd& k = fit.correlation;
   test.reasons.clear();

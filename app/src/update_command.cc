@@ -107,6 +107,7 @@ void PrintSummary(const updating::UpdateResult& result,
       std::cout << fmt::format("correlation K({}, {}) = {:.4f}\n", fit.name, fit.channels[c],
                                fit.correlation[static_cast<Eigen::Index>(c)]);
     }
+    for (const std::string& line : updating::DescribeBaseline(fit)) std::cout << line << "\n";
   }
 }
 

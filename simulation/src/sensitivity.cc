@@ -79,7 +79,8 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   }
   const std::vector<ChannelSource> sources = ResolveChannels(model, sensors.channels);
   const double tau = sensors.sample_interval_s();
-  const int samples = static_cast<int>(std::floor(options.duration_s / tau + 1e-9)) + 1;
+  const internal::SampleGrid grid = internal::MakeSampleGrid(options.duration_s, sensors);
+  const int samples = grid.count;
 
   SensitivityResult result;
   result.parameters = model_parameters;
@@ -134,6 +135,7 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   exact.channels = sensors.channels;
   for (const ChannelSource& source : sources) exact.units.push_back(source.units);
   exact.sample_interval_s = tau;
+  exact.start_time_s = grid.first_time_s();
   exact.source = "simulation";
   const int channel_count = static_cast<int>(sources.size());
   exact.values.resize(samples, channel_count);
@@ -153,8 +155,8 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   Eigen::MatrixXd dy_dY(simulated.output_count(), jacobian_columns);
   Eigen::MatrixXd dy_dp = Eigen::MatrixXd::Zero(simulated.output_count(), model_count);
   bool forcing_done = !(forcing_end_s > 0);
-  for (int j = 0; j < samples; ++j) {
-    const double t = j * tau;
+  for (int row = 0; row < grid.skipped + grid.count; ++row) {
+    const double t = grid.Time(row);
     if (!forcing_done && t >= forcing_end_s) {
       // Restart the multistep history at the kink of the load, sensitivities carried over.
       integrator.AdvanceTo(forcing_end_s, CvodesIntegrator::Realization::kNone);
@@ -166,7 +168,9 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
     }
     // Outputs realize what they need themselves (the crane's: nothing).
     const SimTK::State& state =
-        j == 0 ? integrator.state() : integrator.AdvanceTo(t, CvodesIntegrator::Realization::kNone);
+        t == 0 ? integrator.state() : integrator.AdvanceTo(t, CvodesIntegrator::Realization::kNone);
+    const int j = row - grid.skipped;
+    if (j < 0) continue;  // visited for the same steps as a record from t = 0
     const Eigen::VectorXd y = simulated.CalcOutputs(state);
     Eigen::VectorXd q(n);
     for (int i = 0; i < n; ++i) q[i] = state.getQ()[i];

@@ -25,8 +25,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   const std::vector<internal::ChannelSource> sources =
       internal::ResolveChannels(model, sensors.channels);
   const double tau = sensors.sample_interval_s();
-  // j = 0..s with s tau <= duration; the tolerance keeps 8 s at 100 Hz at 801 samples.
-  const int samples = static_cast<int>(std::floor(options.duration_s / tau + 1e-9)) + 1;
+  const internal::SampleGrid grid = internal::MakeSampleGrid(options.duration_s, sensors);
 
   SimulationResult result;
   result.initial_q = CalcInitialCoordinates(model, excitation);
@@ -52,13 +51,14 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   exact.channels = sensors.channels;
   for (const internal::ChannelSource& source : sources) exact.units.push_back(source.units);
   exact.sample_interval_s = tau;
+  exact.start_time_s = grid.first_time_s();
   exact.source = "simulation";
-  exact.values.resize(samples, static_cast<Eigen::Index>(sources.size()));
+  exact.values.resize(grid.count, static_cast<Eigen::Index>(sources.size()));
 
   bool forcing_done = !forced;
   IntegratorStatistics before_restart;
-  for (int j = 0; j < samples; ++j) {
-    const double t = j * tau;
+  for (int i = 0; i < grid.skipped + grid.count; ++i) {
+    const double t = grid.Time(i);
     if (!forcing_done && t >= result.forcing_end_s) {
       // Stop exactly where the forcing switches off (a kink in the load) and restart the
       // multistep history there.
@@ -69,7 +69,9 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
       integrator.Initialize(std::move(at_end));
       forcing_done = true;
     }
-    const SimTK::State& state = j == 0 ? integrator.state() : integrator.AdvanceTo(t, kUnrealized);
+    const SimTK::State& state = t == 0 ? integrator.state() : integrator.AdvanceTo(t, kUnrealized);
+    const int j = i - grid.skipped;
+    if (j < 0) continue;
     const Eigen::VectorXd y = simulated.CalcOutputs(state);
     for (size_t c = 0; c < sources.size(); ++c) {
       exact.values(j, static_cast<Eigen::Index>(c)) =

@@ -2,11 +2,35 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
 
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
 
 namespace mbid::simulation::internal {
+
+SampleGrid MakeSampleGrid(double duration_s, const SensorOptions& sensors) {
+  const double tau = sensors.sample_interval_s();
+  const double start = sensors.start_time_s;
+  if (!(start >= 0) || !std::isfinite(start) || start > duration_s) {
+    throw std::invalid_argument("sampling start time must lie in [0, duration]");
+  }
+  SampleGrid grid;
+  grid.tau = tau;
+  // j = 0..s with s tau <= duration; the tolerance keeps 8 s at 100 Hz at 801 samples.
+  const double k = std::round(start / tau);
+  if (std::abs(start / tau - k) <= kWholeSampleTolerance) {
+    const int total = static_cast<int>(std::floor(duration_s / tau + 1e-9)) + 1;
+    grid.skipped = static_cast<int>(k);
+    grid.count = total - grid.skipped;
+  } else {
+    grid.start_s = start;
+    grid.count = static_cast<int>(std::floor((duration_s - start) / tau + 1e-9)) + 1;
+  }
+  if (grid.count < 1) throw std::invalid_argument("no sample between the start and the duration");
+  return grid;
+}
 
 std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
                                            const std::vector<std::string>& channels) {

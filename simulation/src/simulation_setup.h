@@ -8,6 +8,7 @@
 
 #include "mbid/model/mechanical_model.h"
 #include "mbid/simulation/excitation.h"
+#include "mbid/simulation/sensor.h"
 
 namespace mbid::simulation::internal {
 
@@ -35,5 +36,22 @@ std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalM
 // the state `initial` of `model` has Y = [q | u], as every MechanicalModel's has.
 Eigen::MatrixXd CalcNewtonJacobian(const model::MechanicalModel& model,
                                    const SimTK::State& initial);
+
+// Where the samples of a simulation lie. Rows i = 0..skipped + count - 1 at Time(i); the first
+// `skipped` are visited (the integrator stops there as it would for a record from t = 0, so a
+// whole-sample start keeps the bits) but not kept.
+struct SampleGrid {
+  double tau = 0;
+  double start_s = 0;  // fractional start; 0 on the whole-sample grid
+  int skipped = 0;
+  int count = 0;
+
+  double Time(int i) const { return start_s + i * tau; }
+  double first_time_s() const { return Time(skipped); }
+};
+
+// The grid of `sensors` over [0, duration_s]; std::invalid_argument for a start that is negative,
+// not finite or after the duration.
+SampleGrid MakeSampleGrid(double duration_s, const SensorOptions& sensors);
 
 }  // namespace mbid::simulation::internal

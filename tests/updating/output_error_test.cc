@@ -320,8 +320,11 @@ TEST(OutputErrorTest, RejectsBadInput) {
   options.parameters = {{"c_theta"}};
   EXPECT_THROW(UpdateModel(*crane.model, {}, options), InputError);
   TestRecord shifted = test;
-  shifted.record.start_time_s = 0.005;  // half a sample after the excitation
+  shifted.record.start_time_s = -0.005;  // half a sample before the excitation
   EXPECT_THROW(UpdateModel(*crane.model, {shifted}, options), InputError);
+  TestRecord drift_alone = test;
+  drift_alone.fit_drift = true;  // a drift needs its offset
+  EXPECT_THROW(UpdateModel(*crane.model, {drift_alone}, options), InputError);
   TestRecord unknown_noise = test;
   unknown_noise.noise_std["gamma_dot"] = 1e-5;
   EXPECT_THROW(UpdateModel(*crane.model, {unknown_noise}, options), InputError);

@@ -46,6 +46,10 @@ UpdateResult MakeResult() {
   fit.simulated.units = {"rad", "rad"};
   fit.simulated.sample_interval_s = 0.01;
   fit.simulated.values = Eigen::MatrixXd::Random(5, 2) * 1e-3;
+  fit.offset = Eigen::Vector2d(2e-4, -1e-4);
+  fit.offset_std = Eigen::Vector2d(3e-6, kNaN);
+  fit.drift = Eigen::Vector2d(1e-5, 2e-5);
+  fit.drift_std = Eigen::Vector2d(4e-7, 5e-7);
   result.tests = {fit};
   result.simulations = 9;
   result.sensitivity_simulations = 8;
@@ -108,6 +112,25 @@ TEST(ResultIoTest, JsonFollowsTheContract) {
   EXPECT_EQ(json.at("algebraic").at("sets").size(), 2u);
   EXPECT_EQ(json.at("algebraic").at("sets")[1].at("reason"), "d_gamma = -1e+04 < 0");
   EXPECT_EQ(json.at("algebraic").at("sets")[0].at("c").at("theta"), 9.4e6);
+  // The fitted baseline per test and channel, with units; an undefined std is null.
+  const nlohmann::json& test = json.at("tests")[0];
+  EXPECT_EQ(test.at("offset").at("psi").at("value"), 2e-4);
+  EXPECT_EQ(test.at("offset").at("psi").at("std"), 3e-6);
+  EXPECT_EQ(test.at("offset").at("psi").at("units"), "rad");
+  EXPECT_TRUE(test.at("offset").at("phi").at("std").is_null());
+  EXPECT_EQ(test.at("drift").at("phi").at("value"), 2e-5);
+  EXPECT_EQ(test.at("drift").at("phi").at("units"), "rad/s");
+  // Absent when not fitted.
+  UpdateResult plain = MakeResult();
+  plain.tests[0].offset.resize(0);
+  plain.tests[0].drift.resize(0);
+  EXPECT_FALSE(UpdateResultToJson(plain).at("tests")[0].contains("offset"));
+  EXPECT_FALSE(UpdateResultToJson(plain).at("tests")[0].contains("drift"));
+  EXPECT_TRUE(DescribeBaseline(plain.tests[0]).empty());
+  const std::vector<std::string> lines = DescribeBaseline(MakeResult().tests[0]);
+  ASSERT_EQ(lines.size(), 4u);
+  EXPECT_EQ(lines[0], "offset(drop/1, psi) = 0.0002 +- 3e-06 rad");
+  EXPECT_EQ(lines[3], "drift(drop/1, phi) = 2e-05 +- 5e-07 rad/s");
   // Writable: JSON has no NaN, WriteJson would refuse one.
   const std::string path =
       (std::filesystem::temp_directory_path() / "mbid_update_result_test.json").string();
@@ -150,6 +173,11 @@ TEST(ResultIoTest, Hdf5GroupRoundTrips) {
   EXPECT_EQ(reader.ReadVector("/updating/history", "cost").size(), 2);
   EXPECT_EQ(reader.ReadScalar("/updating/correlation", "phi"), 0.99998);
   EXPECT_EQ(reader.ReadVector("/updating/tests/drop_1/simulated", "psi").size(), 5);
+  EXPECT_EQ(reader.ReadScalar("/updating/tests/drop_1/offset", "psi"), 2e-4);
+  EXPECT_EQ(reader.ReadScalar("/updating/tests/drop_1/offset_std", "psi"), 3e-6);
+  EXPECT_EQ(reader.ReadScalar("/updating/tests/drop_1/drift", "phi"), 2e-5);
+  EXPECT_EQ(reader.ReadUnits("/updating/tests/drop_1/drift", "phi"), "rad/s");
+  EXPECT_EQ(reader.ReadScalar("/updating/tests/drop_1/drift_std", "phi"), 5e-7);
   EXPECT_EQ(reader.ReadMatrix("/updating", "parameter_correlation").rows(), 3);
   EXPECT_EQ(reader.ReadStringAttribute("/updating/algebraic", "status"), "solved");
   EXPECT_EQ(reader.ReadMatrix("/updating/algebraic", "c")(0, 1), 9.4e6);

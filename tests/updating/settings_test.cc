@@ -216,5 +216,36 @@ TEST(SettingsTest, TestRecordTakesNoiseAndNuisanceSwitches) {
   EXPECT_FALSE(test.fit_initial_deflection);  // a load drop has no deflections to fit
 }
 
+TEST(SettingsTest, OffsetsAreFittedForImportedRecordsByDefault) {
+  const Crane crane = LoadCrane(testing::kReferenceScenario);
+  Measurement simulated = testing::SimulateExact(crane, 0.2, 50.0);
+  ASSERT_EQ(simulated.source, "simulation");
+  Measurement imported = simulated;
+  imported.source = "import";
+  // auto: imported records get offsets, mbid's own simulations not (existing results stay).
+  const UpdatingSettings defaults = Read("updating: {}", *crane.model);
+  EXPECT_EQ(defaults.fit_offsets, UpdatingSettings::Offsets::kAuto);
+  EXPECT_FALSE(defaults.fit_drift);
+  EXPECT_TRUE(MakeTestRecord("a", imported, crane.excitation, defaults).fit_offsets);
+  EXPECT_FALSE(MakeTestRecord("a", imported, crane.excitation, defaults).fit_drift);
+  EXPECT_FALSE(MakeTestRecord("a", simulated, crane.excitation, defaults).fit_offsets);
+  Measurement synthetic = simulated;  // mbid's synthetic_modes records: no zero error either
+  synthetic.source = "synthetic";
+  EXPECT_FALSE(MakeTestRecord("a", synthetic, crane.excitation, defaults).fit_offsets);
+  // The drift comes with the offsets, wherever they are fitted.
+  const UpdatingSettings drift = Read("updating: {fit_drift: true}", *crane.model);
+  EXPECT_TRUE(MakeTestRecord("a", imported, crane.excitation, drift).fit_drift);
+  EXPECT_FALSE(MakeTestRecord("a", simulated, crane.excitation, drift).fit_drift);
+  const UpdatingSettings always = Read("updating: {fit_offsets: true}", *crane.model);
+  EXPECT_TRUE(MakeTestRecord("a", simulated, crane.excitation, always).fit_offsets);
+  const UpdatingSettings never = Read("updating: {fit_offsets: false}", *crane.model);
+  EXPECT_FALSE(MakeTestRecord("a", imported, crane.excitation, never).fit_offsets);
+  EXPECT_NE(ErrorOf("updating: {fit_offsets: always}", *crane.model).find("one of auto"),
+            std::string::npos);
+  EXPECT_NE(
+      ErrorOf("updating: {fit_offsets: false, fit_drift: true}", *crane.model).find("fit_drift"),
+      std::string::npos);
+}
+
 }  // namespace
 }  // namespace mbid::updating

@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "baseline.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/simulation/sensitivity.h"
 #include "mbid/simulation/simulate.h"
@@ -48,13 +49,13 @@ struct Unknown {
   double ToValue(double x) const { return log_scale ? std::exp(x) : x; }
 };
 
-// A record prepared for the fit: where its samples sit in a simulation from t = 0.
+// A record prepared for the fit: a simulation sampled at the record's own times.
 struct PreparedTest {
   const TestRecord* test = nullptr;
-  int first_sample = 0;  // k0: the record's t0 / tau
   simulation::SimulationOptions simulation;
-  simulation::SensorOptions sensors;  // rate and channels only
-  Eigen::VectorXd sigma;              // weights in use, per channel
+  simulation::SensorOptions sensors;         // rate, start and channels only
+  std::shared_ptr<const Baseline> baseline;  // offsets (and drifts) eliminated, or 0 terms
+  Eigen::VectorXd sigma;                     // weights in use, per channel
   std::vector<bool> sigma_given;
   std::vector<int> unknowns;  // indices of the unknowns that act on this test
 };
@@ -132,11 +133,29 @@ class TestEvaluator {
         simulation::Simulate(model, excitation, test_.simulation, test_.sensors);
     ++work_.simulations;
     work_.Count(run.statistics);
+    CheckSamples(run.exact.values);
     Measurement simulated = run.exact;
-    simulated.values =
-        run.exact.values.middleRows(test_.first_sample, test_.test->record.samples());
     simulated.start_time_s = test_.test->record.start_time_s;
     return simulated;
+  }
+
+  // d(baseline coefficients)/dx of each channel at the last Jacobian's point `x`: rows
+  // terms * c .. terms * (c + 1) - 1 for channel c, one column per unknown; empty elsewhere.
+  Eigen::MatrixXd CalcBaselineRegression(const Eigen::VectorXd& x) const {
+    const Baseline& baseline = *test_.baseline;
+    const int m = test_.test->record.channel_count();
+    const int count = static_cast<int>(unknowns_.size());
+    if (baseline.terms() == 0 || jacobian_x_.size() != x.size() || jacobian_x_ != x) {
+      return Eigen::MatrixXd();
+    }
+    Eigen::MatrixXd regression(baseline.terms() * m, count);
+    for (int c = 0; c < m; ++c) {
+      // The Jacobian's rows are dy/dx / sigma_c.
+      regression.middleRows(baseline.terms() * c, baseline.terms()) =
+          test_.sigma[c] *
+          baseline.CalcRegression(unprojected_jacobian_.data() + c, m, residual_count(), count);
+    }
+    return regression;
   }
 
   // Forgets the cached evaluation (the weights changed).
@@ -168,27 +187,48 @@ class TestEvaluator {
     return excitation;
   }
 
+  void CheckSamples(const Eigen::MatrixXd& simulated) const {
+    if (simulated.rows() != test_.test->record.samples()) {
+      throw std::logic_error("the simulation has " + std::to_string(simulated.rows()) +
+                             " samples, the record " +
+                             std::to_string(test_.test->record.samples()));
+    }
+  }
+
   // (simulated - measured) / sigma, sample-major: r[j * m + c].
-  Eigen::VectorXd Weigh(const Eigen::MatrixXd& simulated_full) const {
+  Eigen::VectorXd Weigh(const Eigen::MatrixXd& simulated) const {
+    CheckSamples(simulated);
     const Measurement& record = test_.test->record;
     const int m = record.channel_count();
     Eigen::VectorXd r(residual_count());
     for (int j = 0; j < record.samples(); ++j) {
       for (int c = 0; c < m; ++c) {
-        r[j * m + c] =
-            (simulated_full(test_.first_sample + j, c) - record.values(j, c)) / test_.sigma[c];
+        r[j * m + c] = (simulated(j, c) - record.values(j, c)) / test_.sigma[c];
       }
     }
     return r;
   }
 
-  Eigen::VectorXd ComputeResiduals(model::MechanicalModel& model, const Eigen::VectorXd& x) {
+  // Each channel's part of `v` (sample-major) orthogonal to its baseline.
+  void Project(double* v) const {
+    const int m = test_.test->record.channel_count();
+    for (int c = 0; c < m; ++c) test_.baseline->Project(v + c, m);
+  }
+
+  // Residuals before the baseline's projection.
+  Eigen::VectorXd ComputeRawResiduals(model::MechanicalModel& model, const Eigen::VectorXd& x) {
     const Excitation excitation = Configure(model, x);
     const simulation::SimulationResult run =
         simulation::Simulate(model, excitation, test_.simulation, test_.sensors);
     ++work_.simulations;
     work_.Count(run.statistics);
     return Weigh(run.exact.values);
+  }
+
+  Eigen::VectorXd ComputeResiduals(model::MechanicalModel& model, const Eigen::VectorXd& x) {
+    Eigen::VectorXd r = ComputeRawResiduals(model, x);
+    Project(r.data());
+    return r;
   }
 
   void ComputeWithJacobian(const Eigen::VectorXd& x) {
@@ -199,6 +239,11 @@ class TestEvaluator {
     } else {
       ComputeSensitivityJacobian(x);
     }
+    if (test_.baseline->terms() == 0) return;
+    // Variable projection: the basis does not depend on x, so P J is the exact Jacobian of P r.
+    unprojected_jacobian_ = jacobian_;
+    Project(jacobian_residuals_.data());
+    for (int k = 0; k < columns; ++k) Project(jacobian_.col(k).data());
   }
 
   // Central differences of whole simulations in Ceres' coordinates; the columns run in
@@ -208,15 +253,15 @@ class TestEvaluator {
     std::vector<std::string> errors(static_cast<size_t>(groups));
     auto run_group = [&](int g) {
       try {
-        if (g == 0) jacobian_residuals_ = ComputeResiduals(*models_[0], x);
+        if (g == 0) jacobian_residuals_ = ComputeRawResiduals(*models_[0], x);
         for (size_t i = static_cast<size_t>(g); i < test_.unknowns.size();
              i += static_cast<size_t>(groups)) {
           const int k = test_.unknowns[i];
           Eigen::VectorXd step = x;
           step[k] = x[k] + options_.numeric_step;
-          const Eigen::VectorXd plus = ComputeResiduals(*models_[static_cast<size_t>(g)], step);
+          const Eigen::VectorXd plus = ComputeRawResiduals(*models_[static_cast<size_t>(g)], step);
           step[k] = x[k] - options_.numeric_step;
-          const Eigen::VectorXd minus = ComputeResiduals(*models_[static_cast<size_t>(g)], step);
+          const Eigen::VectorXd minus = ComputeRawResiduals(*models_[static_cast<size_t>(g)], step);
           jacobian_.col(k) = (plus - minus) / (2 * options_.numeric_step);
         }
       } catch (const std::exception& e) {
@@ -263,6 +308,7 @@ class TestEvaluator {
         ++work_.sensitivity_simulations;
         work_.Count(run.statistics);
         if (g == 0) jacobian_residuals_ = Weigh(run.exact.values);
+        CheckSamples(run.exact.values);
         for (size_t i = 0; i < columns.size(); ++i) {
           const int k = columns[i];
           const Unknown& unknown = unknowns_[static_cast<size_t>(k)];
@@ -271,7 +317,7 @@ class TestEvaluator {
           const Eigen::MatrixXd& dy = run.output_sensitivities[i];
           for (int j = 0; j < record.samples(); ++j) {
             for (int c = 0; c < m; ++c) {
-              jacobian_(j * m + c, k) = dy(test_.first_sample + j, c) * dp_dx / test_.sigma[c];
+              jacobian_(j * m + c, k) = dy(j, c) * dp_dx / test_.sigma[c];
             }
           }
         }
@@ -331,7 +377,8 @@ class TestEvaluator {
   Eigen::VectorXd jacobian_x_;  // where jacobian_ and jacobian_residuals_ were computed
   Eigen::VectorXd jacobian_residuals_;
   Eigen::MatrixXd jacobian_;
-  Eigen::VectorXd residual_x_;  // the last residual-only evaluation
+  Eigen::MatrixXd unprojected_jacobian_;  // with a baseline: before the projection
+  Eigen::VectorXd residual_x_;            // the last residual-only evaluation
   Eigen::VectorXd residuals_;
 };
 
@@ -480,12 +527,9 @@ PreparedTest PrepareTest(const model::MechanicalModel& model, const TestRecord& 
   PreparedTest prepared;
   prepared.test = &test;
   const double tau = record.sample_interval_s;
-  const double offset = record.start_time_s / tau;
-  prepared.first_sample = static_cast<int>(std::lround(offset));
-  if (prepared.first_sample < 0 || std::abs(offset - prepared.first_sample) > 1e-6) {
-    throw InputError(test.name, "start time",
-                     Format(record.start_time_s) + " s with sample interval " + Format(tau) + " s",
-                     "a record starting a whole number (>= 0) of samples after the excitation");
+  if (!(record.start_time_s >= 0)) {
+    throw InputError(test.name, "start time", Format(record.start_time_s) + " s",
+                     "a record starting at or after the excitation's t = 0 (the release)");
   }
   std::vector<std::string> known = model.output_names();
   known.insert(known.end(), model.coordinate_names().begin(), model.coordinate_names().end());
@@ -495,10 +539,28 @@ PreparedTest PrepareTest(const model::MechanicalModel& model, const TestRecord& 
                        "outputs or coordinates of the model");
     }
   }
-  prepared.simulation.duration_s = (prepared.first_sample + record.samples() - 1) * tau;
+  // The simulation samples at the record's times. A start on the whole-sample grid k tau is
+  // sampled as (k + j) tau, bit for bit the rows of a simulation from t = 0 (the duration
+  // computed the same way keeps the count); other starts at t0 + j tau.
+  const double grid_index = std::round(record.start_time_s / tau);
+  const bool whole =
+      std::abs(record.start_time_s / tau - grid_index) <= simulation::kWholeSampleTolerance;
+  prepared.simulation.duration_s = whole ? (grid_index + record.samples() - 1) * tau
+                                         : record.start_time_s + (record.samples() - 1) * tau;
   prepared.simulation.integrator = options.integrator;
   prepared.sensors.sample_rate_hz = 1.0 / tau;
+  prepared.sensors.start_time_s = record.start_time_s;
   prepared.sensors.channels = record.channels;
+  if (test.fit_drift && !test.fit_offsets) {
+    throw InputError(test.name, "fit_drift", "a drift without an offset",
+                     "fit_offsets together with fit_drift");
+  }
+  const int terms = test.fit_offsets ? (test.fit_drift ? 2 : 1) : 0;
+  if (record.samples() <= terms) {
+    throw InputError(test.name, "samples", std::to_string(record.samples()) + " samples",
+                     "more samples than baseline terms per channel");
+  }
+  prepared.baseline = std::make_shared<const Baseline>(record.CalcTime(), terms);
   const int m = record.channel_count();
   for (const auto& [channel, value] : test.noise_std) {
     if (record.FindChannel(channel) < 0) {
@@ -530,6 +592,47 @@ PreparedTest PrepareTest(const model::MechanicalModel& model, const TestRecord& 
     }
   }
   return prepared;
+}
+
+// The baseline of `test` fitted to the difference of record and `fit.simulated` (the model's
+// re-simulation), added to it, with standard deviations from the block inverse of the full
+// problem: Cov(a) = sigma^2 (B^T B)^-1 + G Cov(x) G^T, G = da/dx (`regression`).
+void AddBaseline(const PreparedTest& test, const Eigen::MatrixXd& regression,
+                 const Eigen::MatrixXd& covariance, TestFit& fit) {
+  const Baseline& baseline = *test.baseline;
+  const Measurement& record = test.test->record;
+  const int m = record.channel_count();
+  const int terms = baseline.terms();
+  fit.offset = fit.offset_std = Eigen::VectorXd::Constant(m, kNaN);
+  if (terms == 2) fit.drift = fit.drift_std = Eigen::VectorXd::Constant(m, kNaN);
+  const Eigen::MatrixXd inverse_gram = baseline.CalcInverseGram();
+  for (int c = 0; c < m; ++c) {
+    const Eigen::VectorXd difference = record.values.col(c) - fit.simulated.values.col(c);
+    const Eigen::VectorXd a = baseline.Fit(difference.data(), 1);
+    fit.simulated.values.col(c) += baseline.Evaluate(a);
+    Eigen::MatrixXd cov = test.sigma[c] * test.sigma[c] * inverse_gram;
+    if (regression.rows() == terms * m) {
+      // Only the unknowns acting on this test move its baseline (0 * NaN would spoil it).
+      const int acting = static_cast<int>(test.unknowns.size());
+      Eigen::MatrixXd g(terms, acting), sub(acting, acting);
+      for (int i = 0; i < acting; ++i) {
+        g.col(i) = regression.block(terms * c, test.unknowns[static_cast<size_t>(i)], terms, 1);
+        for (int j = 0; j < acting; ++j) {
+          sub(i, j) = covariance(test.unknowns[static_cast<size_t>(i)],
+                                 test.unknowns[static_cast<size_t>(j)]);
+        }
+      }
+      cov += g * sub * g.transpose();
+    } else {
+      cov.setConstant(kNaN);
+    }
+    fit.offset[c] = a[0];
+    fit.offset_std[c] = cov(0, 0) >= 0 ? std::sqrt(cov(0, 0)) : kNaN;
+    if (terms == 2) {
+      fit.drift[c] = a[1];
+      fit.drift_std[c] = cov(1, 1) >= 0 ? std::sqrt(cov(1, 1)) : kNaN;
+    }
+  }
 }
 
 UpdateResult::Termination ToTermination(ceres::TerminationType type) {
@@ -690,8 +793,8 @@ UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestReco
         summary.termination_type == ceres::USER_FAILURE) {
       break;
     }
-    // Noise from the residual at this fit: sigma_c^2 = SS_c / (N_c - P N_c / N), the
-    // parameters' degrees of freedom shared out by sample count.
+    // Noise from the residual at this fit: sigma_c^2 = SS_c / (N_c - B - P N_c / N), the
+    // parameters' degrees of freedom shared out by sample count, B the channel's baseline terms.
     long total = 0;
     for (const PreparedTest& test : prepared)
       total += test.test->record.samples() * test.test->record.channel_count();
@@ -701,9 +804,12 @@ UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestReco
       const Measurement& record = test.test->record;
       for (int c = 0; c < record.channel_count(); ++c) {
         if (test.sigma_given[static_cast<size_t>(c)]) continue;
-        const double squares = (simulated.values.col(c) - record.values.col(c)).squaredNorm();
+        Eigen::VectorXd difference = simulated.values.col(c) - record.values.col(c);
+        test.baseline->Project(difference.data(), 1);
+        const double squares = difference.squaredNorm();
         const double samples = record.samples();
-        const double dof = std::max(1.0, samples - count * samples / static_cast<double>(total));
+        const double dof = std::max(
+            1.0, samples - test.baseline->terms() - count * samples / static_cast<double>(total));
         test.sigma[c] = std::max(std::sqrt(squares / dof), 1e-300);
       }
     }
@@ -727,6 +833,9 @@ UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestReco
   ceres::CRSMatrix crs;
   ceres::Problem::EvaluateOptions evaluate;
   const bool have_jacobian = problem.Evaluate(evaluate, nullptr, &residuals, nullptr, &crs);
+  // How each test's baseline moves with the unknowns, from the Jacobians just evaluated at x.
+  std::vector<Eigen::MatrixXd> regressions;
+  for (auto& evaluator : evaluators) regressions.push_back(evaluator->CalcBaselineRegression(x));
   Eigen::MatrixXd covariance = Eigen::MatrixXd::Constant(count, count, kNaN);
   if (have_jacobian) {
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
@@ -836,6 +945,7 @@ UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestReco
     for (bool given : test.sigma_given) fit.noise_estimated.push_back(!given);
     try {
       fit.simulated = evaluators[t]->Simulate(x);
+      if (test.baseline->terms() > 0) AddBaseline(test, regressions[t], covariance, fit);
       fit.residual_rms.resize(record.channel_count());
       fit.correlation.resize(record.channel_count());
       for (int c = 0; c < record.channel_count(); ++c) {
@@ -909,8 +1019,8 @@ UpdateResult UpdateModel(const model::MechanicalModel& model, const std::vector<
   for (double fraction : options.continuation_fractions) {
     std::vector<TestRecord> window = current;
     for (TestRecord& test : window) {
-      const int samples =
-          std::max(2, static_cast<int>(std::ceil(fraction * test.record.samples())));
+      const int samples = std::max(test.fit_drift ? 3 : 2,
+                                   static_cast<int>(std::ceil(fraction * test.record.samples())));
       test.record.values = test.record.values.topRows(samples).eval();
     }
     std::ostringstream label;

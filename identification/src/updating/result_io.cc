@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <sstream>
+#include <tuple>
 
 #include "mbid/model/linear_model.h"
 
@@ -42,7 +44,40 @@ std::map<std::string, double> WorstCorrelation(const UpdateResult& result) {
   return worst;
 }
 
+// {"<channel>": {"value", "std", "units"}} of a fitted baseline term.
+nlohmann::json BaselineTerm(const TestFit& test, const Eigen::VectorXd& value,
+                            const Eigen::VectorXd& deviation, const std::string& per) {
+  nlohmann::json json = nlohmann::json::object();
+  for (size_t c = 0; c < test.channels.size() && static_cast<Eigen::Index>(c) < value.size(); ++c) {
+    const Eigen::Index i = static_cast<Eigen::Index>(c);
+    const std::string units = c < test.simulated.units.size() ? test.simulated.units[c] : "";
+    json[test.channels[c]] = {
+        {"value", Number(value[i])}, {"std", Number(deviation[i])}, {"units", units + per}};
+  }
+  return json;
+}
+
 }  // namespace
+
+std::vector<std::string> DescribeBaseline(const TestFit& test) {
+  std::vector<std::string> lines;
+  for (const auto& [name, value, deviation, per] :
+       {std::tuple<const char*, const Eigen::VectorXd*, const Eigen::VectorXd*, const char*>{
+            "offset", &test.offset, &test.offset_std, ""},
+        {"drift", &test.drift, &test.drift_std, "/s"}}) {
+    for (size_t c = 0; c < test.channels.size() && static_cast<Eigen::Index>(c) < value->size();
+         ++c) {
+      const Eigen::Index i = static_cast<Eigen::Index>(c);
+      const std::string units = c < test.simulated.units.size() ? test.simulated.units[c] : "";
+      std::ostringstream line;
+      line.precision(4);
+      line << name << "(" << test.name << ", " << test.channels[c] << ") = " << (*value)[i]
+           << " +- " << (*deviation)[i] << " " << units << per;
+      lines.push_back(line.str());
+    }
+  }
+  return lines;
+}
 
 nlohmann::json CharacteristicResultToJson(const CharacteristicResult& result) {
   nlohmann::json json;
@@ -138,11 +173,17 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
     for (size_t c = 0; c < test.channels.size() && c < test.noise_estimated.size(); ++c) {
       estimated[test.channels[c]] = static_cast<bool>(test.noise_estimated[c]);
     }
-    json["tests"].push_back({{"name", test.name},
-                             {"correlation", PerName(test.channels, test.correlation)},
-                             {"noise_std", PerName(test.channels, test.noise_std)},
-                             {"noise_estimated", estimated},
-                             {"residual_rms", PerName(test.channels, test.residual_rms)}});
+    nlohmann::json entry = {{"name", test.name},
+                            {"correlation", PerName(test.channels, test.correlation)},
+                            {"noise_std", PerName(test.channels, test.noise_std)},
+                            {"noise_estimated", estimated},
+                            {"residual_rms", PerName(test.channels, test.residual_rms)}};
+    if (test.offset.size() > 0) {
+      entry["offset"] = BaselineTerm(test, test.offset, test.offset_std, "");
+    }
+    if (test.drift.size() > 0)
+      entry["drift"] = BaselineTerm(test, test.drift, test.drift_std, "/s");
+    json["tests"].push_back(entry);
   }
   json["history"] = nlohmann::json::array();
   for (const IterationRecord& record : result.history) {
@@ -273,6 +314,14 @@ void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,
       }
       if (test.residual_rms.size() > column) {
         file.WriteScalar(group + "/residual_rms", channel, test.residual_rms[column], units);
+      }
+      if (test.offset.size() > column) {
+        file.WriteScalar(group + "/offset", channel, test.offset[column], units);
+        file.WriteScalar(group + "/offset_std", channel, test.offset_std[column], units);
+      }
+      if (test.drift.size() > column) {
+        file.WriteScalar(group + "/drift", channel, test.drift[column], units + "/s");
+        file.WriteScalar(group + "/drift_std", channel, test.drift_std[column], units + "/s");
       }
     }
   }

@@ -102,6 +102,8 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
                                 "numeric_step",
                                 "fit_payload_mass",
                                 "fit_initial_deflection",
+                                "fit_offsets",
+                                "fit_drift",
                                 "max_iterations",
                                 "function_tolerance",
                                 "gradient_tolerance",
@@ -191,6 +193,15 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
   }
   settings.fit_payload_mass = node.Bool("fit_payload_mass", false);
   settings.fit_initial_deflection = node.Bool("fit_initial_deflection", false);
+  const std::string offsets = node.Choice("fit_offsets", {"auto", "true", "false"}, "auto");
+  settings.fit_offsets = offsets == "auto"   ? UpdatingSettings::Offsets::kAuto
+                         : offsets == "true" ? UpdatingSettings::Offsets::kAlways
+                                             : UpdatingSettings::Offsets::kNever;
+  settings.fit_drift = node.Bool("fit_drift", false);
+  if (settings.fit_drift && settings.fit_offsets == UpdatingSettings::Offsets::kNever) {
+    node.FailAt("fit_drift", "a drift with fit_offsets: false",
+                "fit_offsets auto or true with fit_drift (a drift comes with an offset)");
+  }
   options.max_iterations = node.Int("max_iterations", options.max_iterations);
   options.function_tolerance =
       node.PositiveDouble("function_tolerance", options.function_tolerance);
@@ -316,6 +327,20 @@ TestRecord MakeTestRecord(const std::string& name, const Measurement& record,
       settings.fit_payload_mass && excitation.type == simulation::Excitation::Type::kLoadDrop;
   test.fit_initial_deflection = settings.fit_initial_deflection &&
                                 excitation.type == simulation::Excitation::Type::kInitialDeflection;
+  switch (settings.fit_offsets) {
+    case UpdatingSettings::Offsets::kAuto:
+      // mbid's own records (simulated, or synthetic modes) have no zero error unless a sensor
+      // bias was asked for.
+      test.fit_offsets = record.source != "simulation" && record.source != "synthetic";
+      break;
+    case UpdatingSettings::Offsets::kAlways:
+      test.fit_offsets = true;
+      break;
+    case UpdatingSettings::Offsets::kNever:
+      test.fit_offsets = false;
+      break;
+  }
+  test.fit_drift = settings.fit_drift && test.fit_offsets;
   return test;
 }
 

@@ -14,6 +14,11 @@ namespace mbid::simulation {
 // Every random draw comes from `seed`: the same options give the same bits.
 struct SensorOptions {
   double sample_rate_hz = 100.0;
+  // Time of the first sample after the excitation's t = 0 (s, >= 0): a record cut at a release
+  // between two samples. Samples t_j = start + j tau up to the duration. A start within 1e-6
+  // tau of a whole k tau samples at (k + j) tau: the rows of a record from 0 from row k on,
+  // bit for bit.
+  double start_time_s = 0.0;
   std::vector<std::string> channels{"psi", "phi"};
   std::map<std::string, double> noise_std;          // per channel; absent = 0
   std::map<std::string, double> bias;               // per channel; absent = 0
@@ -22,6 +27,10 @@ struct SensorOptions {
 
   double sample_interval_s() const { return 1.0 / sample_rate_hz; }
 };
+
+// A sampling start within this many sample intervals of a whole k tau counts as k tau (the
+// tolerance of a record's time column, kTimeUniformityTolerance).
+inline constexpr double kWholeSampleTolerance = kTimeUniformityTolerance;
 
 // measured = Q(clean + bias + noise), with Q rounding to the nearest multiple of the step.
 // Noise is drawn channel by channel, sample by sample, from a 64-bit Mersenne twister seeded

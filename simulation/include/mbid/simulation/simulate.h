@@ -29,7 +29,8 @@ struct SimulationResult {
 
 // Simulates a test: the initial state of `excitation`, CVODES integration of the model's
 // Simbody system, outputs (and coordinates, if asked as channels) sampled exactly at
-// t_j = j / sample_rate, j = 0..floor(duration * rate). While a forcing acts the integrator stops
+// t_j = start + j / sample_rate up to the duration (start = sensors.start_time_s, 0 by default;
+// the result's start_time_s). While a forcing acts the integrator stops
 // at each sample time and at the forcing's end; the free decay after it uses dense output when
 // options.integrator.interpolate_outputs (the default) is set. CVODES failures propagate as
 // NumericalError("CVODES", reason).

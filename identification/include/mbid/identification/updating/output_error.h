@@ -19,7 +19,8 @@ namespace mbid::updating {
 // over the selected parameters p (shared joint parameters c_<joint>, d_<joint>; optionally
 // nuisance parameters of each test), where y(t; p) is the model simulated for the test's
 // excitation. The Jacobian comes from CVODES forward sensitivities (default) or from central
-// differences of whole simulations.
+// differences of whole simulations. A test with fit_offsets adds o_c (+ g_c t) to y_c, the
+// best o, g for every p: the cost is minimized over p and the baselines at once.
 
 // A parameter to tune: a model parameter ("c_alpha", "d_theta", ...).
 struct ParameterSetting {
@@ -35,7 +36,8 @@ struct ParameterSetting {
 };
 
 // One test: a record and the excitation that produced it. Its first sample is at
-// record.start_time_s, a whole number of sample intervals after the excitation's t = 0.
+// record.start_time_s >= 0 after the excitation's t = 0 (the release): a whole number of sample
+// intervals, or any fraction of one (the simulation then samples at the record's own times).
 struct TestRecord {
   std::string name;  // e.g. the file name; names nuisance parameters "<name>:payload_mass_kg"
   Measurement record;
@@ -48,6 +50,11 @@ struct TestRecord {
   // initial_deflection test ("<name>:deflection_<coordinate>", rad, linear scale).
   bool fit_payload_mass = false;
   bool fit_initial_deflection = false;
+  // Nuisance baseline per channel, eliminated by variable projection (not among the
+  // parameters): record = simulation + offset (+ drift t). Sensor zero errors and slow drift of
+  // field records; fit_drift needs fit_offsets.
+  bool fit_offsets = false;
+  bool fit_drift = false;
 };
 
 struct UpdateOptions {
@@ -147,7 +154,14 @@ struct TestFit {
   std::vector<bool> noise_estimated;
   Eigen::VectorXd residual_rms;  // per channel, channel units
   Eigen::VectorXd correlation;   // per channel: Pearson's K of record and re-simulation
-  Measurement simulated;         // re-simulation with the tuned values, record's samples
+  // Re-simulation with the tuned values at the record's samples, the fitted offsets and drifts
+  // added: what the record is compared with (residual_rms, correlation).
+  Measurement simulated;
+  // The fitted baseline per channel (empty when not fitted): offset at the excitation's t = 0
+  // (channel units) and drift (channel units per s), with standard deviations that include the
+  // parameters' uncertainty.
+  Eigen::VectorXd offset, offset_std;
+  Eigen::VectorXd drift, drift_std;
 };
 
 struct UpdateResult {
@@ -188,7 +202,7 @@ struct UpdateResult {
 
 // Tunes the parameters of `model` (left unchanged) to the tests. Throws InputError for unknown
 // parameters, bounds that do not bracket the start, records whose channels the model lacks,
-// records not on the simulation's sample grid; a failing simulation inside the fit is a
+// records starting before the excitation; a failing simulation inside the fit is a
 // Termination::kFailure result, not an exception.
 UpdateResult UpdateModel(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
                          const UpdateOptions& options);

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "mbid/common/hdf5_io.h"
 #include "mbid/identification/updating/characteristic.h"
@@ -16,13 +17,18 @@ namespace mbid::updating {
 // with the contract's optional extensions: per parameter "relative_std", "determined",
 // "at_bound" and, for nuisance parameters, "test"; top level "message", "jacobian",
 // "undetermined", "rank", "singular_values", "parameter_correlation" {"names", "matrix"},
-// "warnings", "tests" (per record: correlation, noise_std, noise_estimated, residual_rms),
+// "warnings", "tests" (per record: correlation, noise_std, noise_estimated, residual_rms and,
+// when fitted, "offset" and "drift": {"<channel>": {"value", "std", "units"}}),
 // "history" (per iteration: iteration, cost, step_norm, gradient_max_norm, successful),
 // "work" (simulations, sensitivity_simulations, rhs_evaluations, wall_time_s) and, when given,
 // "algebraic" (CharacteristicResultToJson). "correlation" is the smallest K of a channel over
 // the records. Undefined numbers (a std the records do not determine) are null.
 nlohmann::json UpdateResultToJson(const UpdateResult& result,
                                   const CharacteristicResult* algebraic = nullptr);
+
+// One console line per fitted baseline term of `test`:
+//   "offset(<test>, <channel>) = <value> +- <std> <units>", then the drifts in <units>/s.
+std::vector<std::string> DescribeBaseline(const TestFit& test);
 
 // Route 1 (eqs. 6-8): {"status", "message", "starts", "converged_starts", "best_residual",
 // "chosen", "ambiguous", "poles": [{"re", "im", "frequency_hz", "decay_rate_per_s"}], "sets":
@@ -39,8 +45,9 @@ nlohmann::json CharacteristicResultToJson(const CharacteristicResult& result);
 //   parameters/<name>/{value, initial, lower, upper, std, relative_std} with units,
 //   correlation/<channel>, history/{iteration, cost, step_norm, gradient_max_norm, successful},
 //   tests/<test>/{simulated/<channel>, noise_std/<channel>, correlation/<channel>,
-//   residual_rms/<channel>}, work/{simulations, sensitivity_simulations, rhs_evaluations,
-//   wall_time_s}
+//   residual_rms/<channel>, offset/<channel>, offset_std/<channel>, drift/<channel>,
+//   drift_std/<channel> (the last four when fitted)}, work/{simulations, sensitivity_simulations,
+//   rhs_evaluations, wall_time_s}
 // and, when given, /updating/algebraic (WriteCharacteristicGroup). '/' in names becomes '_'.
 // `root` other than /updating: a further test's result in the same layout.
 void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,

@@ -31,6 +31,9 @@ namespace mbid::updating {
 //                                          #   else estimated from a first fit
 //     fit_payload_mass: false              # nuisance: each load drop's payload mass
 //     fit_initial_deflection: false        # nuisance: each initial_deflection test's angles
+//     fit_offsets: auto                    # auto | true | false: a constant offset per test and
+//                                          #   channel (auto: records not made by mbid)
+//     fit_drift: false                     # also a linear drift (with the offsets)
 //     max_iterations: 50
 //     function_tolerance: 1.0e-6           # Ceres: relative cost decrease
 //     gradient_tolerance: 1.0e-10
@@ -71,6 +74,11 @@ struct UpdatingSettings {
   std::map<std::string, double> noise_std;  // per channel; empty: not given
   bool fit_payload_mass = false;
   bool fit_initial_deflection = false;
+  // Offsets per channel: kAuto fits them for imported records (Measurement::source other than
+  // "simulation" and "synthetic"), not for records mbid made itself (no zero error to fit).
+  enum class Offsets { kAuto, kAlways, kNever };
+  Offsets fit_offsets = Offsets::kAuto;
+  bool fit_drift = false;  // a drift too, wherever offsets are fitted
 };
 
 // The defaults: every parameter of `model`, the scenario's integrator with outputs interpolated.
@@ -96,7 +104,8 @@ std::vector<std::string> MarkAlgebraicAmbiguity(const CharacteristicResult& alge
                                                 UpdateResult& result,
                                                 double relative_difference = 0.1);
 
-// A test record with the settings' noise levels and nuisance switches.
+// A test record with the settings' noise levels and nuisance switches (fit_offsets resolved
+// for this record).
 TestRecord MakeTestRecord(const std::string& name, const Measurement& record,
                           const simulation::Excitation& excitation,
                           const UpdatingSettings& settings);
