@@ -30,7 +30,8 @@ std::string OutputList(const model::MechanicalModel& model) {
 RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
                      const std::string& scenario_dir, const model::MechanicalModel& model) {
   if (!entry.IsMap()) entry.Fail("not a mapping", "{file: PATH} or {synthetic_modes: {...}}");
-  std::vector<std::string> keys = {"name", "file", "synthetic_modes", "excitation"};
+  std::vector<std::string> keys = {"name",       "file",    "synthetic_modes",
+                                   "excitation", "release", "release_time_s"};
   keys.insert(keys.end(), ImportKeys().begin(), ImportKeys().end());
   entry.ExpectMap(keys);
   RecordSource source;
@@ -57,6 +58,7 @@ RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
       entry.FailAt("file", "'" + source.file + "' does not exist", "a readable measurement file");
     }
     source.import = ReadImportOptions(entry);
+    source.release = ReadReleaseChoice(entry);
     if (entry.Has("excitation")) {
       source.excitation = simulation::ReadExcitation(entry.Child("excitation"), model);
       source.excitation_origin = "record entry";
@@ -66,7 +68,9 @@ RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
       entry.FailAt("excitation", "given for synthetic_modes",
                    "an excitation only with file: PATH (synthetic modes have none)");
     }
-    for (const std::string& key : ImportKeys()) {
+    std::vector<std::string> file_keys = ImportKeys();
+    file_keys.insert(file_keys.end(), {"release", "release_time_s"});
+    for (const std::string& key : file_keys) {
       if (entry.Has(key))
         entry.FailAt(key, "given for synthetic_modes", "import keys only with file: PATH");
     }

@@ -86,6 +86,15 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
       progress.Say(fmt::format("test {}: excitation {} from {}", test.name,
                                test.excitation->type_name(), loaded.excitation_origin));
     }
+    if (!source.synthetic) {
+      test.release = CutRecordAtRelease(&test.measured, test.origin,
+                                        OverrideRelease(source.release, overrides),
+                                        test.excitation ? *test.excitation : excitation);
+      progress.Say(
+          fmt::format("test {}: free decay from {:.6g} s of the record ({}); that is "
+                      "t = 0 of the test",
+                      test.name, test.release->release_time_s, test.release->how));
+    }
     progress.Say(fmt::format("test {}: {} ({} samples x {} channels)", test.name, test.origin,
                              test.measured.samples(), test.measured.channel_count()));
     tests.push_back(std::move(test));
@@ -292,6 +301,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   }
   summary["model"] = LinearModelToJson(linear, exact_modes);
   summary["identification"] = identification::ModalResultToJson(first.identified);
+  if (first.release) summary["release"] = first.release->ToJson();
   summary["updating"] = updating::UpdateResultToJson(first.tuned, first.algebraic.get());
   if (!scenario.records.empty()) {
     nlohmann::json list = nlohmann::json::array();
@@ -305,6 +315,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
                       {"updating", updating::UpdateResultToJson(test.tuned, test.algebraic.get())},
                       {"validation", TestValidationJson(test, threshold)}});
       if (test.import) list.back()["import"] = ImportReportToJson(*test.import);
+      if (test.release) list.back()["release"] = test.release->ToJson();
       const updating::TestFit& fit = test.tuned.tests.front();
       for (size_t c = 0; c < fit.channels.size(); ++c) {
         const double k = fit.correlation[static_cast<Eigen::Index>(c)];

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "mbid/app/release_cut.h"
 #include "mbid/common/measurement.h"
 #include "mbid/identification/modal_result.h"
 #include "mbid/identification/options.h"
@@ -28,6 +29,7 @@ struct RunTest {
   std::optional<records::ImportReport> import;  // what reading the record's file did
   // The test's own excitation (record_source.h); unset: the scenario's.
   std::optional<simulation::Excitation> excitation;
+  std::optional<AppliedRelease> release;  // where a recorded test was cut (release_cut.h)
   std::optional<simulation::SimulationResult> simulation;  // a simulated test's integration
   identification::ModalResult identified;
   std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, if it ran

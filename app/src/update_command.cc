@@ -45,6 +45,7 @@ struct LoadedTest {
   std::string excitation_source;  // "scenario" or the file whose /scenario gave it
   identification::ModalResult identified;
   records::ImportReport import;
+  AppliedRelease release;
 };
 
 LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
@@ -68,6 +69,9 @@ LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
   }
   test.excitation = source->RequireExcitation();
   test.excitation_source = source == &scenario ? "scenario" : path;
+  // The simulation of the test starts at the release: the record is cut there.
+  test.release =
+      CutRecordAtRelease(&test.record, path, OverrideRelease({}, overrides), test.excitation);
 
   test.identified = identification::Identify(
       test.record, FreeDecayOptions(identification_options, test.excitation), path);
@@ -129,6 +133,9 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     if (!common.quiet) {
       const LoadedTest& test = tests.back();
       std::cerr << fmt::format("mbid: {}: {}\n", path, DescribeImport(test.import));
+      std::cerr << fmt::format(
+          "mbid: {}: free decay from {:.6g} s of the record ({}); t = 0 there\n", path,
+          test.release.release_time_s, test.release.how);
       std::cerr << fmt::format("mbid: {}: {} samples x {} channels, {} ({}), {} modes identified\n",
                                path, test.record.samples(), test.record.channel_count(),
                                test.excitation.type_name(), test.excitation_source,
@@ -164,10 +171,14 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   nlohmann::json summary = updating::UpdateResultToJson(result, algebraic.get());
   summary["start"] = start;
   summary["import"] = nlohmann::json::array();
+  summary["release"] = nlohmann::json::array();
   for (const LoadedTest& test : tests) {
     nlohmann::json item = ImportReportToJson(test.import);
     item["file"] = test.path;
     summary["import"].push_back(item);
+    nlohmann::json release = test.release.ToJson();
+    release["file"] = test.path;
+    summary["release"].push_back(release);
   }
   if (!note.empty()) summary["start_note"] = note;
   // A failed fit leaves no output file (interfaces.md); standard output still gets its JSON.

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "mbid/app/record_import.h"
+#include "mbid/app/release_cut.h"
 #include "mbid/common/measurement.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/mechanical_model.h"
@@ -25,6 +26,7 @@ struct RecordSource {
   // wrote, the excitation of the scenario stored in it; unset: the scenario's excitation.
   std::optional<simulation::Excitation> excitation;
   std::string excitation_origin;  // "record entry", "<file>:/scenario"
+  ReleaseChoice release;          // the entry's release / release_time_s
 };
 
 // Reads the section strictly; `scenario_dir` resolves relative file names. Channels of synthetic
