@@ -1,6 +1,7 @@
 #include "mbid/app/release_cut.h"
 
 #include "mbid/common/error.h"
+#include "mbid/identification/identify.h"
 #include "mbid/identification/release.h"
 
 namespace mbid::app {
@@ -49,6 +50,18 @@ AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin
     applied.how = detection.detected ? "detected" : "record start";
     applied.release_time_s = detection.release_time_s;
     if (!detection.detected) return applied;
+    if (detection.from_rest) {
+      // The identified decay places a release from rest to a fraction of a sample: the test's
+      // simulation starts there, and a sample's error is a phase error of every mode.
+      identification::IdentificationOptions options;
+      options.compute_spectrum = false;
+      options.compute_stabilization = false;
+      try {
+        applied.release_time_s = identification::Identify(*record, options, origin).release_time_s;
+      } catch (const NumericalError&) {
+        // No modes to refine with: the onset fit's instant stands (identification will say why).
+      }
+    }
   }
   *record = identification::CutAtRelease(*record, applied.release_time_s, origin);
   return applied;

@@ -444,7 +444,9 @@ Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOpti
 
 // Where the free decay starts, and the options with the analysis window starting there.
 IdentificationOptions ApplyRelease(const Measurement& measurement,
-                                   const IdentificationOptions& options, ModalResult* result) {
+                                   const IdentificationOptions& options, ModalResult* result,
+                                   bool* from_rest) {
+  *from_rest = false;
   IdentificationOptions applied = options;
   result->release_time_s = measurement.start_time_s;
   switch (options.release) {
@@ -459,6 +461,7 @@ IdentificationOptions ApplyRelease(const Measurement& measurement,
       const ReleaseDetection detection = DetectRelease(measurement);
       result->release = detection.detected ? "detected" : "record start";
       result->release_time_s = detection.release_time_s;
+      *from_rest = detection.from_rest;
       if (detection.detected) {
         result->warnings.push_back(fmt::format(
             "{}; the analysis starts there (--release none to analyse the whole record)",
@@ -550,7 +553,8 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   if (const auto problem = FindOptionProblem(options)) {
     throw InputError("identification options", problem->field, problem->problem, problem->expected);
   }
-  const IdentificationOptions applied = ApplyRelease(measurement, options, &result);
+  bool from_rest = false;
+  const IdentificationOptions applied = ApplyRelease(measurement, options, &result, &from_rest);
   const AnalysisRecord record = PrepareRecord(measurement, applied, origin);
   result.channels = record.channels;
   result.units = record.units;
@@ -630,6 +634,10 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   std::vector<IdentifiedMode> sorted;
   for (size_t i : order) sorted.push_back(result.modes[i]);
   result.modes = std::move(sorted);
+  if (from_rest) {
+    // The whole decay knows the release better than its first samples (release.h).
+    result.release_time_s = RefineReleaseFromModes(result, result.release_time_s);
+  }
   AssessReliability(record, options, estimate, &result);
   return result;
 }

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "mbid/common/error.h"
+#include "mbid/identification/modal_result.h"
 
 namespace mbid::identification {
 namespace {
@@ -160,7 +161,11 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   fit.jump_everywhere = true;
   double jump_cost = 0;
   const double jump_t0 = FindOnset(fit, early, &jump_cost);
-  if (cost - jump_cost > 25 * noise_variance) t0 = jump_t0;
+  bool jumps = std::any_of(fit.rate.begin(), fit.rate.end(), [](bool rate) { return rate; });
+  if (cost - jump_cost > 25 * noise_variance) {
+    t0 = jump_t0;
+    jumps = true;
+  }
   const int rest = static_cast<int>(std::ceil(t0));  // samples before the release
   if (rest < kMinRestSamples + 1) return detection;
   // The segment before must really be at rest: within kRestFraction of its own median.
@@ -173,11 +178,49 @@ ReleaseDetection DetectRelease(const Measurement& record) {
     }
   }
   detection.detected = true;
+  detection.from_rest = !jumps;
   detection.rest_samples = rest;
   detection.release_time_s = record.start_time_s + t0 * record.sample_interval_s;
   detection.description = fmt::format("free decay starts at {:.6g} s after {} samples at rest",
                                       detection.release_time_s, rest);
   return detection;
+}
+
+double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s) {
+  const double tau = modes.sample_interval_s;
+  const size_t channels = modes.channels.size();
+  if (modes.modes.empty() || channels == 0 || !(tau > 0)) return coarse_time_s;
+  std::vector<double> scale(channels, 0.0);
+  for (const IdentifiedMode& mode : modes.modes) {
+    for (size_t c = 0; c < channels; ++c) {
+      scale[c] += mode.amplitude(static_cast<Eigen::Index>(c)) * std::abs(mode.lambda);
+    }
+  }
+  // Sum of squared velocities, each channel relative to its largest possible one.
+  const auto velocity_norm = [&](double t) {
+    const double s = t - modes.start_time_s;
+    double sum = 0;
+    for (size_t c = 0; c < channels; ++c) {
+      if (!(scale[c] > 0)) continue;
+      double v = 0;
+      for (const IdentifiedMode& mode : modes.modes) {
+        const auto k = static_cast<Eigen::Index>(c);
+        const double d = mode.decay_rate_per_s, w = 2 * M_PI * mode.frequency_hz;
+        const double angle = w * s + mode.phase_rad(k);
+        v += mode.amplitude(k) * std::exp(-d * s) * (-d * std::cos(angle) - w * std::sin(angle));
+      }
+      sum += std::pow(v / scale[c], 2);
+    }
+    return sum;
+  };
+  double best = coarse_time_s, best_value = velocity_norm(coarse_time_s);
+  constexpr int kSteps = 600;  // a hundredth of a sample over +-3 samples
+  for (int i = 0; i <= kSteps; ++i) {
+    const double t = coarse_time_s + (6.0 * i / kSteps - 3.0) * tau;
+    const double value = velocity_norm(t);
+    if (value < best_value) best_value = value, best = t;
+  }
+  return best;
 }
 
 Measurement CutAtRelease(const Measurement& record, double release_time_s,

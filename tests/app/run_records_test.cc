@@ -5,7 +5,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <string>
 
 #include "command_test.h"
@@ -94,6 +96,86 @@ TEST_F(RunRecordsTest, SeveralRecordedTestsAreTunedEachWithTheirSpread) {
   const std::string report = ReadText(out / "report.md");
   EXPECT_NE(report.find("relative spread, %"), std::string::npos);
   EXPECT_TRUE(fs::exists(out / "b" / "convergence.png"));  // each test's figures in its folder
+}
+
+// Each recorded test is simulated with its own load: two load drops of the reference crane,
+// 650 kg and 1300 kg, as HDF5 records that carry their scenarios. Tuned with the run scenario's
+// 650 kg for both (the old behaviour), the heavy drop's parameters came out wrong; with its own
+// excitation both recover the truth within 4 of their reported standard deviations (d_eta of a
+// 5 s load drop is weakly determined: its std is several percent).
+TEST_F(RunRecordsTest, EachRecordIsTunedWithItsOwnExcitation) {
+  const fs::path base = WriteVariant(kScenarios + "reference-crane-load-drop.yaml", "base.yaml",
+                                     "  duration_s: 8", "  duration_s: 5");
+  ASSERT_EQ(Run("simulate " + base.string() + " -o " + (dir_ / "light.h5").string()).exit_code, 0);
+  const fs::path heavy =
+      WriteVariant(base, "heavy.yaml", "  payload_mass_kg: 650.0", "  payload_mass_kg: 1300.0");
+  ASSERT_EQ(Run("simulate " + heavy.string() + " -o " + (dir_ / "heavy.h5").string()).exit_code, 0);
+  std::ofstream(base, std::ios::app) << "record:\n  - {name: light, file: light.h5}\n"
+                                     << "  - {name: heavy, file: heavy.h5}\n";
+  const fs::path out = dir_ / "both";
+  const CommandResult result = Run("run " + base.string() + " -o " + out.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.err.find("excitation load_drop from " + (dir_ / "heavy.h5").string()),
+            std::string::npos)
+      << result.err;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));
+  const std::map<std::string, double> truth{
+      {"c_alpha", 4.9e7},    {"c_gamma", 1.1e6},    {"c_eta", 5.5e6},   {"c_theta", 9.4e6},
+      {"d_alpha", 520000.0}, {"d_gamma", 178000.0}, {"d_eta", 44000.0}, {"d_theta", 116000.0}};
+  ASSERT_EQ(summary["tests"].size(), 2u);
+  for (const nlohmann::json& test : summary["tests"]) {
+    for (const auto& [name, value] : truth) {
+      const nlohmann::json& parameter = test["updating"]["parameters"][name];
+      EXPECT_NEAR(parameter["value"].get<double>(), value, 4 * parameter["std"].get<double>())
+          << test["name"] << " " << name;
+    }
+  }
+}
+
+// A field record as a logger keeps it: one second at rest at the deflection before the release,
+// and a zero error of the sensors. The run finds the release, starts the test there, fits the
+// offsets (an imported record) and recovers the truth within issue 5's bounds.
+TEST_F(RunRecordsTest, FieldRecordIsCutAtTheReleaseAndItsOffsetsFitted) {
+  const fs::path base = WriteVariant(kScenarios + "reference-crane.yaml", "base.yaml",
+                                     "  duration_s: 8", "  duration_s: 5");
+  ASSERT_EQ(Run("simulate " + base.string() + " -o " + (dir_ / "sim.h5").string()).exit_code, 0);
+  const mbid::Measurement simulated = mbid::ReadMeasurementH5((dir_ / "sim.h5").string());
+  constexpr int kRest = 100;  // 1 s at 100 Hz
+  mbid::Measurement field = simulated;
+  field.source = "import";
+  field.values.resize(kRest + simulated.samples(), simulated.channel_count());
+  field.values.bottomRows(simulated.samples()) = simulated.values;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 1e-5);  // the scenario's sensor noise
+  for (int j = 0; j < kRest; ++j) {
+    for (int c = 0; c < field.channel_count(); ++c) {
+      // At rest at the deflection the record starts from (its noise-free value is the first
+      // simulated sample less that sample's noise, within 1e-5).
+      field.values(j, c) = simulated.values(0, c) + noise(rng);
+    }
+  }
+  const Eigen::Vector2d offset(2e-3, -1e-3);  // rad: a fifth of the deflection
+  field.values.rowwise() += offset.transpose();
+  mbid::WriteMeasurementCsv(field, (dir_ / "field.csv").string());
+  std::ofstream(base, std::ios::app) << "record: {name: field, file: field.csv}\n";
+  const fs::path out = dir_ / "run";
+  const CommandResult result = Run("run " + base.string() + " -o " + out.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));
+  const nlohmann::json& test = summary["tests"][0];
+  EXPECT_EQ(test["release"]["release"], "detected");
+  // Refined from the identified decay (a release from rest: every velocity vanishes there):
+  // measured 0.25 ms; a tenth of a sample allowed.
+  EXPECT_NEAR(test["release"]["release_time_s"].get<double>(), kRest * 0.01, 0.001);
+  const std::map<std::string, double> truth{
+      {"c_alpha", 4.9e7},    {"c_gamma", 1.1e6},    {"c_eta", 5.5e6},   {"c_theta", 9.4e6},
+      {"d_alpha", 520000.0}, {"d_gamma", 178000.0}, {"d_eta", 44000.0}, {"d_theta", 116000.0}};
+  for (const auto& [name, value] : truth) {
+    const double tuned = test["updating"]["parameters"][name]["value"].get<double>();
+    // Issue 5's bounds; measured worst: c_eta 0.8 %, d_alpha 1.0 %.
+    EXPECT_NEAR(tuned, value, (name[0] == 'c' ? 0.01 : 0.05) * value) << name;
+  }
+  EXPECT_EQ(summary["validation"]["verdict"], "passed") << summary["validation"].dump();
 }
 
 struct BadRecord {

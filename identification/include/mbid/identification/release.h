@@ -7,6 +7,8 @@
 
 namespace mbid::identification {
 
+struct ModalResult;
+
 // Where the free decay of a record starts: the load or pull release, the impact, the end of
 // leading zeros or of a pre-trigger segment. Before it the structure is at rest (a constant per
 // channel plus noise); after it the response sets off from that constant like
@@ -18,12 +20,21 @@ struct ReleaseDetection {
   // true: a segment at rest precedes the decay and release_time_s is where it ends (to a
   // fraction of a sample); false: the record starts in the decay, release_time_s is its start.
   bool detected = false;
-  int rest_samples = 0;     // samples at rest before the release
+  int rest_samples = 0;  // samples at rest before the release
+  // true when the structure set off from rest in every channel (positions, no jump): a load or
+  // pull release, whose instant the identified modes then refine (RefineReleaseFromModes).
+  bool from_rest = false;
   std::string description;  // one line for the user
 };
 
 // Finds the release in `record`'s channels (all of them). Never throws on a valid record.
 ReleaseDetection DetectRelease(const Measurement& record);
+
+// A release from rest is where the velocity of every channel vanishes: the reconstruction of
+// `modes` (identified on the decay after `coarse_time_s`) differentiated in time, searched
+// within 3 samples of the coarse instant. Uses the whole record's information instead of the few
+// samples around the onset: on the crane at 1e-5 rad noise, a tenth of a sample.
+double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s);
 
 // The part of `record` from `release_time_s` on, with the release as time origin: samples at
 // t >= release_time_s (less a millionth of a sample for round-off) keep their values, and
