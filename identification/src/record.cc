@@ -67,28 +67,35 @@ int ChooseDecimation(const Eigen::MatrixXd& centered, double sample_interval_s,
     SpectrumOptions options;
     options.zero_padding_factor = 1;  // the floor and the top, not fine peak positions
     options.min_peak_prominence = 1;  // no peak list needed
-    const Spectrum spectrum = CalcSpectrum(centered, sample_interval_s, options);
     double top_hz = 0;
-    for (Eigen::Index c = 0; c < spectrum.amplitude.cols(); ++c) {
-      const Eigen::VectorXd amplitude = spectrum.amplitude.col(c);
-      std::vector<double> sorted(amplitude.data(), amplitude.data() + amplitude.size());
-      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-      // White noise's Hann spectrum is Rayleigh distributed: 10x its median is 12 standard
-      // deviations, which no noise bin reaches (probability e^-69 per bin).
-      const double floor = sorted[sorted.size() / 2];
-      for (Eigen::Index b = amplitude.size() - 1; b > 0; --b) {
-        if (amplitude(b) > 10 * floor) {
-          top_hz = std::max(top_hz, spectrum.frequency_hz(b));
-          break;
+    // A fast-decaying high mode is gone from most of a long record and sinks into the whole
+    // record's noise floor; the record's beginning shows it. So the top is the highest over the
+    // first 2048, 16384, ... samples and the whole.
+    for (Eigen::Index length = 2048;; length *= 8) {
+      const Eigen::Index used = std::min(length, samples);
+      const Spectrum spectrum = CalcSpectrum(centered.topRows(used), sample_interval_s, options);
+      for (Eigen::Index c = 0; c < spectrum.amplitude.cols(); ++c) {
+        const Eigen::VectorXd amplitude = spectrum.amplitude.col(c);
+        std::vector<double> sorted(amplitude.data(), amplitude.data() + amplitude.size());
+        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+        // White noise's Hann spectrum is Rayleigh distributed: 10x its median is 12 standard
+        // deviations, which no noise bin reaches (probability e^-69 per bin).
+        const double floor = sorted[sorted.size() / 2];
+        for (Eigen::Index b = amplitude.size() - 1; b > 0; --b) {
+          if (amplitude(b) > 10 * floor) {
+            top_hz = std::max(top_hz, spectrum.frequency_hz(b));
+            break;
+          }
         }
       }
+      if (used == samples) break;
     }
     if (top_hz <= 0) return 1;
     band_hz = 1.25 * top_hz;
   }
   const double nyquist_hz = 0.5 / sample_interval_s;
   const int by_band = static_cast<int>(std::floor(kFlatFraction * nyquist_hz / band_hz));
-  const int by_length = static_cast<int>(samples / 1000);
+  const int by_length = static_cast<int>(samples / 500);
   return std::max(1, std::min(by_band, by_length));
 }
 

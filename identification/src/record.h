@@ -38,7 +38,7 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
 // The decimation factor for IdentificationOptions::decimation = 0: the largest that keeps the
 // band (max_frequency_hz if > 0, else 1.25 x the highest frequency where some channel's
 // spectrum stands 10x above its median, the noise floor) inside the filter's flat part and at
-// least 1000 samples; 1 if the record is not oversampled.
+// least 500 samples; 1 if the record is not oversampled.
 int ChooseDecimation(const Eigen::MatrixXd& centered, double sample_interval_s,
                      double max_frequency_hz);
 

@@ -2,6 +2,7 @@
 // no output left behind on failure, and files that other tools (h5py) read.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -286,6 +287,39 @@ TEST_F(CliTest, UnreliableIdentificationMakesTheRunInconclusive) {
   EXPECT_FALSE(summary["identification"]["reliable"].get<bool>());
   EXPECT_NE(result.err.find("INCONCLUSIVE"), std::string::npos) << result.err;
   EXPECT_NE(ReadText(out / "report.md").find("INCONCLUSIVE"), std::string::npos);
+}
+
+// The 500 Hz record of the reference crane gave "no modes found" (exit 3) unless the user
+// knew about decimation. The band is now chosen from the spectrum: the four modes the 100 Hz
+// record gives come back, and the result is reliable.
+TEST_F(CliTest, OversampledCraneRecordGivesItsFourModes) {
+  const fs::path scenario = WriteVariant("  sample_rate_hz: 100", "  sample_rate_hz: 500");
+  const fs::path record = dir_ / "c500.h5";
+  ASSERT_EQ(Run("simulate " + scenario.string() + " -o " + record.string()).exit_code, 0);
+  const fs::path json = dir_ / "modes.json";
+  const CommandResult result = Run("identify " + record.string() + " --json " + json.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(json));
+  EXPECT_GT(summary["decimation"].get<int>(), 1);
+  EXPECT_TRUE(summary["reliable"].get<bool>()) << summary["reasons"].dump();
+  // The same test sampled at 100 Hz, as mbid always identified it.
+  const fs::path slow = WriteVariant("  seed: 1", "  seed: 1");
+  const fs::path slow_record = dir_ / "c100.h5";
+  const fs::path slow_json = dir_ / "modes100.json";
+  ASSERT_EQ(Run("simulate " + slow.string() + " -o " + slow_record.string()).exit_code, 0);
+  ASSERT_EQ(Run("identify " + slow_record.string() + " --json " + slow_json.string()).exit_code, 0);
+  const nlohmann::json reference = nlohmann::json::parse(ReadText(slow_json));
+  ASSERT_EQ(summary["modes"].size(), 4u);
+  ASSERT_EQ(reference["modes"].size(), 4u);
+  for (size_t k = 0; k < 4; ++k) {
+    const nlohmann::json& fast = summary["modes"][k];
+    const nlohmann::json& base = reference["modes"][k];
+    // Two independent noise records of the same decay: within 5 combined standard deviations.
+    EXPECT_NEAR(fast["frequency_hz"].get<double>(), base["frequency_hz"].get<double>(),
+                5 * std::hypot(fast["std_frequency_hz"].get<double>(),
+                               base["std_frequency_hz"].get<double>()))
+        << k;
+  }
 }
 
 TEST_F(CliTest, FailedRunLeavesNoResultsFolder) {

@@ -122,7 +122,7 @@ struct IdentificationOptions {
   // and the reconstruction always use the full-rate record. The filter loses the first and last
   // 20 * decimation samples for the pole estimate. 0 (default): chosen from the spectrum, so
   // that the highest mode (and max_frequency_hz, if given) lies in the flat part of the filter
-  // with a margin, keeping at least 1000 samples; a record that is not oversampled keeps 1.
+  // with a margin, keeping at least 500 samples; a record that is not oversampled keeps 1.
   int decimation = 0;
 
   // Step 5 of method.md: poles outside these limits are dropped. Modes are oscillatory:
