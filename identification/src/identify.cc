@@ -11,6 +11,7 @@
 
 #include "internal.h"
 #include "mbid/common/error.h"
+#include "mbid/identification/backbone.h"
 #include "mbid/identification/hankel_svd.h"
 #include "mbid/identification/modal_fit.h"
 #include "mbid/identification/prony_svd.h"
@@ -477,6 +478,84 @@ IdentificationOptions ApplyRelease(const Measurement& measurement,
   return applied;
 }
 
+// Poles within 3 % of each other are, in a free decay, one mode whose frequency drifts with
+// amplitude far more often than two modes the record resolves. Each such cluster is measured in
+// sliding windows (backbone.h) with the other modes subtracted; when the windows confirm a drift,
+// the cluster is reported as its largest member with the backbone attached. `result->modes` and
+// `shapes` are in `estimate.lambda`'s order.
+void MergeDriftingModes(const AnalysisRecord& record, const Estimate& estimate,
+                        const IdentificationOptions& options, ModalResult* result,
+                        std::vector<Eigen::VectorXcd>* shapes) {
+  const size_t n = result->modes.size();
+  std::vector<size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return result->modes[a].frequency_hz < result->modes[b].frequency_hz;
+  });
+  std::vector<bool> drop(n, false);
+  for (size_t i = 0; i < n;) {
+    size_t j = i + 1;
+    while (j < n &&
+           result->modes[order[j]].frequency_hz - result->modes[order[j - 1]].frequency_hz <
+               0.03 * result->modes[order[j]].frequency_hz) {
+      ++j;
+    }
+    if (j - i >= 2) {
+      std::vector<size_t> cluster(order.begin() + static_cast<long>(i),
+                                  order.begin() + static_cast<long>(j));
+      size_t dominant = cluster.front();
+      for (size_t k : cluster) {
+        if (result->modes[k].amplitude.sum() > result->modes[dominant].amplitude.sum()) {
+          dominant = k;
+        }
+      }
+      // The record with every mode outside the cluster (and the offset) taken away.
+      std::vector<std::complex<double>> members;
+      Eigen::MatrixXd coefficients(2 * static_cast<Eigen::Index>(cluster.size()),
+                                   record.decimated.cols());
+      for (size_t m = 0; m < cluster.size(); ++m) {
+        members.push_back(estimate.lambda[cluster[m]]);
+        coefficients.middleRows(2 * static_cast<Eigen::Index>(m), 2) =
+            estimate.fit.coefficients.middleRows(2 * static_cast<Eigen::Index>(cluster[m]), 2);
+      }
+      const Eigen::MatrixXd alone =
+          record.decimated - estimate.fit.reconstruction +
+          CalcDampedSinusoidBasis(members, record.decimated_interval_s,
+                                  static_cast<int>(record.decimated.rows()), false) *
+              coefficients;
+      Backbone backbone =
+          CalcBackbone(alone, record.decimated_interval_s, record.decimated_start_time_s,
+                       estimate.lambda[dominant], estimate.weights, options.refinement);
+      if (backbone.amplitude_dependent) {
+        const auto [low, high] =
+            std::minmax_element(backbone.frequency_hz.begin(), backbone.frequency_hz.end());
+        std::string merged;
+        for (size_t k : cluster) {
+          merged +=
+              fmt::format("{}{:.4g}", merged.empty() ? "" : ", ", result->modes[k].frequency_hz);
+          if (k != dominant) drop[k] = true;
+        }
+        result->warnings.push_back(fmt::format(
+            "modes at {} Hz are one mode drifting with amplitude: reported as the mode at "
+            "{:.4g} Hz with its backbone (frequency {:.4g} to {:.4g} Hz over {} windows)",
+            merged, result->modes[dominant].frequency_hz, *low, *high,
+            backbone.frequency_hz.size()));
+        result->modes[dominant].backbone = std::move(backbone);
+      }
+    }
+    i = j;
+  }
+  std::vector<IdentifiedMode> kept;
+  std::vector<Eigen::VectorXcd> kept_shapes;
+  for (size_t k = 0; k < n; ++k) {
+    if (drop[k]) continue;
+    kept.push_back(result->modes[k]);
+    kept_shapes.push_back((*shapes)[k]);
+  }
+  result->modes = std::move(kept);
+  *shapes = std::move(kept_shapes);
+}
+
 // Reasons the data do not support the result (ModalResult::reliable).
 void AssessReliability(const AnalysisRecord& record, const IdentificationOptions& options,
                        const Estimate& estimate, ModalResult* result) {
@@ -525,6 +604,16 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
           "the mode at {:.4g} Hz is undetermined (std of frequency {:.3g} Hz, of decay {:.3g} "
           "1/s)",
           mode.frequency_hz, mode.std_frequency_hz, mode.std_decay_rate_per_s));
+    }
+  }
+  for (const IdentifiedMode& mode : result->modes) {
+    if (mode.backbone && mode.backbone->amplitude_dependent) {
+      const auto [low, high] = std::minmax_element(mode.backbone->frequency_hz.begin(),
+                                                   mode.backbone->frequency_hz.end());
+      reasons.push_back(fmt::format(
+          "the mode at {:.4g} Hz is amplitude dependent ({:.4g} to {:.4g} Hz): its constant "
+          "frequency and damping hold at no amplitude; use its backbone",
+          mode.frequency_hz, *low, *high));
     }
   }
   // Modes within 3 % of each other: one mode whose frequency drifts with amplitude, or two the
@@ -623,8 +712,11 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
     mode.significant = mode.significance >= result.significance_threshold;
     result.modes.push_back(mode);
   }
+  MergeDriftingModes(record, estimate, options, &result, &shapes);
   // Eq. 5 with the output vectors w_k = the modes' complex amplitudes per channel.
-  result.eq2_coefficients = CalcEq2Coefficients(estimate.lambda, shapes);
+  std::vector<std::complex<double>> poles;
+  for (const IdentifiedMode& mode : result.modes) poles.push_back(mode.lambda);
+  result.eq2_coefficients = CalcEq2Coefficients(poles, shapes);
 
   std::vector<size_t> order(result.modes.size());
   std::iota(order.begin(), order.end(), 0);

@@ -67,6 +67,17 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
     m["std_decay_rate_per_s"] = Number(mode.std_decay_rate_per_s);
     m["significance"] = Number(mode.significance);
     m["significant"] = mode.significant;
+    if (mode.backbone) {
+      const Backbone& b = *mode.backbone;
+      m["backbone"] = {{"time_s", b.time_s},
+                       {"amplitude", b.amplitude},
+                       {"frequency_hz", b.frequency_hz},
+                       {"damping_ratio", b.damping_ratio},
+                       {"std_frequency_hz", b.std_frequency_hz},
+                       {"std_damping_ratio", b.std_damping_ratio},
+                       {"amplitude_dependent", b.amplitude_dependent},
+                       {"spread_chi_square_per_dof", b.spread_chi_square_per_dof}};
+    }
     modes.push_back(m);
   }
   json["modes"] = modes;
@@ -149,6 +160,24 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result, const std::st
   const auto write_mode_vector = [&](const char* name, const char* units, auto get) {
     writer.WriteVector(modes, name, ModeVector(result, get), units);
   };
+  for (size_t k = 0; k < result.modes.size(); ++k) {
+    if (!result.modes[k].backbone) continue;
+    const Backbone& b = *result.modes[k].backbone;
+    const std::string backbone_group = modes + "/backbone/" + std::to_string(k);
+    const auto vector = [](const std::vector<double>& v) {
+      return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()))
+          .eval();
+    };
+    writer.WriteVector(backbone_group, "time_s", vector(b.time_s), "s");
+    writer.WriteVector(backbone_group, "amplitude", vector(b.amplitude),
+                       "units of the mode's largest channel");
+    writer.WriteVector(backbone_group, "frequency_hz", vector(b.frequency_hz), "Hz");
+    writer.WriteVector(backbone_group, "damping_ratio", vector(b.damping_ratio), "1");
+    writer.WriteVector(backbone_group, "std_frequency_hz", vector(b.std_frequency_hz), "Hz");
+    writer.WriteVector(backbone_group, "std_damping_ratio", vector(b.std_damping_ratio), "1");
+    writer.WriteStringAttribute(backbone_group, "amplitude_dependent",
+                                b.amplitude_dependent ? "true" : "false");
+  }
   write_mode_vector("frequency_hz", "Hz", [](const IdentifiedMode& m) { return m.frequency_hz; });
   write_mode_vector("decay_rate_per_s", "1/s",
                     [](const IdentifiedMode& m) { return m.decay_rate_per_s; });

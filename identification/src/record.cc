@@ -238,6 +238,8 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
                     : Eigen::VectorXd(record.values.colwise().mean().transpose());
   record.centered = record.values.rowwise() - record.mean.transpose();
   record.decimated = Decimate(record.centered, q);
+  // "Valid" filtering: output n is centred on input n q + H.
+  record.decimated_start_time_s = record.start_time_s + (q == 1 ? 0 : kFilterHalfLength * q) * tau;
   return record;
 }
 

@@ -3,10 +3,12 @@
 #include <Eigen/Core>
 #include <complex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "mbid/common/hdf5_io.h"
+#include "mbid/identification/backbone.h"
 #include "mbid/identification/spectrum.h"
 
 namespace mbid::identification {
@@ -33,6 +35,9 @@ struct IdentifiedMode {
   // ModalResult::significance_threshold.
   double significance = 0;
   bool significant = true;
+  // For a mode whose frequency drifts with amplitude (close poles merged into it): its
+  // frequency and damping ratio against amplitude (backbone.h).
+  std::optional<Backbone> backbone;
 
   // Fills the derived quantities from lambda.
   void SetPole(std::complex<double> pole);

@@ -1,0 +1,74 @@
+#include "mbid/identification/backbone.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mbid/identification/modal_fit.h"
+#include "mbid/identification/refinement.h"
+
+namespace mbid::identification {
+
+Backbone CalcBackbone(const Eigen::MatrixXd& mode_alone, double sample_interval_s,
+                      double start_time_s, std::complex<double> lambda,
+                      const Eigen::VectorXd& channel_weights, const RefinementOptions& options) {
+  Backbone backbone;
+  const double tau = sample_interval_s;
+  const int samples = static_cast<int>(mode_alone.rows());
+  const double period_s = 2 * M_PI / lambda.imag();
+  const int window = std::max(32, static_cast<int>(std::lround(8 * period_s / tau)));
+  if (window > samples) return backbone;
+  // The channel where the mode is largest carries its amplitude.
+  Eigen::Index reference = 0;
+  mode_alone.colwise().squaredNorm().maxCoeff(&reference);
+  std::complex<double> start = lambda;
+  for (int first = 0; first + window <= samples; first += window / 2) {
+    const Eigen::MatrixXd part = mode_alone.middleRows(first, window);
+    ModalModel initial;
+    initial.lambda = {start};
+    initial.with_offset = false;
+    initial.coefficients = FitAmplitudes(part, tau, initial.lambda, false).coefficients;
+    const RefinementSummary summary =
+        RefineModalModel(part, tau, channel_weights, initial, options);
+    if (summary.termination == "failure" || summary.model.lambda.size() != 1) continue;
+    const std::complex<double> pole = summary.model.lambda.front();
+    if (!(pole.imag() > 0)) continue;
+    const auto covariance = CalcPoleCovariance(part, tau, channel_weights, summary.model);
+    if (covariance.size() != 1) continue;
+    const double frequency_hz = pole.imag() / (2 * M_PI);
+    const double std_frequency_hz = std::sqrt(covariance[0](1, 1)) / (2 * M_PI);
+    if (!(std_frequency_hz < 0.05 * frequency_hz)) continue;  // the mode has sunk into noise
+    const double centre = 0.5 * (window - 1) * tau;
+    const Eigen::Vector2d cs = summary.model.coefficients.block(0, reference, 2, 1);
+    const double decay = -pole.real();
+    // d zeta / d decay = 1 / |lambda| (omega fixed) up to the small omega term; the decay's std
+    // dominates the damping ratio's.
+    backbone.time_s.push_back(start_time_s + first * tau + centre);
+    backbone.amplitude.push_back(cs.norm() * std::exp(-decay * centre));
+    backbone.frequency_hz.push_back(frequency_hz);
+    backbone.damping_ratio.push_back(decay / std::abs(pole));
+    backbone.std_frequency_hz.push_back(std_frequency_hz);
+    backbone.std_damping_ratio.push_back(std::sqrt(covariance[0](0, 0)) / std::abs(pole));
+    start = pole;  // the next window continues from here: the drift is slow
+  }
+  const size_t n = backbone.frequency_hz.size();
+  if (n >= 3) {
+    double weight_sum = 0, mean = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const double w = 1 / std::pow(backbone.std_frequency_hz[i], 2);
+      weight_sum += w;
+      mean += w * backbone.frequency_hz[i];
+    }
+    mean /= weight_sum;
+    double chi_square = 0;
+    for (size_t i = 0; i < n; ++i) {
+      chi_square += std::pow((backbone.frequency_hz[i] - mean) / backbone.std_frequency_hz[i], 2);
+    }
+    // Half-overlapping windows share noise, so the statistic runs high even for a linear mode:
+    // 4 per degree of freedom leaves that margin.
+    backbone.spread_chi_square_per_dof = chi_square / static_cast<double>(n - 1);
+    backbone.amplitude_dependent = backbone.spread_chi_square_per_dof > 4;
+  }
+  return backbone;
+}
+
+}  // namespace mbid::identification
