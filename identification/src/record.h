@@ -25,8 +25,8 @@ struct AnalysisRecord {
   Eigen::MatrixXd decimated;
   double decimated_interval_s = 0;
   double decimated_start_time_s = 0;  // time of the decimated record's first sample
-  double max_frequency_hz = 0;  // the band's upper limit (resolved from 0 = Nyquist)
-  int decimation = 1;           // as used (resolved from 0 = automatic)
+  double max_frequency_hz = 0;        // the band's upper limit (resolved from 0 = Nyquist)
+  int decimation = 1;                 // as used (resolved from 0 = automatic)
   // The highest frequency the low-pass filter passes flat (the Nyquist frequency without
   // decimation): modes above it are at the band's edge.
   double flat_frequency_hz = 0;

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "internal.h"  // common/src: ReadTextFile
 #include "mbid/common/error.h"
 
 namespace mbid::records::internal {
@@ -71,21 +72,7 @@ inline bool ParseInteger(std::string_view text, long long minimum, long long max
 
 // The whole file; one that cannot be opened or read is an InputError naming it.
 inline std::string ReadWholeFile(const std::string& path, const std::string& expected) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) {
-    throw InputError(path, "", std::string("cannot open: ") + std::strerror(errno), expected);
-  }
-  std::string bytes;
-  char buffer[65536];
-  size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), file)) > 0) bytes.append(buffer, n);
-  const bool failed = std::ferror(file) != 0;
-  const int error = errno;
-  std::fclose(file);
-  if (failed) {
-    throw InputError(path, "", std::string("cannot read: ") + std::strerror(error), expected);
-  }
-  return bytes;
+  return mbid::internal::ReadTextFile(path, expected);
 }
 
 // Most samples per channel any reader accepts (8e8 bytes per channel as doubles), checked before
