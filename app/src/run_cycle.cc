@@ -113,6 +113,11 @@ nlohmann::json ChannelValues(const std::vector<std::string>& channels, const Eig
 void WriteTestGroups(H5Writer& run, const RunTest& test, const std::string& root,
                      double threshold) {
   run.WriteMeasurement(test.measured, root + "/measurement");
+  if (test.release) {
+    // Where the record was cut: the release in the file's own time, t = 0 of the test.
+    run.WriteScalar(root + "/release", "release_time_s", test.release->release_time_s, "s");
+    run.WriteStringAttribute(root + "/release", "release", test.release->how);
+  }
   identification::WriteModalResult(run, test.identified, root + "/identification");
   updating::WriteUpdatingGroup(run, test.tuned, test.algebraic.get(), root + "/updating");
   const updating::TestFit& fit = test.tuned.tests.front();

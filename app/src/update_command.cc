@@ -190,6 +190,17 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     file.WriteMeasurement(tests.front().record);
     file.WriteScenarioYaml(scenario.yaml_text);
     updating::WriteUpdatingGroup(file, result, algebraic.get());
+    // Where each DATA file was cut: its release in the file's own time (t = 0 of the test).
+    Eigen::VectorXd release_s(static_cast<Eigen::Index>(tests.size()));
+    std::vector<std::string> how, files;
+    for (size_t i = 0; i < tests.size(); ++i) {
+      release_s(static_cast<Eigen::Index>(i)) = tests[i].release.release_time_s;
+      how.push_back(tests[i].release.how);
+      files.push_back(tests[i].path);
+    }
+    file.WriteVector("/release", "release_time_s", release_s, "s");
+    file.WriteStrings("/release", "release", how);
+    file.WriteStrings("/release", "file", files);
     file.Commit();
   }
   for (const std::string& warning : result.warnings) {

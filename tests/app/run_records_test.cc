@@ -176,6 +176,8 @@ TEST_F(RunRecordsTest, FieldRecordIsCutAtTheReleaseAndItsOffsetsFitted) {
     EXPECT_NEAR(tuned, value, (name[0] == 'c' ? 0.01 : 0.05) * value) << name;
   }
   EXPECT_EQ(summary["validation"]["verdict"], "passed") << summary["validation"].dump();
+  const mbid::H5Reader run((out / "run.h5").string());
+  EXPECT_TRUE(run.Exists("/tests/field/release/release_time_s"));
 }
 
 struct BadRecord {
