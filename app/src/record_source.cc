@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <set>
 
+#include "mbid/app/scenario.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/records/records.h"
@@ -131,23 +132,18 @@ LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel
   loaded.excitation_origin = source.excitation_origin;
   if (!loaded.excitation && report.format == "hdf5") {
     // A test mbid simulated carries its scenario: its own load, not the run scenario's.
-    const std::string yaml = ReadScenarioYaml(source.file);
-    if (!yaml.empty()) {
-      YAML::Node root;
-      try {
-        root = YAML::Load(yaml);
-      } catch (const YAML::Exception& error) {
-        throw InputError(source.file, "/scenario", "the stored scenario is not YAML",
-                         "the scenario mbid simulate stored");
-      }
-      if (root.IsMap() && root["excitation"]) {
-        const YamlReader stored(root["excitation"], source.file + ":/scenario", "excitation");
-        loaded.excitation = simulation::ReadExcitation(stored, model);
-        loaded.excitation_origin = source.file + ":/scenario";
-      }
-    }
+    loaded.excitation = ReadStoredExcitation(source.file);
+    if (loaded.excitation) loaded.excitation_origin = source.file + ":/scenario";
   }
   return loaded;
+}
+
+std::optional<simulation::Excitation> ReadStoredExcitation(const std::string& path) {
+  const std::string yaml = ReadScenarioYaml(path);
+  if (yaml.empty()) return std::nullopt;
+  const Scenario stored = LoadScenarioFromText(yaml, path + ":/scenario");
+  if (!stored.has_excitation) return std::nullopt;
+  return stored.excitation;
 }
 
 void RequireModelOutputs(const Measurement& record, const std::string& origin,

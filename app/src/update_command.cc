@@ -60,15 +60,10 @@ LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
   RequireModelOutputs(test.record, path, model);
   // A simulated test carries its own scenario: its excitation is the one of this record (a load
   // drop and an initial deflection can then be fitted together).
-  const std::string yaml = IsHdf5(path) ? ReadScenarioYaml(path) : std::string();
-  const Scenario* source = &scenario;
-  std::unique_ptr<Scenario> own;
-  if (!yaml.empty()) {
-    own = std::make_unique<Scenario>(LoadScenarioFromText(yaml, path + ":/scenario"));
-    if (own->has_excitation) source = own.get();
-  }
-  test.excitation = source->RequireExcitation();
-  test.excitation_source = source == &scenario ? "scenario" : path;
+  std::optional<simulation::Excitation> own =
+      IsHdf5(path) ? ReadStoredExcitation(path) : std::nullopt;
+  test.excitation = own ? *own : scenario.RequireExcitation();
+  test.excitation_source = own ? path : "scenario";
   // The simulation of the test starts at the release: the record is cut there.
   test.release =
       CutRecordAtRelease(&test.record, path, OverrideRelease({}, overrides), test.excitation);

@@ -45,6 +45,11 @@ struct LoadedRecord {
   std::string excitation_origin;
 };
 
+// The excitation of the scenario an HDF5 record mbid simulated stores under /scenario; none when
+// the file has no stored scenario or the scenario no excitation. An invalid stored scenario is an
+// InputError naming "<path>:/scenario".
+std::optional<simulation::Excitation> ReadStoredExcitation(const std::string& path);
+
 // Throws InputError naming `origin` unless every channel of `record` is an output of `model`.
 void RequireModelOutputs(const Measurement& record, const std::string& origin,
                          const model::MechanicalModel& model);
