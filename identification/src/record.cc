@@ -110,9 +110,6 @@ int RequiredSamples(const IdentificationOptions& options, int channels) {
 
 AnalysisRecord PrepareRecord(const Measurement& measurement, const IdentificationOptions& options,
                              const std::string& origin) {
-  if (const auto problem = FindOptionProblem(options)) {
-    throw InputError(kOptionsSource, problem->field, problem->problem, problem->expected);
-  }
   const double tau = measurement.sample_interval_s;
   if (!(std::isfinite(tau) && tau > 0)) {
     throw InputError(origin, "sample_interval_s", fmt::format("{} s", tau),
@@ -160,15 +157,16 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
   const int count = last - first + 1;
   record.sample_interval_s = tau;
   record.start_time_s = t0 + first * tau;
+  // The window's channels as recorded (checked below, after the sample count).
+  record.values.resize(std::max(count, 0), static_cast<Eigen::Index>(columns.size()));
+  for (size_t c = 0; c < columns.size(); ++c) {
+    record.values.col(c) = measurement.values.col(columns[c]).segment(first, record.values.rows());
+  }
   int q = options.decimation;
   if (q == 0) {
-    // Chosen on the window's channels, offset removed (a constant dominates the lowest bin only).
-    Eigen::MatrixXd window(count, static_cast<Eigen::Index>(columns.size()));
-    for (size_t c = 0; c < columns.size(); ++c) {
-      window.col(c) = measurement.values.col(columns[c]).segment(first, std::max(count, 0));
-    }
-    q = count > 0 && window.allFinite()
-            ? ChooseDecimation(window.rowwise() - window.colwise().mean(), tau,
+    // Chosen with the offset removed (a constant dominates the lowest bin only).
+    q = count > 0 && record.values.allFinite()
+            ? ChooseDecimation(record.values.rowwise() - record.values.colwise().mean(), tau,
                                options.max_frequency_hz)
             : 1;
   }
@@ -190,10 +188,6 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
         fmt::format("at least {} for {}", required, order));
   }
 
-  record.values.resize(count, static_cast<Eigen::Index>(columns.size()));
-  for (size_t c = 0; c < columns.size(); ++c) {
-    record.values.col(c) = measurement.values.col(columns[c]).segment(first, count);
-  }
   for (size_t c = 0; c < columns.size(); ++c) {
     const auto column = record.values.col(c);
     for (int j = 0; j < count; ++j) {

@@ -32,7 +32,8 @@ struct AnalysisRecord {
   double flat_frequency_hz = 0;
 };
 
-// Applies the options to the measurement and checks the input (see Identify for the errors).
+// Applies the options (already checked by Identify, its caller) to the measurement and checks the
+// input (see Identify for the errors).
 AnalysisRecord PrepareRecord(const Measurement& measurement, const IdentificationOptions& options,
                              const std::string& origin);
 
