@@ -41,7 +41,7 @@ AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin
   } else if (excitation.CalcForcingEndTime() > 0) {
     applied.how = "forced test";
     return applied;
-  } else if (record->source == "simulation" || record->source == "synthetic") {
+  } else if (record->made_by_mbid()) {
     // mbid's own records start at the excitation by construction.
     applied.how = "record start";
     return applied;

@@ -331,7 +331,7 @@ TestRecord MakeTestRecord(const std::string& name, const Measurement& record,
     case UpdatingSettings::Offsets::kAuto:
       // mbid's own records (simulated, or synthetic modes) have no zero error unless a sensor
       // bias was asked for.
-      test.fit_offsets = record.source != "simulation" && record.source != "synthetic";
+      test.fit_offsets = !record.made_by_mbid();
       break;
     case UpdatingSettings::Offsets::kAlways:
       test.fit_offsets = true;

@@ -18,6 +18,9 @@ struct Measurement {
   std::string source = "import";   // "simulation" | "import" | ...
 
   int samples() const { return static_cast<int>(values.rows()); }
+  // Made by mbid itself (`mbid simulate` or synthetic modes): it starts at the excitation and has
+  // no sensor zero error, unlike a record imported from a test.
+  bool made_by_mbid() const { return source == "simulation" || source == "synthetic"; }
   int channel_count() const { return static_cast<int>(values.cols()); }
   Eigen::VectorXd CalcTime() const;
   // Index of `channel`, or -1.
