@@ -6,6 +6,8 @@ set(MBID_UPDATING_DIR "${CMAKE_CURRENT_LIST_DIR}")
 add_library(mbid_updating
   "${MBID_UPDATING_DIR}/src/updating/baseline.cc"
   "${MBID_UPDATING_DIR}/src/updating/characteristic.cc"
+  "${MBID_UPDATING_DIR}/src/updating/credibility.cc"
+  "${MBID_UPDATING_DIR}/src/updating/global_search.cc"
   "${MBID_UPDATING_DIR}/src/updating/output_error.cc"
   "${MBID_UPDATING_DIR}/src/updating/result_io.cc"
   "${MBID_UPDATING_DIR}/src/updating/settings.cc")

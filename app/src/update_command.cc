@@ -78,24 +78,36 @@ std::string FormatNumber(double value) {
 }
 
 void PrintSummary(const updating::UpdateResult& result,
-                  const updating::CharacteristicResult* algebraic, const std::string& start) {
+                  const updating::CharacteristicResult* algebraic, const std::string& start,
+                  const updating::GlobalSearchResult& search) {
   if (algebraic) {
     int admissible = 0;
     for (const auto& set : algebraic->solutions) admissible += set.admissible ? 1 : 0;
     std::cout << fmt::format("route 1: {} ({} admissible sets{})\n", algebraic->status_name(),
                              admissible, algebraic->ambiguous ? ", ambiguous choice" : "");
   }
-  std::cout << fmt::format("route 2: {} after {} iterations (start: {}), cost {:.6g} -> {:.6g}\n",
-                           result.termination_name(), result.iterations, start, result.initial_cost,
-                           result.final_cost);
+  const std::string& best_start =
+      search.minima.empty() ? start : search.minima.front().starts.front();
+  std::cout << fmt::format("route 2: {} after {} iterations (start: {}{}), cost {:.6g} -> {:.6g}\n",
+                           result.termination_name(), result.iterations, best_start,
+                           best_start == start ? "" : "; the primary start was " + start,
+                           result.initial_cost, result.final_cost);
   std::cout << fmt::format("{:<12} {:>13} {:>13} {:>11} {:>9} {:>10}\n", "parameter", "value",
                            "initial", "std", "rel_std", "units");
   for (const updating::ParameterEstimate& p : result.parameters) {
-    const std::string name = p.test.empty() ? p.name : p.test + ":" + p.name;
-    std::cout << fmt::format(
-        "{:<12} {:>13} {:>13} {:>11} {:>9} {:>10}{}{}\n", name, FormatNumber(p.value),
-        FormatNumber(p.initial), FormatNumber(p.std), FormatNumber(p.relative_std), p.units,
-        p.determined ? "" : "  (undetermined)", p.at_bound ? "  (at bound)" : "");
+    // A nuisance parameter's name already carries its test ("<test>:payload_mass_kg").
+    const std::string& name = p.name;
+    std::cout << fmt::format("{:<12} {:>13} {:>13} {:>11} {:>9} {:>10}{}{}\n", name,
+                             FormatNumber(p.value), FormatNumber(p.initial), FormatNumber(p.std),
+                             FormatNumber(p.relative_std), p.units,
+                             p.determined ? "" : "  (undetermined: " + p.why_undetermined + ")",
+                             p.at_bound ? "  (at bound)" : "");
+  }
+  for (const std::string& line : updating::DescribeGlobalSearch(search)) {
+    std::cout << line << "\n";
+  }
+  for (const std::string& reason : result.credibility) {
+    std::cout << "credibility: " << reason << "\n";
   }
   if (!result.undetermined.empty()) {
     std::cout << fmt::format("undetermined by the records: {}\n",
@@ -138,17 +150,12 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     }
   }
 
-  std::string start = "scenario";
   std::string note;
   const auto algebraic = SolveAlgebraicRoute(*model, tests.front().identified, tests.front().record,
                                              tests.front().excitation, settings, &note);
-  // Route 1 only informs the start: its failure is reported, the fit starts from the scenario.
-  if (algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)) {
-    start = "route1";
-  }
   if (!common.quiet) {
-    std::cerr << fmt::format("mbid: route 1: {}; route 2 starts from {}{}\n",
-                             algebraic ? algebraic->status_name() : "not run", start,
+    std::cerr << fmt::format("mbid: route 1: {}{}\n",
+                             algebraic ? algebraic->status_name() : "not run",
                              note.empty() ? "" : " (" + note + ")");
   }
 
@@ -159,12 +166,19 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     WeighByIdentifiedNoise(test.identified, record);
     records.push_back(std::move(record));
   }
-  updating::UpdateResult result = updating::UpdateModel(*model, records, settings.options);
-  if (algebraic) updating::MarkAlgebraicAmbiguity(*algebraic, result);
+  std::string start;
+  const updating::GlobalSearchResult search =
+      TuneModel(*model, records, settings, algebraic.get(), &start, &note,
+                [&common](const std::string& line) {
+                  if (!common.quiet) std::cerr << "mbid: " << line << "\n";
+                });
+  const updating::UpdateResult& result = search.best;
 
   const bool converged = result.termination == updating::UpdateResult::Termination::kConverged;
   nlohmann::json summary = updating::UpdateResultToJson(result, algebraic.get());
+  updating::AddGlobalSearchToJson(search, summary);
   summary["start"] = start;
+  if (!search.minima.empty()) summary["best_start"] = search.minima.front().starts.front();
   summary["import"] = nlohmann::json::array();
   summary["release"] = nlohmann::json::array();
   for (const LoadedTest& test : tests) {
@@ -185,6 +199,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     file.WriteMeasurement(tests.front().record);
     file.WriteScenarioYaml(scenario.yaml_text);
     updating::WriteUpdatingGroup(file, result, algebraic.get());
+    updating::WriteGlobalSearchGroup(file, search);
     // Where each DATA file was cut: its release in the file's own time (t = 0 of the test).
     Eigen::VectorXd release_s(static_cast<Eigen::Index>(tests.size()));
     std::vector<std::string> how, files;
@@ -201,7 +216,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   for (const std::string& warning : result.warnings) {
     if (!common.quiet) std::cerr << "mbid: warning: " << warning << "\n";
   }
-  if (common.json_path != "-") PrintSummary(result, algebraic.get(), start);
+  if (common.json_path != "-") PrintSummary(result, algebraic.get(), start, search);
   if (!converged) {
     std::cerr << fmt::format("mbid: numerical failure: updating: {}: {}\n",
                              result.termination_name(), result.message);

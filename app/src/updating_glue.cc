@@ -77,6 +77,28 @@ std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
           settings.algebraic));
 }
 
+updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
+                                       const std::vector<updating::TestRecord>& records,
+                                       updating::UpdatingSettings settings,
+                                       const updating::CharacteristicResult* algebraic,
+                                       std::string* start, std::string* note,
+                                       const std::function<void(const std::string&)>& say) {
+  *start = "scenario";
+  bool from_route1 = false;
+  if (algebraic != nullptr) {
+    std::string why;
+    from_route1 = updating::ApplyAlgebraicStart(*algebraic, settings.options, &why);
+    if (from_route1) *start = "route1";
+    if (!why.empty()) *note = note->empty() ? why : *note + "; " + why;
+  }
+  std::vector<updating::SearchStart> starts;
+  if (algebraic != nullptr) starts = updating::MakeAlgebraicStarts(*algebraic, from_route1);
+  updating::GlobalSearchResult search = updating::SearchGlobally(
+      model, records, settings.options, *start, starts, settings.global_search, say);
+  if (algebraic != nullptr) updating::MarkAlgebraicAmbiguity(*algebraic, search.best);
+  return search;
+}
+
 void WeighByIdentifiedNoise(const identification::ModalResult& identified,
                             updating::TestRecord& record) {
   for (size_t c = 0; c < identified.channels.size(); ++c) {

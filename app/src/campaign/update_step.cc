@@ -22,22 +22,21 @@ void RunUpdateStep(const StepInput& input, CaseOutcome& outcome) {
   updating::UpdatingSettings settings = scenario.ReadUpdating(model);
   settings.options.quiet = true;  // the campaign reports progress, not each fit
 
-  std::string start = "scenario";
+  std::string start;
   std::string note;
   const auto algebraic = input.identified
                              ? SolveAlgebraicRoute(model, *input.identified, input.test->measured,
                                                    scenario.excitation, settings, &note)
                              : nullptr;
   if (!input.identified) note = "no identify step";
-  if (algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)) {
-    start = "route1";
-  }
   updating::TestRecord test =
       updating::MakeTestRecord(outcome.id, input.test->measured, scenario.excitation, settings);
   if (input.identified) WeighByIdentifiedNoise(*input.identified, test);
-  auto result = std::make_shared<updating::UpdateResult>(
-      updating::UpdateModel(model, {test}, settings.options));
-  if (algebraic) updating::MarkAlgebraicAmbiguity(*algebraic, *result);
+  // The campaign's workers share the machine: each case searches on one thread.
+  settings.global_search.threads = 1;
+  const updating::GlobalSearchResult search =
+      TuneModel(model, {test}, settings, algebraic.get(), &start, &note, {});
+  auto result = std::make_shared<updating::UpdateResult>(search.best);
   // The only number of the fit that depends on the machine and its load: a campaign's file must
   // be the same bit for bit whoever ran the case, so it is not recorded (NaN).
   result->wall_time_s = std::numeric_limits<double>::quiet_NaN();
@@ -47,6 +46,8 @@ void RunUpdateStep(const StepInput& input, CaseOutcome& outcome) {
   row["updated.start"] = start;
   if (!note.empty()) row["updated.start_note"] = note;
   row["updated.iterations"] = result->iterations;
+  row["updated.minima"] = static_cast<int>(search.minima.size());
+  row["updated.non_unique"] = search.non_unique;
   row["updated.cost_initial"] = Number(result->initial_cost);
   row["updated.cost_final"] = Number(result->final_cost);
   row["updated.rank"] = result->rank;

@@ -15,7 +15,9 @@
 #include <thread>
 
 #include "baseline.h"
+#include "credibility.h"
 #include "mbid/common/yaml_reader.h"
+#include "mbid/identification/updating/global_search.h"
 #include "mbid/simulation/sensitivity.h"
 #include "mbid/simulation/simulate.h"
 #include "statistics.h"
@@ -983,10 +985,9 @@ UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestReco
   return result;
 }
 
-}  // namespace
-
-UpdateResult UpdateModel(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
-                         const UpdateOptions& options) {
+// UpdateModel before its credibility check.
+UpdateResult FitStages(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
+                       const UpdateOptions& options) {
   const auto start_time = std::chrono::steady_clock::now();
   std::string why;
   if (!options.IsValid(&why)) {
@@ -1062,6 +1063,25 @@ UpdateResult UpdateModel(const model::MechanicalModel& model, const std::vector<
   result.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return result;
+}
+
+}  // namespace
+
+UpdateResult UpdateModel(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
+                         const UpdateOptions& options) {
+  UpdateResult result = FitStages(model, tests, options);
+  AssessCredibility(result, tests, options);
+  return result;
+}
+
+std::vector<ParameterSetting> ResolveParameterSettings(const model::MechanicalModel& model,
+                                                       const UpdateOptions& options) {
+  std::vector<ParameterSetting> settings;
+  for (const Unknown& unknown : ResolveUnknowns(model, {}, options)) {
+    settings.push_back(
+        {unknown.name, unknown.initial, unknown.lower, unknown.upper, unknown.log_scale});
+  }
+  return settings;
 }
 
 }  // namespace mbid::updating

@@ -129,16 +129,19 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
   std::vector<std::string> names;
   for (const ParameterEstimate& p : result.parameters) {
     names.push_back(p.name);
-    nlohmann::json entry = {{"value", Number(p.value)},
-                            {"initial", Number(p.initial)},
-                            {"lower", Number(p.lower)},
-                            {"upper", Number(p.upper)},
-                            {"std", Number(p.std)},
-                            {"units", p.units},
-                            {"relative_std", Number(p.relative_std)},
-                            {"determined", p.determined},
-                            {"at_bound", p.at_bound}};
+    nlohmann::json entry = {
+        {"value", Number(p.value)},
+        {"initial", Number(p.initial)},
+        {"lower", Number(p.lower)},
+        {"upper", Number(p.upper)},
+        {"std", Number(p.std)},
+        {"units", p.units},
+        {"relative_std", Number(p.relative_std)},
+        {"determined", p.determined},
+        {"at_bound", p.at_bound},
+        {"interval", nlohmann::json::array({Number(p.interval_lower), Number(p.interval_upper)})}};
     if (!p.test.empty()) entry["test"] = p.test;
+    if (!p.why_undetermined.empty()) entry["why_undetermined"] = p.why_undetermined;
     parameters[p.name] = entry;
   }
   json["parameters"] = parameters;
@@ -167,6 +170,11 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
   }
   json["parameter_correlation"] = {{"names", names}, {"matrix", matrix}};
   json["warnings"] = result.warnings;
+  json["credibility"] = {{"credible", result.credible},
+                         {"chi_square_per_dof", Number(result.chi_square_per_dof)},
+                         {"weights_from_records", result.weights_from_records},
+                         {"std_inflation", Number(result.std_inflation)},
+                         {"reasons", result.credibility}};
   json["tests"] = nlohmann::json::array();
   for (const TestFit& test : result.tests) {
     nlohmann::json estimated = nlohmann::json::object();
@@ -178,6 +186,11 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
                             {"noise_std", PerName(test.channels, test.noise_std)},
                             {"noise_estimated", estimated},
                             {"residual_rms", PerName(test.channels, test.residual_rms)}};
+    if (test.correlation_time.size() > 0) {
+      entry["whiteness"] = {{"ljung_box_q", PerName(test.channels, test.whiteness_q)},
+                            {"p_value", PerName(test.channels, test.whiteness_p)},
+                            {"correlation_time", PerName(test.channels, test.correlation_time)}};
+    }
     if (test.offset.size() > 0) {
       entry["offset"] = BaselineTerm(test, test.offset, test.offset_std, "");
     }
@@ -273,7 +286,14 @@ void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,
     file.WriteScalar(group, "upper", p.upper, p.units);
     file.WriteScalar(group, "std", p.std, p.units);
     file.WriteScalar(group, "relative_std", p.relative_std, "1");
+    file.WriteScalar(group, "interval_lower", p.interval_lower, p.units);
+    file.WriteScalar(group, "interval_upper", p.interval_upper, p.units);
+    file.WriteStringAttribute(group, "determined", p.determined ? "1" : "0");
   }
+  file.WriteStringAttribute(root, "credible", result.credible ? "1" : "0");
+  file.WriteScalar(root, "chi_square_per_dof", result.chi_square_per_dof, "1");
+  file.WriteScalar(root, "std_inflation", result.std_inflation, "1");
+  file.WriteStrings(root, "credibility", result.credibility);
   file.WriteStrings(root, "parameter_names", names);
   file.WriteMatrix(root, "parameter_correlation", result.correlation, "1");
   file.WriteMatrix(root, "covariance", result.covariance, "1");
@@ -332,6 +352,100 @@ void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,
                    "1");
   file.WriteScalar(root + "/work", "wall_time_s", result.wall_time_s, "s");
   if (algebraic != nullptr) WriteCharacteristicGroup(file, *algebraic, root + "/algebraic");
+}
+
+namespace {
+
+nlohmann::json MinimumToJson(const SearchMinimum& minimum) {
+  nlohmann::json values = nlohmann::json::object();
+  for (const ParameterEstimate& p : minimum.fit.parameters) values[p.name] = Number(p.value);
+  return {{"parameters", values},
+          {"cost", Number(minimum.cost)},
+          {"f_statistic", Number(minimum.f_statistic)},
+          {"p_value", Number(minimum.p_value)},
+          {"starts", minimum.starts},
+          {"differs_in", minimum.differs_in},
+          {"alternative", minimum.alternative},
+          {"iterations", minimum.fit.iterations},
+          {"wall_time_s", Number(minimum.fit.wall_time_s)}};
+}
+
+}  // namespace
+
+void AddGlobalSearchToJson(const GlobalSearchResult& search, nlohmann::json& json) {
+  json["non_unique"] = search.non_unique;
+  json["alternatives"] = nlohmann::json::array();
+  nlohmann::json minima = nlohmann::json::array();
+  for (size_t m = 0; m < search.minima.size(); ++m) {
+    nlohmann::json entry = MinimumToJson(search.minima[m]);
+    if (m > 0 && search.minima[m].alternative) json["alternatives"].push_back(entry);
+    minima.push_back(entry);
+  }
+  json["search"] = {{"starts", search.starts},
+                    {"screened", search.screened},
+                    {"full_fits", search.full_fits},
+                    {"residual_count", search.residual_count},
+                    {"wall_time_s", Number(search.wall_time_s)},
+                    {"screen_time_s", Number(search.screen_time_s)},
+                    {"differing", search.differing},
+                    {"notes", search.notes},
+                    {"minima", minima}};
+}
+
+void WriteGlobalSearchGroup(H5Writer& file, const GlobalSearchResult& search,
+                            const std::string& group) {
+  file.WriteStringAttribute(group, "non_unique", search.non_unique ? "1" : "0");
+  file.WriteScalar(group, "starts", search.starts, "1");
+  file.WriteScalar(group, "screened", search.screened, "1");
+  file.WriteScalar(group, "full_fits", search.full_fits, "1");
+  file.WriteStrings(group, "differing", search.differing);
+  const Eigen::Index count = static_cast<Eigen::Index>(search.minima.size());
+  if (count == 0) return;
+  std::vector<std::string> names;
+  for (const ParameterEstimate& p : search.minima.front().fit.parameters) names.push_back(p.name);
+  Eigen::VectorXd cost(count), f(count), p_value(count), alternative(count);
+  Eigen::MatrixXd values(count, static_cast<Eigen::Index>(names.size()));
+  for (Eigen::Index m = 0; m < count; ++m) {
+    const SearchMinimum& minimum = search.minima[static_cast<size_t>(m)];
+    cost[m] = minimum.cost;
+    f[m] = minimum.f_statistic;
+    p_value[m] = minimum.p_value;
+    alternative[m] = minimum.alternative ? 1.0 : 0.0;
+    for (size_t k = 0; k < names.size(); ++k) {
+      values(m, static_cast<Eigen::Index>(k)) = minimum.fit.Find(names[k]).value;
+    }
+  }
+  file.WriteVector(group, "cost", cost, "1");
+  file.WriteVector(group, "f_statistic", f, "1");
+  file.WriteVector(group, "p_value", p_value, "1");
+  file.WriteVector(group, "alternative", alternative, "1");
+  file.WriteMatrix(group, "values", values, "1");
+  file.WriteStrings(group, "parameter_names", names);
+}
+
+std::vector<std::string> DescribeGlobalSearch(const GlobalSearchResult& search) {
+  std::vector<std::string> lines;
+  if (search.minima.empty()) return lines;
+  std::ostringstream line;
+  line << "global search: " << search.starts << " starts, " << search.full_fits
+       << " whole-record fits, " << search.minima.size() << " distinct minima; best from "
+       << search.minima.front().starts.front();
+  lines.push_back(line.str());
+  for (size_t m = 1; m < search.minima.size(); ++m) {
+    const SearchMinimum& minimum = search.minima[m];
+    std::ostringstream text;
+    text << (minimum.alternative ? "  alternative" : "  worse minimum") << " (from "
+         << minimum.starts.front() << "): cost " << minimum.cost << ", F = " << minimum.f_statistic
+         << ", p = " << minimum.p_value << "; differs in";
+    for (const std::string& name : minimum.differs_in) text << " " << name;
+    lines.push_back(text.str());
+  }
+  if (search.non_unique) {
+    std::string list;
+    for (const std::string& name : search.differing) list += (list.empty() ? "" : ", ") + name;
+    lines.push_back("NON-UNIQUE: the records do not single out one minimum; undetermined: " + list);
+  }
+  return lines;
 }
 
 }  // namespace mbid::updating

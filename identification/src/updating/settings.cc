@@ -3,11 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <thread>
 
 #include "mbid/simulation/scenario_sections.h"
 
 namespace mbid::updating {
 namespace {
+
+// Local fits of the global search in parallel: its result does not depend on the count.
+int DefaultSearchThreads() {
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
 
 std::vector<std::string> ParameterNames(const model::MechanicalModel& model) {
   std::vector<std::string> names;
@@ -75,6 +81,27 @@ CharacteristicOptions ReadAlgebraic(const YamlReader& node, CharacteristicOption
   return o;
 }
 
+GlobalSearchOptions ReadGlobalSearch(const YamlReader& node, GlobalSearchOptions o) {
+  node.ExpectMap({"enabled", "design_starts", "seed", "screen_fraction", "screen_iterations",
+                  "full_fits", "cluster_tolerance", "significance", "threads"});
+  o.enabled = node.Bool("enabled", o.enabled);
+  o.design_starts = node.Int("design_starts", o.design_starts);
+  const int seed = node.Int("seed", static_cast<int>(o.seed));
+  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
+  o.seed = static_cast<std::uint64_t>(seed);
+  o.screen_fraction = node.PositiveDouble("screen_fraction", o.screen_fraction);
+  o.screen_iterations = node.Int("screen_iterations", o.screen_iterations);
+  o.full_fits = node.Int("full_fits", o.full_fits);
+  o.cluster_tolerance = node.PositiveDouble("cluster_tolerance", o.cluster_tolerance);
+  o.significance = node.PositiveDouble("significance", o.significance);
+  const int threads = node.Int("threads", 0);
+  if (threads < 0) node.FailAt("threads", "negative thread count", "0 (hardware) or more");
+  o.threads = threads > 0 ? threads : DefaultSearchThreads();
+  std::string why;
+  if (!o.IsValid(&why)) node.Fail(why, "valid global search options (docs/scenarios.md)");
+  return o;
+}
+
 }  // namespace
 
 UpdatingSettings MakeDefaultUpdatingSettings(const model::MechanicalModel& model,
@@ -87,6 +114,7 @@ UpdatingSettings MakeDefaultUpdatingSettings(const model::MechanicalModel& model
   }
   settings.options.integrator = integrator;
   settings.options.integrator.interpolate_outputs = true;
+  settings.global_search.threads = DefaultSearchThreads();
   return settings;
 }
 
@@ -115,6 +143,7 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
                                 "continuation_fractions",
                                 "integrator",
                                 "sensitivity",
+                                "global_search",
                                 "algebraic"};
   // Residual weights in each channel's unit: noise_std_rad, noise_std_mps2, ...
   for (const std::string& key : simulation::UnitKeys("noise_std")) keys.push_back(key);
@@ -233,6 +262,9 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
   if (node.Has("sensitivity")) {
     options.sensitivity = ReadSensitivity(node.Child("sensitivity"), options.sensitivity);
   }
+  if (node.Has("global_search")) {
+    settings.global_search = ReadGlobalSearch(node.Child("global_search"), settings.global_search);
+  }
   if (node.Has("algebraic")) {
     settings.algebraic = ReadAlgebraic(node.Child("algebraic"), settings.algebraic);
   }
@@ -252,6 +284,7 @@ bool ApplyAlgebraicStart(const CharacteristicResult& algebraic, UpdateOptions& o
   }
   const CharacteristicSolution& set = algebraic.solutions[static_cast<size_t>(algebraic.chosen)];
   UpdateOptions changed = options;
+  int applied = 0;
   for (size_t i = 0; i < algebraic.coordinates.size(); ++i) {
     const Eigen::Index k = static_cast<Eigen::Index>(i);
     for (const auto& [name, value] :
@@ -267,10 +300,30 @@ bool ApplyAlgebraicStart(const CharacteristicResult& algebraic, UpdateOptions& o
         return fail(reason.str());
       }
       setting->initial = value;
+      ++applied;
     }
   }
+  if (applied == 0) return fail("every tuned parameter has an explicit start");
   options = changed;
   return true;
+}
+
+std::vector<SearchStart> MakeAlgebraicStarts(const CharacteristicResult& algebraic,
+                                             bool skip_chosen) {
+  std::vector<SearchStart> starts;
+  for (size_t s = 0; s < algebraic.solutions.size(); ++s) {
+    const CharacteristicSolution& set = algebraic.solutions[s];
+    if (!set.admissible || (skip_chosen && static_cast<int>(s) == algebraic.chosen)) continue;
+    SearchStart start;
+    start.label = "route1 set " + std::to_string(s);
+    for (size_t i = 0; i < algebraic.coordinates.size(); ++i) {
+      const Eigen::Index k = static_cast<Eigen::Index>(i);
+      start.values["c_" + algebraic.coordinates[i]] = set.c[k];
+      start.values["d_" + algebraic.coordinates[i]] = set.d[k];
+    }
+    starts.push_back(start);
+  }
+  return starts;
 }
 
 std::vector<std::string> MarkAlgebraicAmbiguity(const CharacteristicResult& algebraic,

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -7,6 +8,7 @@
 #include "mbid/common/measurement.h"
 #include "mbid/identification/modal_result.h"
 #include "mbid/identification/updating/characteristic.h"
+#include "mbid/identification/updating/global_search.h"
 #include "mbid/identification/updating/output_error.h"
 #include "mbid/identification/updating/settings.h"
 #include "mbid/model/mechanical_model.h"
@@ -26,6 +28,17 @@ std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
     const model::MechanicalModel& model, const identification::ModalResult& identified,
     const Measurement& record, const simulation::Excitation& excitation,
     const updating::UpdatingSettings& settings, std::string* note);
+
+// Route 2 as every command runs it: from Route 1's chosen set when it applies (else the
+// scenario's values), with the other admissible Route-1 sets and the settings' space-filling
+// design as further starts of the global search (global_search.h); Route 1's ambiguity marks the
+// result too. `start` gets the primary start's label ("route1" or "scenario").
+updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
+                                       const std::vector<updating::TestRecord>& records,
+                                       updating::UpdatingSettings settings,
+                                       const updating::CharacteristicResult* algebraic,
+                                       std::string* start, std::string* note,
+                                       const std::function<void(const std::string&)>& say);
 
 // The identification's residual noise weighs the channels whose weights the settings leave open.
 void WeighByIdentifiedNoise(const identification::ModalResult& identified,

@@ -99,6 +99,15 @@ struct UpdateOptions {
   // Ceres' own limit for inverting J^T J, a reciprocal condition number of 1e-14).
   double undetermined_relative_std = 0.3;
   double rank_tolerance = 1e-7;
+  // Credibility of the Fisher standard deviations (credibility.cc). With weights from the
+  // record's own noise (the identification's residual), 2 cost / (N - k) is about 1 when the
+  // model explains the record; above `max_chi_square_per_dof` the fit does not (a local
+  // minimum, or a model that lacks something) and no parameter is reported determined. Between
+  // 1 and it, and for residuals whose integrated autocorrelation time over `whiteness_lags` lags
+  // exceeds 1 (not white), the standard deviations are inflated by sqrt(chi^2/dof * time) before
+  // the undetermined test, and the result says so.
+  double max_chi_square_per_dof = 4.0;
+  int whiteness_lags = 20;
   // Ceres' Levenberg-Marquardt starts with this trust region radius (Ceres' default is 1e4):
   // strong regularization at first keeps the early steps from jumping into the far local
   // minima that oscillatory records have.
@@ -131,6 +140,11 @@ struct ParameterEstimate {
   double relative_std = std::numeric_limits<double>::quiet_NaN();
   bool determined = true;
   bool at_bound = false;  // within 1e-6 (relative) of a bound: the std means little there
+  // Approximate 95% interval: value */ exp(2 relative_std std_inflation) for log-scale
+  // parameters, value -+ 2 std std_inflation otherwise; open (infinite) when undefined.
+  double interval_lower = -std::numeric_limits<double>::infinity();
+  double interval_upper = std::numeric_limits<double>::infinity();
+  std::string why_undetermined;  // empty when determined
 };
 
 struct IterationRecord {
@@ -162,6 +176,10 @@ struct TestFit {
   // parameters' uncertainty.
   Eigen::VectorXd offset, offset_std;
   Eigen::VectorXd drift, drift_std;
+  // Per channel, the weighted residual's whiteness: Ljung-Box Q over UpdateOptions::
+  // whiteness_lags lags, its p-value (chi-square), and the integrated autocorrelation time
+  // 1 + 2 sum rho_k (1 for white noise; how many samples one independent one is worth).
+  Eigen::VectorXd whiteness_q, whiteness_p, correlation_time;
 };
 
 struct UpdateResult {
@@ -184,6 +202,16 @@ struct UpdateResult {
   int rank = 0;
   std::vector<std::string> undetermined;
   std::vector<std::string> warnings;
+  // Credibility (UpdateOptions::max_chi_square_per_dof): chi^2 per degree of freedom of the
+  // weighted cost, whether every weight came from the records' noise (else some were estimated
+  // from this fit's residual, which makes chi^2/dof 1 by construction), the factor the
+  // standard deviations were inflated by for the undetermined test and the intervals, and in
+  // words why the Fisher numbers are not to be taken as they are (empty: credible).
+  double chi_square_per_dof = std::numeric_limits<double>::quiet_NaN();
+  bool weights_from_records = false;
+  double std_inflation = 1;
+  bool credible = true;
+  std::vector<std::string> credibility;
   std::vector<TestFit> tests;
   // Work: simulations (with and without sensitivities), right-hand-side evaluations (all
   // kinds), wall time.

@@ -6,6 +6,7 @@
 
 #include "mbid/common/hdf5_io.h"
 #include "mbid/identification/updating/characteristic.h"
+#include "mbid/identification/updating/global_search.h"
 #include "mbid/identification/updating/output_error.h"
 
 namespace mbid::updating {
@@ -61,5 +62,22 @@ void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,
 // velocity_mismatch vectors.
 void WriteCharacteristicGroup(H5Writer& file, const CharacteristicResult& result,
                               const std::string& group = "/updating/algebraic");
+
+// The global search in the `update` JSON (interfaces.md): "non_unique", "alternatives" (the
+// other minima of indistinguishable cost: {"parameters": {name: value}, "cost", "f_statistic",
+// "p_value", "starts", "differs_in"}) and "search" {"starts", "screened", "full_fits",
+// "residual_count", "wall_time_s", "differing", "notes", "minima": [every distinct minimum as an
+// alternative is, with "alternative": true|false]}.
+void AddGlobalSearchToJson(const GlobalSearchResult& search, nlohmann::json& json);
+
+// /updating/search: attributes non_unique (0/1); starts, screened, full_fits; differing
+// (strings); per distinct minimum (rows, by ascending cost) cost, f_statistic, p_value,
+// alternative (0/1), and values (minima x parameters) with parameter_names.
+void WriteGlobalSearchGroup(H5Writer& file, const GlobalSearchResult& search,
+                            const std::string& group = "/updating/search");
+
+// Console lines: how many minima the search found and, for each alternative, its cost and the
+// parameters in which it differs from the best.
+std::vector<std::string> DescribeGlobalSearch(const GlobalSearchResult& search);
 
 }  // namespace mbid::updating

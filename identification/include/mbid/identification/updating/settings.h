@@ -5,6 +5,7 @@
 
 #include "mbid/common/yaml_reader.h"
 #include "mbid/identification/updating/characteristic.h"
+#include "mbid/identification/updating/global_search.h"
 #include "mbid/identification/updating/output_error.h"
 #include "mbid/model/mechanical_model.h"
 #include "mbid/simulation/integrator_options.h"
@@ -58,6 +59,16 @@ namespace mbid::updating {
 //       relative_tolerance: 1.0e-6         # looser than the state's on purpose
 //       absolute_tolerance: 1.0e-8         # divided by each parameter's magnitude
 //       error_control: true
+//     global_search:                       # Route 2 from many starts (global_search.h)
+//       enabled: true
+//       design_starts: 12                  # space-filling points over the bounds
+//       seed: 1
+//       screen_fraction: 0.3               # design points fitted on this much of each record
+//       screen_iterations: 20
+//       full_fits: 3                       # whole-record fits from the best screened ends
+//       cluster_tolerance: 0.02            # relative distance of one minimum's end points
+//       significance: 0.05                 # F-test level of an alternative minimum
+//       threads: 0                         # parallel local fits; 0: one per hardware thread
 //     algebraic:                           # Route 1 (eq. 7)
 //       starts: 100                        # multi-start points
 //       seed: 1
@@ -70,6 +81,7 @@ namespace mbid::updating {
 struct UpdatingSettings {
   UpdateOptions options;  // parameters carry NaN where the section gives no start or bounds
   CharacteristicOptions algebraic;
+  GlobalSearchOptions global_search;  // threads resolved (0 in the file: hardware threads)
   bool algebraic_start = true;
   std::map<std::string, double> noise_std;  // per channel; empty: not given
   bool fit_payload_mass = false;
@@ -95,6 +107,11 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& updating,
 // every such start lies within the parameter's explicit bounds; `why` says why not.
 bool ApplyAlgebraicStart(const CharacteristicResult& algebraic, UpdateOptions& options,
                          std::string* why = nullptr);
+
+// Every admissible Route-1 set as a start of the global search ("route1 set <i>", i its index
+// in `algebraic.solutions`), except `skip_chosen`'s chosen set.
+std::vector<SearchStart> MakeAlgebraicStarts(const CharacteristicResult& algebraic,
+                                             bool skip_chosen);
 
 // When Route 1's choice was ambiguous, the parameters in which its rival sets differ from the
 // chosen one by more than `relative_difference` are not determined by the record either, even
