@@ -29,6 +29,13 @@
 namespace mbid::app {
 namespace {
 
+// A test's `updating` JSON: the best minimum's fit with the global search beside it.
+nlohmann::json TestUpdatingJson(const RunTest& test) {
+  nlohmann::json json = updating::UpdateResultToJson(test.tuned, test.algebraic.get());
+  updating::AddGlobalSearchToJson(test.search, json);
+  return json;
+}
+
 namespace fs = std::filesystem;
 
 // Progress lines on standard error, with the time since the start.
@@ -120,6 +127,7 @@ void WriteTestGroups(H5Writer& run, const RunTest& test, const std::string& root
   }
   identification::WriteModalResult(run, test.identified, root + "/identification");
   updating::WriteUpdatingGroup(run, test.tuned, test.algebraic.get(), root + "/updating");
+  updating::WriteGlobalSearchGroup(run, test.search, root + "/updating/search");
   const updating::TestFit& fit = test.tuned.tests.front();
   const std::string validation = root + "/validation";
   run.WriteStringAttribute(validation, "passed", test.passed ? "true" : "false");
@@ -308,6 +316,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   summary["identification"] = identification::ModalResultToJson(first.identified);
   if (first.release) summary["release"] = first.release->ToJson();
   summary["updating"] = updating::UpdateResultToJson(first.tuned, first.algebraic.get());
+  updating::AddGlobalSearchToJson(first.search, summary["updating"]);
   if (!scenario.records.empty()) {
     nlohmann::json list = nlohmann::json::array();
     for (const RunTest& test : tests) {
@@ -317,7 +326,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
                       {"sample_interval_s", test.measured.sample_interval_s},
                       {"channels", test.measured.channels},
                       {"identification", identification::ModalResultToJson(test.identified)},
-                      {"updating", updating::UpdateResultToJson(test.tuned, test.algebraic.get())},
+                      {"updating", TestUpdatingJson(test)},
                       {"validation", TestValidationJson(test, threshold)}});
       if (test.import) list.back()["import"] = ImportReportToJson(*test.import);
       if (test.release) list.back()["release"] = test.release->ToJson();

@@ -11,6 +11,7 @@
 #include "mbid/identification/modal_result.h"
 #include "mbid/identification/options.h"
 #include "mbid/identification/updating/characteristic.h"
+#include "mbid/identification/updating/global_search.h"
 #include "mbid/identification/updating/output_error.h"
 #include "mbid/identification/updating/settings.h"
 #include "mbid/model/mechanical_model.h"
@@ -34,11 +35,13 @@ struct RunTest {
   identification::ModalResult identified;
   std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, if it ran
   std::string start_note;                                           // where Route 2 started
-  updating::UpdateResult tuned;
-  bool passed = false;  // verdict == "passed"
-  // "passed": the re-simulation correlates at least at the threshold on every channel and the
-  // identification is reliable; "failed": some channel below the threshold; "inconclusive": the
-  // correlations pass but the identification is not to be trusted. `reasons` says why.
+  updating::GlobalSearchResult search;  // Route 2 from many starts (global_search.h)
+  updating::UpdateResult tuned;         // its best minimum
+  bool passed = false;                  // verdict == "passed"
+  // "passed": the re-simulation correlates at least at the threshold on every channel, the
+  // identification is reliable, every tuned joint parameter is determined, the minimum is unique
+  // and the Fisher numbers are credible; "failed": some channel below the threshold;
+  // "inconclusive": the correlations pass but something else is missing. `reasons` says why.
   std::string verdict = "failed";
   std::vector<std::string> reasons;
 };

@@ -93,6 +93,10 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
   }
   std::vector<updating::SearchStart> starts;
   if (algebraic != nullptr) starts = updating::MakeAlgebraicStarts(*algebraic, from_route1);
+  // Route 1 ran on as many poles as coordinates (SolveAlgebraicRoute) and solved: its sets are
+  // every joint set with these poles.
+  settings.global_search.complete_starts =
+      algebraic != nullptr && algebraic->status == updating::CharacteristicResult::Status::kSolved;
   updating::GlobalSearchResult search = updating::SearchGlobally(
       model, records, settings.options, *start, starts, settings.global_search, say);
   if (algebraic != nullptr) updating::MarkAlgebraicAmbiguity(*algebraic, search.best);

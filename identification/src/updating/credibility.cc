@@ -1,4 +1,4 @@
-#include "credibility.h"
+#include "mbid/identification/updating/credibility.h"
 
 #include <fmt/format.h>
 

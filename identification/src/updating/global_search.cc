@@ -8,11 +8,15 @@
 #include <boost/math/distributions/fisher_f.hpp>
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <random>
 #include <set>
 #include <thread>
 
 #include "mbid/common/error.h"
+#include "mbid/identification/updating/characteristic.h"
+#include "mbid/model/linear_model.h"
 
 namespace mbid::updating {
 namespace {
@@ -123,6 +127,51 @@ UpdateOptions StartOptions(const UpdateOptions& options,
 
 bool Converged(const UpdateResult& result) {
   return result.termination == UpdateResult::Termination::kConverged;
+}
+
+// Every other admissible solution of eq. 7 for the exact poles of `model` carrying `fit`'s
+// values, as starts; none unless every coordinate has a tuned spring and damper and all its
+// modes oscillate.
+std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& model,
+                                              const UpdateResult& fit, std::uint64_t seed) {
+  std::vector<SearchStart> starts;
+  if (!FindFreeCoordinate(model).empty()) return starts;
+  std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
+  ApplyEstimates(fit, *tuned);
+  const model::LinearModel linear = tuned->Linearize();
+  for (const std::string& coordinate : linear.coordinates) {
+    for (const std::string& name : {"c_" + coordinate, "d_" + coordinate}) {
+      bool found = false;
+      for (const ParameterEstimate& p : fit.parameters) found = found || p.name == name;
+      if (!found) return starts;
+    }
+  }
+  std::vector<std::complex<double>> lambda;
+  for (const model::Mode& mode : model::CalcModes(linear)) {
+    if (mode.lambda.imag() > 0) lambda.push_back(mode.lambda);
+  }
+  if (static_cast<int>(lambda.size()) != tuned->coordinate_count()) return starts;
+  CharacteristicOptions options;
+  options.seed = seed;
+  const CharacteristicResult sets = SolveCharacteristicEquation(
+      MakeCharacteristicProblem(*tuned, lambda, std::nullopt, std::nullopt), options);
+  for (size_t s = 0; s < sets.solutions.size(); ++s) {
+    const CharacteristicSolution& set = sets.solutions[s];
+    if (!set.admissible) continue;
+    SearchStart start;
+    start.label = fmt::format("pole-equivalent set {}", s);
+    bool same = true;  // the tuned set itself (to eq. 7's convergence)
+    for (size_t i = 0; i < sets.coordinates.size(); ++i) {
+      const Eigen::Index k = static_cast<Eigen::Index>(i);
+      const std::string c = "c_" + sets.coordinates[i], d = "d_" + sets.coordinates[i];
+      start.values[c] = set.c[k];
+      start.values[d] = set.d[k];
+      same = same && std::abs(set.c[k] / fit.Find(c).value - 1) < 1e-3 &&
+             std::abs(set.d[k] / fit.Find(d).value - 1) < 1e-3;
+    }
+    if (!same) starts.push_back(start);
+  }
+  return starts;
 }
 
 }  // namespace
@@ -241,13 +290,42 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     given.erase(given.begin());
   }
 
-  // The design: shared parameters only, uniform in Ceres' coordinates over the bounds.
+  // The given starts on the whole records, in parallel.
+  const auto batch_start = std::chrono::steady_clock::now();
+  if (!given.empty()) {
+    say(fmt::format("global search: {} given start(s) on the whole records", given.size()));
+  }
+  std::vector<Run> first(given.size());
+  RunParallel(static_cast<int>(given.size()), search.threads, [&](int i) {
+    const size_t index = static_cast<size_t>(i);
+    first[index] = fit_full(given[index].first, given[index].second, local);
+  });
+  full.insert(full.end(), first.begin(), first.end());
+
+  // The design, unless the given starts settle the question: they hold every parameter set
+  // that matches the identified poles (complete_starts) and the best of them explains the
+  // records to their noise, so that no other minimum can fit better and an equally good one
+  // would be among them.
+  bool settled = false;
+  if (search.complete_starts) {
+    for (const Run& run : full) {
+      settled = settled || (!run.failed && Converged(run.fit) && run.fit.weights_from_records &&
+                            run.fit.chi_square_per_dof <= options.max_chi_square_per_dof);
+    }
+  }
+  const int design_count = settled ? 0 : search.design_starts;
+  if (settled) {
+    result.notes.push_back(
+        "no space-filling design: the given starts hold every set that matches the identified "
+        "poles, and the best of them fits the records to their noise");
+  }
   std::vector<std::map<std::string, double>> design;
   for (const std::vector<double>& point :
-       SpaceFillingDesign(search.design_starts, static_cast<int>(settings.size()), search.seed)) {
+       SpaceFillingDesign(design_count, static_cast<int>(settings.size()), search.seed)) {
     std::map<std::string, double> values;
     for (size_t k = 0; k < settings.size(); ++k) {
       const ParameterSetting& s = settings[k];
+      // Uniform in Ceres' coordinates over the bounds.
       values[s.name] =
           s.log_scale
               ? std::exp(std::log(s.lower) + point[k] * (std::log(s.upper) - std::log(s.lower)))
@@ -257,41 +335,34 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   }
   result.starts = static_cast<int>(given.size() + design.size()) + (all_given ? 0 : 1);
 
-  // Given starts in full and design points on the windows, all in parallel.
-  say(
-      fmt::format("global search: {} given start(s) on the whole records, {} design points on "
-                  "the first {:.0f}% of each",
-                  given.size(), design.size(), 100 * search.screen_fraction));
+  // Design points on the first part of each record, in parallel.
+  if (!design.empty()) {
+    say(fmt::format("global search: {} design points on the first {:.0f}% of each record",
+                    design.size(), 100 * search.screen_fraction));
+  }
   const std::vector<TestRecord> windows = Window(weighted, search.screen_fraction);
   UpdateOptions screen = local;
   screen.max_iterations = search.screen_iterations;
   screen.continuation_fractions.clear();
-  const auto batch_start = std::chrono::steady_clock::now();
-  std::vector<Run> batch(given.size() + design.size());
+  std::vector<Run> batch(design.size());
   RunParallel(static_cast<int>(batch.size()), search.threads, [&](int i) {
-    const size_t index = static_cast<size_t>(i);
-    if (index < given.size()) {
-      batch[index] = fit_full(given[index].first, given[index].second, local);
-      return;
-    }
-    const size_t d = index - given.size();
+    const size_t d = static_cast<size_t>(i);
     Run run{fmt::format("design {}", d + 1), {}, false};
     try {
       run.fit = UpdateModel(model, windows, StartOptions(screen, settings, design[d]));
     } catch (const std::exception& e) {
       run.failed = true;
     }
-    batch[index] = run;
+    batch[d] = run;
   });
   result.screen_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - batch_start).count();
-  for (size_t i = 0; i < given.size(); ++i) full.push_back(batch[i]);
   result.screened = static_cast<int>(design.size());
 
   // The best distinct screened ends (a failed window fit has nothing to offer), minus those
   // already reached by a whole-record fit.
   std::vector<size_t> order;
-  for (size_t i = given.size(); i < batch.size(); ++i) {
+  for (size_t i = 0; i < batch.size(); ++i) {
     if (!batch[i].failed && batch[i].fit.termination != UpdateResult::Termination::kFailure &&
         std::isfinite(batch[i].fit.final_cost)) {
       order.push_back(i);
@@ -309,7 +380,10 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     }
     if (!known) chosen.push_back(i);
   }
-  say(fmt::format("global search: {} screened end(s) fitted on the whole records", chosen.size()));
+  if (!chosen.empty()) {
+    say(fmt::format("global search: {} screened end(s) fitted on the whole records",
+                    chosen.size()));
+  }
   std::vector<Run> refits(chosen.size());
   RunParallel(static_cast<int>(chosen.size()), search.threads, [&](int i) {
     const Run& screened = batch[chosen[static_cast<size_t>(i)]];
@@ -320,6 +394,37 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     refits[static_cast<size_t>(i)] = fit_full(screened.label, values, local);
   });
   full.insert(full.end(), refits.begin(), refits.end());
+
+  // The sets with the best end's own poles (eq. 7 on the tuned model's exact modes): joints
+  // trading roles give the same frequencies and dampings and differ only in what the record's
+  // mode shapes show, so a poorly excited mode leaves such a set as good a fit. The design
+  // finds them by chance; eq. 7 lists them.
+  if (search.pole_equivalent_starts && !search.complete_starts) {
+    const Run* provisional = nullptr;
+    for (const Run& run : full) {
+      if (run.failed || !Converged(run.fit)) continue;
+      if (provisional == nullptr || run.fit.final_cost < provisional->fit.final_cost) {
+        provisional = &run;
+      }
+    }
+    std::vector<SearchStart> equivalent;
+    if (provisional != nullptr) {
+      equivalent = PoleEquivalentStarts(model, provisional->fit, search.seed);
+    }
+    if (!equivalent.empty()) {
+      say(
+          fmt::format("global search: {} set(s) with the best end's poles (eq. 7) fitted on the "
+                      "whole records",
+                      equivalent.size()));
+    }
+    std::vector<Run> more(equivalent.size());
+    RunParallel(static_cast<int>(equivalent.size()), search.threads, [&](int i) {
+      const SearchStart& start = equivalent[static_cast<size_t>(i)];
+      more[static_cast<size_t>(i)] = fit_full(start.label, start.values, local);
+    });
+    full.insert(full.end(), more.begin(), more.end());
+    result.starts += static_cast<int>(equivalent.size());
+  }
   result.full_fits = static_cast<int>(full.size());
 
   // Distinct minima among the converged whole-record fits, by ascending cost (ties: start

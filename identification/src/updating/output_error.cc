@@ -15,8 +15,8 @@
 #include <thread>
 
 #include "baseline.h"
-#include "credibility.h"
 #include "mbid/common/yaml_reader.h"
+#include "mbid/identification/updating/credibility.h"
 #include "mbid/identification/updating/global_search.h"
 #include "mbid/simulation/sensitivity.h"
 #include "mbid/simulation/simulate.h"

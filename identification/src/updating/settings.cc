@@ -83,7 +83,9 @@ CharacteristicOptions ReadAlgebraic(const YamlReader& node, CharacteristicOption
 
 GlobalSearchOptions ReadGlobalSearch(const YamlReader& node, GlobalSearchOptions o) {
   node.ExpectMap({"enabled", "design_starts", "seed", "screen_fraction", "screen_iterations",
-                  "full_fits", "cluster_tolerance", "significance", "threads"});
+                  "full_fits", "cluster_tolerance", "significance", "threads",
+                  "pole_equivalent_starts"});
+  o.pole_equivalent_starts = node.Bool("pole_equivalent_starts", o.pole_equivalent_starts);
   o.enabled = node.Bool("enabled", o.enabled);
   o.design_starts = node.Int("design_starts", o.design_starts);
   const int seed = node.Int("seed", static_cast<int>(o.seed));

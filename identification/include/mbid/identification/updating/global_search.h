@@ -41,6 +41,14 @@ struct GlobalSearchOptions {
   // at this level.
   double significance = 0.05;
   int threads = 1;  // local fits in parallel (each fit then runs single-threaded)
+  // The given starts hold every parameter set that matches the identified poles (Route 1
+  // solved on as many modes as coordinates): when the best of them fits the records to their
+  // noise, the design is skipped (an equally good minimum reproduces the poles, so it is one of
+  // them). Set by the caller.
+  bool complete_starts = false;
+  // Otherwise the sets with the best end's own poles (eq. 7 on its exact modes: joints that
+  // trade roles) are fitted too; each is a candidate alternative the design may have missed.
+  bool pole_equivalent_starts = true;
 
   bool IsValid(std::string* why) const;
 };

@@ -69,6 +69,7 @@ namespace mbid::updating {
 //       cluster_tolerance: 0.02            # relative distance of one minimum's end points
 //       significance: 0.05                 # F-test level of an alternative minimum
 //       threads: 0                         # parallel local fits; 0: one per hardware thread
+//       pole_equivalent_starts: true       # also fit the other sets with the best's poles
 //     algebraic:                           # Route 1 (eq. 7)
 //       starts: 100                        # multi-start points
 //       seed: 1
