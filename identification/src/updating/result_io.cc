@@ -361,6 +361,7 @@ nlohmann::json MinimumToJson(const SearchMinimum& minimum) {
   for (const ParameterEstimate& p : minimum.fit.parameters) values[p.name] = Number(p.value);
   return {{"parameters", values},
           {"cost", Number(minimum.cost)},
+          {"initial_cost", Number(minimum.fit.initial_cost)},
           {"f_statistic", Number(minimum.f_statistic)},
           {"p_value", Number(minimum.p_value)},
           {"starts", minimum.starts},

@@ -79,6 +79,7 @@ struct GlobalSearchResult {
   std::vector<std::string> differing;  // parameters in which the alternatives differ from it
   int starts = 0;                      // given + design
   int screened = 0;                    // design points fitted on the windows
+  int pole_equivalent = 0;             // sets with the best end's poles (eq. 7)
   int full_fits = 0;                   // whole-record local fits
   int residual_count = 0;              // samples x channels over the tests
   double wall_time_s = 0;
