@@ -33,7 +33,7 @@ namespace {
 
 // One sensitivity run: a test on its model.
 struct Job {
-  const model::MechanicalModel* model = nullptr;
+  const model::MechanicalModel* model = nullptr;  // this job's own copy
   const TestDesign* test = nullptr;
   FisherInformation result;
   std::exception_ptr error;
@@ -85,29 +85,26 @@ TestPlan PlanNextTest(const model::MechanicalModel& model, const std::vector<Tes
   for (Eigen::Index k = 0; k < n; ++k) {
     plan.values[k] = model.GetParameter(plan.parameters[static_cast<size_t>(k)]);
   }
-  // Each candidate on its own model with the plan's values of the tuned parameters.
-  std::vector<std::unique_ptr<model::MechanicalModel>> candidate_models;
+  // Every test on a model of its own: simulations change a model's internal state (loads,
+  // caches), so tests in parallel must not share one. A candidate's own model gets the plan's
+  // values of the tuned parameters.
+  std::vector<std::unique_ptr<model::MechanicalModel>> models;
+  std::vector<Job> jobs;
+  for (const TestDesign& test : recorded) {
+    models.push_back(model.Clone());
+    jobs.push_back({models.back().get(), &test, {}, nullptr});
+  }
   for (const PlanCandidate& candidate : candidates) {
-    if (!candidate.model) {
-      candidate_models.emplace_back();
-      continue;
-    }
-    candidate_models.push_back(candidate.model->Clone());
-    for (Eigen::Index k = 0; k < n; ++k) {
+    models.push_back(candidate.model ? candidate.model->Clone() : model.Clone());
+    for (Eigen::Index k = 0; k < n && candidate.model; ++k) {
       try {
-        candidate_models.back()->SetParameter(plan.parameters[static_cast<size_t>(k)],
-                                              plan.values[k]);
+        models.back()->SetParameter(plan.parameters[static_cast<size_t>(k)], plan.values[k]);
       } catch (const InputError& e) {
         throw InputError(candidate.name, "model", e.what(),
                          "a model with the tuned parameters of the scenario's");
       }
     }
-  }
-  std::vector<Job> jobs;
-  for (const TestDesign& test : recorded) jobs.push_back({&model, &test, {}, nullptr});
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    const model::MechanicalModel* own = candidate_models[i].get();
-    jobs.push_back({own != nullptr ? own : &model, &candidates[i].test, {}, nullptr});
+    jobs.push_back({models.back().get(), &candidate.test, {}, nullptr});
   }
   RunJobs(jobs, plan.parameters, options);
 
