@@ -41,7 +41,8 @@ struct TestDesign {
 // The design of a recorded test as UpdateModel fits it: the record's own samples (its start
 // after the release, rate, length, channels), excitation and offset switches, with the noise
 // per channel `noise_std` (TestFit::noise_std, the weights of the fit, in the record's channel
-// order) and the fit's integrator.
+// order) and the fit's integrator. Its nuisance parameters (fit_payload_mass,
+// fit_initial_deflection) are taken as known: the design carries no information about them.
 TestDesign MakeRecordedDesign(const TestRecord& test, const Eigen::VectorXd& noise_std,
                               const simulation::IntegratorOptions& integrator);
 
