@@ -1,6 +1,7 @@
 // `mbid plan`: ranks candidate tests by the information they add to the recorded ones
 // (D-optimal, updating/plan.h) at the estimate the recorded tests give (as `mbid update`).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <iostream>
@@ -94,6 +95,8 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   std::vector<updating::TestDesign> recorded;
   std::map<std::string, double> recorded_noise;
   std::string estimate_source = "scenario";
+  std::vector<std::string> recorded_undetermined;
+  bool non_unique = false;
   if (!tests.empty()) {
     const RecordedUpdate update =
         UpdateFromTests(*model, tests, settings, [&common](const std::string& line) {
@@ -105,6 +108,10 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
                                            ": " + result.message);
     }
     updating::ApplyEstimates(result, *model);
+    // What the fit itself leaves undetermined, by its std and by other minima of equal fit
+    // (the global search): the plan's F is local to this estimate and does not see the latter.
+    recorded_undetermined = result.undetermined;
+    non_unique = update.search.non_unique;
     estimate_source = "estimated";
     // The noise of each channel: the weights of the fit (the identification's residual noise
     // unless the updating section gives one), averaged over the tests that have the channel.
@@ -157,13 +164,24 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   summary["estimate_source"] = estimate_source;
   summary["recorded_tests"] = data_paths;
   summary["recorded_score"] = Number(plan.recorded_score);
+  summary["recorded_undetermined"] = recorded_undetermined;
+  summary["recorded_non_unique"] = non_unique;
   summary["current_relative_std"] = PerParameter(plan.parameters, plan.current_relative_std);
   summary["undetermined_relative_std"] = options.undetermined_relative_std;
   summary["score"] =
       "log det(F_recorded + F_candidate + ridge I), F the Fisher information in log coordinates";
   summary["wall_time_s"] = plan.wall_time_s;
   if (!common.json_path.empty()) WriteJson(summary, common.json_path);
-  if (common.json_path != "-") PrintPlan(plan, estimate_source);
+  if (common.json_path != "-") {
+    PrintPlan(plan, estimate_source);
+    if (!recorded_undetermined.empty()) {
+      std::cout << fmt::format("the recorded tests' fit leaves undetermined: {}{}\n",
+                               fmt::join(recorded_undetermined, ", "),
+                               non_unique ? " (other minima of equal fit: the plan is local to the "
+                                            "best one)"
+                                          : "");
+    }
+  }
   return 0;
 }
 
