@@ -171,6 +171,19 @@ int Main(int argc, char** argv) {
   update->add_option("-o,--output", output_path, "Write /measurement, /scenario, /updating (.h5)");
   update->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
 
+  std::vector<std::string> plan_data;
+  std::string plan_candidates;
+  CLI::App* plan = app.add_subcommand(
+      "plan", "Rank candidate next tests by the information they add (D-optimal design)");
+  plan->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
+  plan->add_option("DATA", plan_data,
+                   "Recorded tests (.h5, .csv, .txt), one per test; none: "
+                   "plan from the scenario's values");
+  plan->add_option("--candidates", plan_candidates, "Candidate tests (YAML, docs/planning.md)")
+      ->required();
+  AddImportFlags(plan, &import_flags);
+  plan->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -203,6 +216,9 @@ int Main(int argc, char** argv) {
   }
   if (update->parsed()) {
     return mbid::app::RunUpdateCommand(scenario_path, update_data, output_path, common);
+  }
+  if (plan->parsed()) {
+    return mbid::app::RunPlanCommand(scenario_path, plan_data, plan_candidates, common);
   }
   if (modes->parsed()) return mbid::app::RunModesCommand(scenario_path, common);
   if (simulate->parsed()) {

@@ -8,7 +8,9 @@ add_library(mbid_updating
   "${MBID_UPDATING_DIR}/src/updating/characteristic.cc"
   "${MBID_UPDATING_DIR}/src/updating/credibility.cc"
   "${MBID_UPDATING_DIR}/src/updating/global_search.cc"
+  "${MBID_UPDATING_DIR}/src/updating/fisher.cc"
   "${MBID_UPDATING_DIR}/src/updating/output_error.cc"
+  "${MBID_UPDATING_DIR}/src/updating/plan.cc"
   "${MBID_UPDATING_DIR}/src/updating/result_io.cc"
   "${MBID_UPDATING_DIR}/src/updating/settings.cc")
 target_include_directories(mbid_updating PUBLIC "${MBID_UPDATING_DIR}/include")

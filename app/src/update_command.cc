@@ -14,6 +14,7 @@
 #include "mbid/app/commands.h"
 #include "mbid/app/identification_settings.h"
 #include "mbid/app/record_source.h"
+#include "mbid/app/recorded_tests.h"
 #include "mbid/app/scenario.h"
 #include "mbid/app/updating_glue.h"
 #include "mbid/common/error.h"
@@ -28,50 +29,6 @@
 
 namespace mbid::app {
 namespace {
-
-bool IsHdf5(const std::string& path) {
-  const auto ends_with = [&](const std::string& tail) {
-    return path.size() >= tail.size() &&
-           path.compare(path.size() - tail.size(), tail.size(), tail) == 0;
-  };
-  return ends_with(".h5") || ends_with(".hdf5");
-}
-
-// One DATA file: its record, the excitation that produced it and what identification found.
-struct LoadedTest {
-  std::string path;
-  Measurement record;
-  simulation::Excitation excitation;
-  std::string excitation_source;  // "scenario" or the file whose /scenario gave it
-  identification::ModalResult identified;
-  records::ImportReport import;
-  AppliedRelease release;
-};
-
-LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
-                    const model::MechanicalModel& model,
-                    const identification::IdentificationOptions& identification_options,
-                    const ImportOverrides& overrides) {
-  LoadedTest test;
-  test.path = path;
-  test.record =
-      records::ImportMeasurement(path, MergeImportOptions({}, overrides, &model), &test.import);
-  // Checked here rather than left to the fit: identification would run first on any channels.
-  RequireModelOutputs(test.record, path, model);
-  // A simulated test carries its own scenario: its excitation is the one of this record (a load
-  // drop and an initial deflection can then be fitted together).
-  std::optional<simulation::Excitation> own =
-      IsHdf5(path) ? ReadStoredExcitation(path) : std::nullopt;
-  test.excitation = own ? *own : scenario.RequireExcitation();
-  test.excitation_source = own ? path : "scenario";
-  // The simulation of the test starts at the release: the record is cut there.
-  test.release =
-      CutRecordAtRelease(&test.record, path, OverrideRelease({}, overrides), test.excitation);
-
-  test.identified = identification::Identify(
-      test.record, FreeDecayOptions(identification_options, test.excitation), path);
-  return test;
-}
 
 std::string FormatNumber(double value) {
   return std::isfinite(value) ? fmt::format("{:.6g}", value) : std::string("-");
@@ -150,28 +107,14 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     }
   }
 
-  std::string note;
-  const auto algebraic = SolveAlgebraicRoute(*model, tests.front().identified, tests.front().record,
-                                             tests.front().excitation, settings, &note);
-  if (!common.quiet) {
-    std::cerr << fmt::format("mbid: route 1: {}{}\n",
-                             algebraic ? algebraic->status_name() : "not run",
-                             note.empty() ? "" : " (" + note + ")");
-  }
-
-  std::vector<updating::TestRecord> records;
-  for (const LoadedTest& test : tests) {
-    updating::TestRecord record =
-        updating::MakeTestRecord(test.path, test.record, test.excitation, settings);
-    WeighByIdentifiedNoise(test.identified, record);
-    records.push_back(std::move(record));
-  }
-  std::string start;
-  const updating::GlobalSearchResult search =
-      TuneModel(*model, records, settings, algebraic.get(), &start, &note,
-                [&common](const std::string& line) {
-                  if (!common.quiet) std::cerr << "mbid: " << line << "\n";
-                });
+  const RecordedUpdate update =
+      UpdateFromTests(*model, tests, settings, [&common](const std::string& line) {
+        if (!common.quiet) std::cerr << "mbid: " << line << "\n";
+      });
+  const auto& algebraic = update.algebraic;
+  const std::string& start = update.start;
+  const std::string& note = update.note;
+  const updating::GlobalSearchResult& search = update.search;
   const updating::UpdateResult& result = search.best;
 
   const bool converged = result.termination == updating::UpdateResult::Termination::kConverged;

@@ -44,4 +44,9 @@ int RunIdentifyCommand(const std::string& data_path,
 int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::string>& data_paths,
                      const std::string& output_path, const CommonOptions& common);
 
+// `mbid plan SCENARIO [DATA...] --candidates FILE.yaml [--json FILE]`: ranks candidate tests
+// by the information they add to the recorded ones (docs/planning.md), best first.
+int RunPlanCommand(const std::string& scenario_path, const std::vector<std::string>& data_paths,
+                   const std::string& candidates_path, const CommonOptions& common);
+
 }  // namespace mbid::app

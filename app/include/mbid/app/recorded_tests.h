@@ -1,0 +1,64 @@
+#pragma once
+
+// The DATA files of `mbid update` and `mbid plan`: each record read, cut at its release and
+// identified, then all of them tuned together (Route 1 start from the first, Route 2 on all).
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbid/app/record_import.h"
+#include "mbid/app/release_cut.h"
+#include "mbid/app/scenario.h"
+#include "mbid/common/measurement.h"
+#include "mbid/identification/modal_result.h"
+#include "mbid/identification/options.h"
+#include "mbid/identification/updating/characteristic.h"
+#include "mbid/identification/updating/global_search.h"
+#include "mbid/identification/updating/output_error.h"
+#include "mbid/identification/updating/settings.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/records/records.h"
+#include "mbid/simulation/excitation.h"
+
+namespace mbid::app {
+
+// One DATA file: its record, the excitation that produced it and what identification found.
+struct LoadedTest {
+  std::string path;
+  Measurement record;
+  simulation::Excitation excitation;
+  std::string excitation_source;  // "scenario" or the file whose /scenario gave it
+  identification::ModalResult identified;
+  records::ImportReport import;
+  AppliedRelease release;
+};
+
+// Reads `path` (any record format, the overrides of the command line), takes its excitation
+// from the HDF5 file mbid simulated it into or else from the scenario, cuts it at the release
+// and identifies its modes (for the noise levels and Route 1).
+LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
+                    const model::MechanicalModel& model,
+                    const identification::IdentificationOptions& identification_options,
+                    const ImportOverrides& overrides);
+
+// Route 2 on the loaded tests as `mbid update` runs it.
+struct RecordedUpdate {
+  std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, or null
+  std::string start;  // "route1" or "scenario": Route 2's primary start
+  std::string note;   // why Route 1 did not run or was not used, if so
+  std::vector<updating::TestRecord> records;
+  updating::GlobalSearchResult search;  // search.best: the estimate
+};
+
+// Route 1 on the first test's identified poles, then Route 2 on every test with the
+// identification's residual noise as weights, from Route 1's set (else the scenario's values)
+// and the global search's further starts (TuneModel). `settings` as read from the scenario;
+// `say` gets the progress lines (Route 1's status first).
+RecordedUpdate UpdateFromTests(const model::MechanicalModel& model,
+                               const std::vector<LoadedTest>& tests,
+                               const updating::UpdatingSettings& settings,
+                               const std::function<void(const std::string&)>& say);
+
+}  // namespace mbid::app

@@ -1,0 +1,188 @@
+// `mbid plan`: ranks candidate tests by the information they add to the recorded ones
+// (D-optimal, updating/plan.h) at the estimate the recorded tests give (as `mbid update`).
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mbid/app/commands.h"
+#include "mbid/app/plan_candidates.h"
+#include "mbid/app/recorded_tests.h"
+#include "mbid/app/scenario.h"
+#include "mbid/common/error.h"
+#include "mbid/common/json_io.h"
+#include "mbid/identification/updating/fisher.h"
+#include "mbid/identification/updating/output_error.h"
+#include "mbid/identification/updating/plan.h"
+
+namespace mbid::app {
+namespace {
+
+nlohmann::json Number(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json PerParameter(const std::vector<std::string>& names, const Eigen::VectorXd& values) {
+  nlohmann::json out = nlohmann::json::object();
+  for (size_t k = 0; k < names.size(); ++k) {
+    out[names[k]] = Number(values[static_cast<Eigen::Index>(k)]);
+  }
+  return out;
+}
+
+std::string Cell(double relative_std) {
+  return std::isfinite(relative_std) ? fmt::format("{:.3g}", relative_std) : std::string("inf");
+}
+
+void PrintPlan(const updating::TestPlan& plan, const std::string& estimate_source) {
+  std::cout << fmt::format(
+      "plan: {} candidate(s) against {} recorded test(s), at the {} values; score = log det of "
+      "the Fisher information of all tests (log coordinates), best first\n",
+      plan.candidates.size(), plan.recorded_tests, estimate_source);
+  std::string header = fmt::format("{:<20} {:>10} {:>9}", "candidate", "score", "gain");
+  for (const std::string& name : plan.parameters) header += fmt::format(" {:>8}", name);
+  std::cout << header << "\n";
+  if (plan.recorded_tests > 0) {
+    std::string row =
+        fmt::format("{:<20} {:>10.4g} {:>9}", "(recorded only)", plan.recorded_score, "");
+    for (Eigen::Index k = 0; k < plan.current_relative_std.size(); ++k) {
+      row += fmt::format(" {:>8}", Cell(plan.current_relative_std[k]));
+    }
+    std::cout << row << "\n";
+  }
+  for (const updating::CandidateScore& candidate : plan.candidates) {
+    std::string row =
+        fmt::format("{:<20} {:>10.4g} {:>9}", candidate.name, candidate.score,
+                    std::isfinite(candidate.gain) ? fmt::format("{:.4g}", candidate.gain) : "-");
+    for (Eigen::Index k = 0; k < candidate.relative_std.size(); ++k) {
+      row += fmt::format(" {:>8}", Cell(candidate.relative_std[k]));
+    }
+    std::cout << row << "\n";
+  }
+  std::cout << "(columns per parameter: expected relative standard deviation with the recorded "
+               "tests; inf = undetermined)\n";
+}
+
+}  // namespace
+
+int RunPlanCommand(const std::string& scenario_path, const std::vector<std::string>& data_paths,
+                   const std::string& candidates_path, const CommonOptions& common) {
+  const Scenario scenario = LoadScenario(scenario_path);
+  const auto model = scenario.MakeModel();
+  updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
+  settings.options.quiet = common.quiet;
+  // The candidates are checked before any long work starts.
+  CandidateFile file = ReadCandidateFile(candidates_path, scenario, *model);
+  const identification::IdentificationOptions identification_options =
+      scenario.ReadIdentification();
+  std::vector<LoadedTest> tests;
+  for (const std::string& path : data_paths) {
+    tests.push_back(LoadTest(path, scenario, *model, identification_options, common.import));
+  }
+
+  updating::PlanOptions options;
+  options.sensitivity = settings.options.sensitivity;
+  options.rank_tolerance = settings.options.rank_tolerance;
+  options.undetermined_relative_std = settings.options.undetermined_relative_std;
+  options.threads = settings.options.threads;
+  for (const updating::ParameterSetting& setting : settings.options.parameters) {
+    options.parameters.push_back(setting.name);
+  }
+  std::vector<updating::TestDesign> recorded;
+  std::map<std::string, double> recorded_noise;
+  std::string estimate_source = "scenario";
+  std::vector<std::string> recorded_undetermined;
+  bool non_unique = false;
+  if (!tests.empty()) {
+    const RecordedUpdate update =
+        UpdateFromTests(*model, tests, settings, [&common](const std::string& line) {
+          if (!common.quiet) std::cerr << "mbid: " << line << "\n";
+        });
+    const updating::UpdateResult& result = update.search.best;
+    if (result.termination != updating::UpdateResult::Termination::kConverged) {
+      throw NumericalError("updating", "the recorded tests' fit: " + result.termination_name() +
+                                           ": " + result.message);
+    }
+    updating::ApplyEstimates(result, *model);
+    // What the fit itself leaves undetermined, by its std and by other minima of equal fit
+    // (the global search): the plan's F is local to this estimate and does not see the latter.
+    recorded_undetermined = result.undetermined;
+    non_unique = update.search.non_unique;
+    estimate_source = "estimated";
+    // The noise of each channel: the weights of the fit (the identification's residual noise
+    // unless the updating section gives one), averaged over the tests that have the channel.
+    std::map<std::string, std::pair<double, int>> noise_sums;
+    for (size_t t = 0; t < update.records.size(); ++t) {
+      const updating::TestFit& fit = result.tests[t];
+      recorded.push_back(updating::MakeRecordedDesign(update.records[t], fit.noise_std,
+                                                      settings.options.integrator));
+      for (size_t c = 0; c < fit.channels.size(); ++c) {
+        auto& [sum, count] = noise_sums[fit.channels[c]];
+        sum += fit.noise_std[static_cast<Eigen::Index>(c)];
+        ++count;
+      }
+    }
+    for (const auto& [channel, sum_count] : noise_sums) {
+      recorded_noise[channel] = sum_count.first / sum_count.second;
+    }
+  }
+  FillCandidateNoise(file, recorded_noise, scenario.sensors.noise_std);
+  const updating::TestPlan plan =
+      updating::PlanNextTest(*model, recorded, file.candidates, options);
+
+  nlohmann::json summary;
+  summary["candidates"] = nlohmann::json::array();
+  for (const updating::CandidateScore& candidate : plan.candidates) {
+    nlohmann::json item;
+    item["name"] = candidate.name;
+    item["score"] = Number(candidate.score);
+    item["gain"] = Number(candidate.gain);
+    item["expected_relative_std"] = PerParameter(plan.parameters, candidate.relative_std);
+    nlohmann::json determined = nlohmann::json::object();
+    for (size_t k = 0; k < plan.parameters.size(); ++k) {
+      determined[plan.parameters[k]] = static_cast<bool>(candidate.determined[k]);
+    }
+    item["determined"] = determined;
+    item["rank"] = candidate.rank;
+    item["ridge"] = Number(candidate.ridge);
+    for (size_t i = 0; i < file.candidates.size(); ++i) {
+      if (file.candidates[i].name != candidate.name) continue;
+      nlohmann::json noise = nlohmann::json::object();
+      for (const auto& [channel, value] : file.candidates[i].test.sensors.noise_std) {
+        noise[channel] = value;
+      }
+      item["noise_std"] = noise;
+    }
+    summary["candidates"].push_back(item);
+  }
+  summary["parameters"] = plan.parameters;
+  summary["estimate"] = PerParameter(plan.parameters, plan.values);
+  summary["estimate_source"] = estimate_source;
+  summary["recorded_tests"] = data_paths;
+  summary["recorded_score"] = Number(plan.recorded_score);
+  summary["recorded_undetermined"] = recorded_undetermined;
+  summary["recorded_non_unique"] = non_unique;
+  summary["current_relative_std"] = PerParameter(plan.parameters, plan.current_relative_std);
+  summary["undetermined_relative_std"] = options.undetermined_relative_std;
+  summary["score"] =
+      "log det(F_recorded + F_candidate + ridge I), F the Fisher information in log coordinates";
+  summary["wall_time_s"] = plan.wall_time_s;
+  if (!common.json_path.empty()) WriteJson(summary, common.json_path);
+  if (common.json_path != "-") {
+    PrintPlan(plan, estimate_source);
+    if (!recorded_undetermined.empty()) {
+      std::cout << fmt::format("the recorded tests' fit leaves undetermined: {}{}\n",
+                               fmt::join(recorded_undetermined, ", "),
+                               non_unique ? " (other minima of equal fit: the plan is local to the "
+                                            "best one)"
+                                          : "");
+    }
+  }
+  return 0;
+}
+
+}  // namespace mbid::app
