@@ -12,8 +12,7 @@
 #include <vector>
 
 #include "mbid/app/commands.h"
-#include "mbid/app/identification_settings.h"
-#include "mbid/app/record_source.h"
+#include "mbid/app/loaded_test.h"
 #include "mbid/app/scenario.h"
 #include "mbid/app/updating_glue.h"
 #include "mbid/common/error.h"
@@ -28,50 +27,6 @@
 
 namespace mbid::app {
 namespace {
-
-bool IsHdf5(const std::string& path) {
-  const auto ends_with = [&](const std::string& tail) {
-    return path.size() >= tail.size() &&
-           path.compare(path.size() - tail.size(), tail.size(), tail) == 0;
-  };
-  return ends_with(".h5") || ends_with(".hdf5");
-}
-
-// One DATA file: its record, the excitation that produced it and what identification found.
-struct LoadedTest {
-  std::string path;
-  Measurement record;
-  simulation::Excitation excitation;
-  std::string excitation_source;  // "scenario" or the file whose /scenario gave it
-  identification::ModalResult identified;
-  records::ImportReport import;
-  AppliedRelease release;
-};
-
-LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
-                    const model::MechanicalModel& model,
-                    const identification::IdentificationOptions& identification_options,
-                    const ImportOverrides& overrides) {
-  LoadedTest test;
-  test.path = path;
-  test.record =
-      records::ImportMeasurement(path, MergeImportOptions({}, overrides, &model), &test.import);
-  // Checked here rather than left to the fit: identification would run first on any channels.
-  RequireModelOutputs(test.record, path, model);
-  // A simulated test carries its own scenario: its excitation is the one of this record (a load
-  // drop and an initial deflection can then be fitted together).
-  std::optional<simulation::Excitation> own =
-      IsHdf5(path) ? ReadStoredExcitation(path) : std::nullopt;
-  test.excitation = own ? *own : scenario.RequireExcitation();
-  test.excitation_source = own ? path : "scenario";
-  // The simulation of the test starts at the release: the record is cut there.
-  test.release =
-      CutRecordAtRelease(&test.record, path, OverrideRelease({}, overrides), test.excitation);
-
-  test.identified = identification::Identify(
-      test.record, FreeDecayOptions(identification_options, test.excitation), path);
-  return test;
-}
 
 std::string FormatNumber(double value) {
   return std::isfinite(value) ? fmt::format("{:.6g}", value) : std::string("-");
@@ -137,17 +92,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   std::vector<LoadedTest> tests;
   for (const std::string& path : data_paths) {
     tests.push_back(LoadTest(path, scenario, *model, identification_options, common.import));
-    if (!common.quiet) {
-      const LoadedTest& test = tests.back();
-      std::cerr << fmt::format("mbid: {}: {}\n", path, DescribeImport(test.import));
-      std::cerr << fmt::format(
-          "mbid: {}: free decay from {:.6g} s of the record ({}); t = 0 there\n", path,
-          test.release.release_time_s, test.release.how);
-      std::cerr << fmt::format("mbid: {}: {} samples x {} channels, {} ({}), {} modes identified\n",
-                               path, test.record.samples(), test.record.channel_count(),
-                               test.excitation.type_name(), test.excitation_source,
-                               test.identified.modes.size());
-    }
+    if (!common.quiet) DescribeLoadedTest(tests.back());
   }
 
   std::string note;
