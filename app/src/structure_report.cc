@@ -144,6 +144,7 @@ void WriteStructureReport(const updating::StructureRanking& ranking,
     figure.x_label = "rank (table of the report)";
     figure.y_label = "criterion - best + 1";
     figure.log_y = true;
+    figure.key = "bottom right box opaque";
     figure.pad_x = true;
     const Eigen::Index n = static_cast<Eigen::Index>(ranking.structures.size());
     double best_aic = INFINITY;
