@@ -39,12 +39,12 @@ UpdateOptions PrepareOptions(const StructureCandidate& candidate, const UpdateRe
     if (candidate.start_from_reference && reference != nullptr && std::isnan(setting.initial)) {
       for (const ParameterEstimate& estimate : reference->parameters) {
         if (estimate.test.empty() && estimate.name == setting.name) {
-          setting.initial = estimate.value;
-          // Derived bounds follow the new start; explicit ones stay (and must hold it).
-          if (!std::isnan(setting.lower))
-            setting.initial = std::max(setting.initial, setting.lower);
-          if (!std::isnan(setting.upper))
-            setting.initial = std::min(setting.initial, setting.upper);
+          // The reference's bounds too: bounds derived from the new start would let a parameter
+          // the reference pushed to its bound run 100x further (a joint stiffened 1e4x makes
+          // every simulation of the fit stiff and slow, and means nothing more).
+          if (std::isnan(setting.lower)) setting.lower = estimate.lower;
+          if (std::isnan(setting.upper)) setting.upper = estimate.upper;
+          setting.initial = std::clamp(estimate.value, setting.lower, setting.upper);
         }
       }
     }
@@ -275,7 +275,10 @@ StructureRanking RankStructures(const std::vector<StructureCandidate>& candidate
       for (ParameterSetting& setting : loo.parameters) {
         for (const ParameterEstimate& estimate : fits[i].fit.parameters) {
           if (estimate.test.empty() && estimate.name == setting.name) {
-            setting.initial = estimate.value;
+            // Within the all-record fit's bounds (see PrepareOptions).
+            setting.lower = estimate.lower;
+            setting.upper = estimate.upper;
+            setting.initial = std::clamp(estimate.value, estimate.lower, estimate.upper);
           }
         }
       }
