@@ -56,7 +56,8 @@ nlohmann::json StructureRankingToJson(const updating::StructureRanking& ranking,
     nlohmann::json parameters = nlohmann::json::object();
     nlohmann::json parameter_std = nlohmann::json::object();
     for (const updating::ParameterEstimate& p : fit.fit.parameters) {
-      const std::string name = p.test.empty() ? p.name : p.test + ":" + p.name;
+      // A nuisance parameter's name already carries its test ("<test>:payload_mass_kg").
+      const std::string& name = p.name;
       parameters[name] = Number(p.value);
       parameter_std[name] = Number(p.std);
     }
@@ -240,8 +241,7 @@ void WriteStructureGroup(H5Writer& file, const updating::StructureRanking& ranki
     Eigen::VectorXd stds(values.size());
     for (size_t p = 0; p < fit.fit.parameters.size(); ++p) {
       const updating::ParameterEstimate& estimate = fit.fit.parameters[p];
-      parameters.push_back(estimate.test.empty() ? estimate.name
-                                                 : estimate.test + ":" + estimate.name);
+      parameters.push_back(estimate.name);  // a nuisance one's name carries its test
       values[static_cast<Eigen::Index>(p)] = estimate.value;
       stds[static_cast<Eigen::Index>(p)] = estimate.std;
     }
