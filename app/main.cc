@@ -184,6 +184,26 @@ int Main(int argc, char** argv) {
   AddImportFlags(plan, &import_flags);
   plan->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
 
+  std::vector<std::string> structure_data;
+  int structure_max_rigid = 1;
+  int structure_threads = 0;
+  CLI::App* structure = app.add_subcommand(
+      "structure", "Rank structures (which joints really move) by BIC of their Route 2 fits");
+  structure->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
+  structure->add_option("DATA", structure_data, "Measurement files (.h5, .csv, .txt), one per test")
+      ->required();
+  AddImportFlags(structure, &import_flags);
+  structure
+      ->add_option("--max-rigid", structure_max_rigid,
+                   "Candidates with up to K compliant coordinates made rigid")
+      ->capture_default_str();
+  structure->add_option("--threads", structure_threads,
+                        "Fits side by side (default: one per core)");
+  structure->add_option("-o,--output", output_path,
+                        "Write /measurement, /scenario, /structure (.h5) and the report beside it");
+  structure->add_option("--json", common.json_path,
+                        "Write the JSON summary to FILE ('-' = stdout)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -219,6 +239,10 @@ int Main(int argc, char** argv) {
   }
   if (plan->parsed()) {
     return mbid::app::RunPlanCommand(scenario_path, plan_data, plan_candidates, common);
+  }
+  if (structure->parsed()) {
+    return mbid::app::RunStructureCommand(scenario_path, structure_data, structure_max_rigid,
+                                          structure_threads, output_path, common);
   }
   if (modes->parsed()) return mbid::app::RunModesCommand(scenario_path, common);
   if (simulate->parsed()) {

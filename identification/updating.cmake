@@ -12,8 +12,9 @@ add_library(mbid_updating
   "${MBID_UPDATING_DIR}/src/updating/output_error.cc"
   "${MBID_UPDATING_DIR}/src/updating/plan.cc"
   "${MBID_UPDATING_DIR}/src/updating/result_io.cc"
-  "${MBID_UPDATING_DIR}/src/updating/settings.cc")
+  "${MBID_UPDATING_DIR}/src/updating/settings.cc"
+  "${MBID_UPDATING_DIR}/src/updating/structure.cc")
 target_include_directories(mbid_updating PUBLIC "${MBID_UPDATING_DIR}/include")
 target_link_libraries(mbid_updating
   PUBLIC mbid_simulation mbid_model mbid_common
-  PRIVATE Ceres::ceres mbid_simbody mbid_cvodes mbid_warnings)
+  PRIVATE Ceres::ceres fmt::fmt mbid_simbody mbid_cvodes mbid_warnings)

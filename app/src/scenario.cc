@@ -18,6 +18,19 @@ std::unique_ptr<model::MechanicalModel> Scenario::MakeModel() const {
   return model::MakeModel(root.Child("model"));
 }
 
+std::unique_ptr<model::MechanicalModel> Scenario::MakeAlternativeModel(size_t index) const {
+  const std::string& file = structure_alternatives.at(index);
+  if (!std::filesystem::is_regular_file(file)) {
+    throw InputError(path, "structure.alternatives[" + std::to_string(index) + "]",
+                     "cannot open '" + file + "'", "a readable YAML file with a model: section");
+  }
+  const YamlReader alternative = YamlReader::FromFile(file);
+  if (!alternative.IsMap() || !alternative.Has("model")) {
+    alternative.Fail("no model: section", "a YAML file with a model: section");
+  }
+  return model::MakeModel(alternative.Child("model"));
+}
+
 identification::IdentificationOptions Scenario::ReadIdentification() const {
   return root.Has("identification") ? ReadIdentificationSettings(root.Child("identification"))
                                     : identification::IdentificationOptions();
@@ -47,11 +60,11 @@ constexpr double kMaxSamples = 1e8;
 }  // namespace
 
 Scenario LoadScenarioFromText(const std::string& text, const std::string& source) {
-  Scenario scenario{source, "", text, YamlReader::FromString(text, source), false, {}, {},
-                    {},     {}, 0.95};
+  Scenario scenario{source, "",   text, YamlReader::FromString(text, source), false, {}, {}, {},
+                    {},     0.95, {}};
   if (!scenario.root.IsMap()) scenario.root.Fail("not a mapping", "a YAML mapping of sections");
   scenario.root.ExpectMap({"name", "model", "excitation", "simulation", "sensors", "record",
-                           "identification", "updating", "validation"});
+                           "identification", "updating", "validation", "structure"});
   scenario.name = scenario.root.String("name");
   // Any other name is made a safe folder name where it names the results folder.
   if (scenario.name.empty()) scenario.root.FailAt("name", "''", "a non-empty name");
@@ -86,6 +99,20 @@ Scenario LoadScenarioFromText(const std::string& text, const std::string& source
         fmt::format("{:g} s at {:g} Hz is {:.3g} samples per channel",
                     scenario.simulation.duration_s, scenario.sensors.sample_rate_hz, samples),
         fmt::format("2 to {:g} samples (duration_s x sample_rate_hz + 1)", kMaxSamples));
+  }
+  if (scenario.root.Has("structure")) {
+    const YamlReader structure = scenario.root.Child("structure");
+    structure.ExpectMap({"alternatives"});
+    const std::filesystem::path folder = std::filesystem::path(source).parent_path();
+    for (const std::string& file : structure.StringList("alternatives")) {
+      const std::filesystem::path given(file);
+      scenario.structure_alternatives.push_back(
+          given.is_absolute() || folder.empty() ? file : (folder / given).string());
+    }
+    // Every alternative's model is built now, so that its errors surface at load time.
+    for (size_t i = 0; i < scenario.structure_alternatives.size(); ++i) {
+      scenario.MakeAlternativeModel(i);
+    }
   }
   if (scenario.root.Has("record")) {
     const std::filesystem::path folder = std::filesystem::path(source).parent_path();

@@ -12,8 +12,7 @@
 #include <vector>
 
 #include "mbid/app/commands.h"
-#include "mbid/app/identification_settings.h"
-#include "mbid/app/record_source.h"
+#include "mbid/app/loaded_test.h"
 #include "mbid/app/recorded_tests.h"
 #include "mbid/app/scenario.h"
 #include "mbid/app/updating_glue.h"
@@ -94,17 +93,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   std::vector<LoadedTest> tests;
   for (const std::string& path : data_paths) {
     tests.push_back(LoadTest(path, scenario, *model, identification_options, common.import));
-    if (!common.quiet) {
-      const LoadedTest& test = tests.back();
-      std::cerr << fmt::format("mbid: {}: {}\n", path, DescribeImport(test.import));
-      std::cerr << fmt::format(
-          "mbid: {}: free decay from {:.6g} s of the record ({}); t = 0 there\n", path,
-          test.release.release_time_s, test.release.how);
-      std::cerr << fmt::format("mbid: {}: {} samples x {} channels, {} ({}), {} modes identified\n",
-                               path, test.record.samples(), test.record.channel_count(),
-                               test.excitation.type_name(), test.excitation_source,
-                               test.identified.modes.size());
-    }
+    if (!common.quiet) DescribeLoadedTest(tests.back());
   }
 
   const RecordedUpdate update =

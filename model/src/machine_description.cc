@@ -73,7 +73,16 @@ bool MachineDescription::IsTranslational(const std::string& coordinate) const {
       return body.joint.type == JointType::kPrismatic;
     }
   }
-  return false;
+  const RigidCoordinate* rigid = FindRigid(coordinate);
+  return rigid != nullptr && rigid->translational;
+}
+
+const MachineDescription::RigidCoordinate* MachineDescription::FindRigid(
+    const std::string& coordinate) const {
+  for (const RigidCoordinate& rigid : rigid_coordinates) {
+    if (rigid.name == coordinate) return &rigid;
+  }
+  return nullptr;
 }
 
 const SpringDescription* MachineDescription::FindSpring(const std::string& coordinate) const {
@@ -205,6 +214,12 @@ void MachineDescription::Validate() const {
     }
   }
 
+  for (const RigidCoordinate& rigid : rigid_coordinates) {
+    if (coordinate_names.count(rigid.name)) {
+      Fail("bodies", "coordinate '" + rigid.name + "' both moves and is rigid",
+           "a rigid coordinate that no joint has");
+    }
+  }
   const std::vector<std::string> all_coordinates = coordinates();
   std::set<std::string> sprung;
   for (const SpringDescription& spring : springs) {
@@ -255,7 +270,7 @@ void MachineDescription::Validate() const {
     if (!output_names.insert(output.name).second) Fail(field, "output named twice", "each once");
     switch (output.type) {
       case OutputType::kCoordinate:
-        if (!coordinate_names.count(output.coordinate)) {
+        if (!coordinate_names.count(output.coordinate) && !FindRigid(output.coordinate)) {
           Fail(field + ".coordinate", "unknown coordinate '" + output.coordinate + "'",
                "one of " + JoinNames(all_coordinates));
         }

@@ -282,9 +282,12 @@ struct MultibodyModel::Impl {
       output.body_frame = description.body_frame;
       output.direction = description.direction.normalized();
       if (description.type == OutputType::kCoordinate) {
-        output.coordinate = static_cast<int>(
-            std::find(coordinates.begin(), coordinates.end(), description.coordinate) -
-            coordinates.begin());
+        // A rigid coordinate (MachineDescription::rigid_coordinates) stays -1: it reads 0.
+        const auto found =
+            std::find(coordinates.begin(), coordinates.end(), description.coordinate);
+        if (found != coordinates.end()) {
+          output.coordinate = static_cast<int>(found - coordinates.begin());
+        }
       } else if (!description.body.empty()) {
         output.body = body_index.at(description.body);
       } else {
@@ -733,7 +736,7 @@ Eigen::VectorXd MultibodyModel::CalcOutputs(const SimTK::State& state) const {
     double value = 0;
     switch (output.type) {
       case OutputType::kCoordinate:
-        value = q[output.coordinate];
+        value = output.coordinate >= 0 ? q[output.coordinate] : 0.0;
         break;
       case OutputType::kAzimuth:
       case OutputType::kElevation: {

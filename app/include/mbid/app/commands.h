@@ -49,4 +49,13 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
 int RunPlanCommand(const std::string& scenario_path, const std::vector<std::string>& data_paths,
                    const std::string& candidates_path, const CommonOptions& common);
 
+// `mbid structure SCENARIO DATA [DATA...] [--max-rigid K] [-o FILE.h5] [--json FILE]`: ranks
+// the candidate structures (the model, the model with up to `max_rigid` compliant coordinates
+// made rigid, the scenario's `structure.alternatives`) by BIC of their Route 2 fits
+// (docs/structure.md); `threads` fits side by side (0: one per core). -o also writes the report
+// beside the file (FILE.md, FILE-criteria.png).
+int RunStructureCommand(const std::string& scenario_path,
+                        const std::vector<std::string>& data_paths, int max_rigid, int threads,
+                        const std::string& output_path, const CommonOptions& common);
+
 }  // namespace mbid::app

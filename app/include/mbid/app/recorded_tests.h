@@ -1,16 +1,14 @@
 #pragma once
 
-// The DATA files of `mbid update` and `mbid plan`: each record read, cut at its release and
-// identified, then all of them tuned together (Route 1 start from the first, Route 2 on all).
+// The DATA files of `mbid update` and `mbid plan` (loaded_test.h) tuned together: Route 1 start
+// from the first, Route 2 on all.
 
 #include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "mbid/app/record_import.h"
-#include "mbid/app/release_cut.h"
-#include "mbid/app/scenario.h"
+#include "mbid/app/loaded_test.h"
 #include "mbid/common/measurement.h"
 #include "mbid/identification/modal_result.h"
 #include "mbid/identification/options.h"
@@ -23,25 +21,6 @@
 #include "mbid/simulation/excitation.h"
 
 namespace mbid::app {
-
-// One DATA file: its record, the excitation that produced it and what identification found.
-struct LoadedTest {
-  std::string path;
-  Measurement record;
-  simulation::Excitation excitation;
-  std::string excitation_source;  // "scenario" or the file whose /scenario gave it
-  identification::ModalResult identified;
-  records::ImportReport import;
-  AppliedRelease release;
-};
-
-// Reads `path` (any record format, the overrides of the command line), takes its excitation
-// from the HDF5 file mbid simulated it into or else from the scenario, cuts it at the release
-// and identifies its modes (for the noise levels and Route 1).
-LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
-                    const model::MechanicalModel& model,
-                    const identification::IdentificationOptions& identification_options,
-                    const ImportOverrides& overrides);
 
 // Route 2 on the loaded tests as `mbid update` runs it.
 struct RecordedUpdate {

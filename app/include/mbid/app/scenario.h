@@ -31,9 +31,15 @@ struct Scenario {
   // `validation: {min_correlation: K}`: the run passes when the re-simulation with the tuned
   // parameters correlates with the record at least this well on every channel.
   double validation_min_correlation = 0.95;
+  // `structure: {alternatives: [file, ...]}`: other descriptions of the machine for
+  // `mbid structure` to rank beside the model's own rigid variants; paths resolved against the
+  // scenario's folder, each a YAML file with a `model:` section (a scenario file will do).
+  std::vector<std::string> structure_alternatives;
 
   // A fresh model instance (one per worker).
   std::unique_ptr<model::MechanicalModel> MakeModel() const;
+  // The model of structure_alternatives[index], checked as the scenario's own.
+  std::unique_ptr<model::MechanicalModel> MakeAlternativeModel(size_t index) const;
   // The `identification:` section, or the identifier's defaults.
   identification::IdentificationOptions ReadIdentification() const;
   // The `updating:` section for `model`, or the defaults; the fits integrate with the

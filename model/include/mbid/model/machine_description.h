@@ -79,12 +79,21 @@ struct MachineDescription {
   // equilibrium (the springs' preload is that of the machine without it).
   double attached_payload_kg = 0.0;
   std::vector<OutputDescription> outputs;
+  // Coordinates made rigid in code (rigid_coordinates.h), not a description key: their joints
+  // are welds now, so they are not among coordinates(), but an output of type coordinate may
+  // still name one and reads 0 (a sensor on a joint that does not move).
+  struct RigidCoordinate {
+    std::string name;
+    bool translational = false;  // m (a prismatic joint's) or rad
+  };
+  std::vector<RigidCoordinate> rigid_coordinates;
 
   // Coordinate names in tree order (the order of q).
   std::vector<std::string> coordinates() const;
-  // True for coordinates of prismatic joints (m), false for angles (rad).
+  // True for coordinates of prismatic joints (m), false for angles (rad); rigid coordinates too.
   bool IsTranslational(const std::string& coordinate) const;
   const SpringDescription* FindSpring(const std::string& coordinate) const;
+  const RigidCoordinate* FindRigid(const std::string& coordinate) const;
 
   // Throws InputError (source "machine description", the key path as field) on the contract's
   // load checks, for descriptions built in code.

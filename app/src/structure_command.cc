@@ -1,0 +1,172 @@
+// `mbid structure`: which degrees of freedom the records support (the paper's sub-problem 4).
+// Candidates: the scenario's model, its variants with up to K compliant coordinates rigid, and
+// the scenario's alternative descriptions; each fitted by Route 2 and ranked by BIC
+// (updating/structure.h, docs/structure.md).
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "mbid/app/commands.h"
+#include "mbid/app/loaded_test.h"
+#include "mbid/app/scenario.h"
+#include "mbid/app/structure_report.h"
+#include "mbid/app/updating_glue.h"
+#include "mbid/common/error.h"
+#include "mbid/common/hdf5_io.h"
+#include "mbid/common/json_io.h"
+#include "mbid/identification/updating/settings.h"
+#include "mbid/identification/updating/structure.h"
+#include "mbid/model/multibody_model.h"
+#include "mbid/model/rigid_coordinates.h"
+
+namespace mbid::app {
+namespace {
+
+// Route 2's options for a model: the given settings, started from Route 1 on the first record
+// when it gives an admissible set (as `mbid update` does).
+updating::UpdateOptions StartedOptions(const model::MechanicalModel& model,
+                                       updating::UpdatingSettings settings, const LoadedTest& first,
+                                       std::string* start) {
+  std::string note;
+  const auto algebraic =
+      SolveAlgebraicRoute(model, first.identified, first.record, first.excitation, settings, &note);
+  *start = algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)
+               ? "route1"
+               : "scenario";
+  return settings.options;
+}
+
+}  // namespace
+
+int RunStructureCommand(const std::string& scenario_path,
+                        const std::vector<std::string>& data_paths, int max_rigid, int threads,
+                        const std::string& output_path, const CommonOptions& common) {
+  const Scenario scenario = LoadScenario(scenario_path);
+  const auto model = scenario.MakeModel();
+  const auto* multibody = dynamic_cast<const model::MultibodyModel*>(model.get());
+  if (multibody == nullptr) {
+    throw InputError(scenario_path, "model.type", model->type(),
+                     "a machine described by bodies and joints (multibody, truck_crane)");
+  }
+  const std::vector<std::string> compliant = model::CompliantCoordinates(multibody->description());
+  if (max_rigid < 0 || max_rigid > static_cast<int>(compliant.size())) {
+    throw InputError("command line", "--max-rigid", std::to_string(max_rigid),
+                     fmt::format("0 to {} (the compliant coordinates: {})", compliant.size(),
+                                 fmt::join(compliant, ", ")));
+  }
+  if (threads < 0) {
+    throw InputError("command line", "--threads", std::to_string(threads), "0 (all cores) or more");
+  }
+  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+
+  // Outputs are checked before the long work: the folder must exist, nothing of the user's is
+  // overwritten.
+  std::optional<H5Writer> file;
+  std::optional<StructureReportPaths> report;
+  if (!output_path.empty()) {
+    report = ReportPathsBeside(output_path);
+    CheckReportPaths(*report);
+    file.emplace(output_path);
+  }
+
+  const updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
+  const identification::IdentificationOptions identification_options =
+      scenario.ReadIdentification();
+  std::vector<LoadedTest> tests;
+  for (const std::string& path : data_paths) {
+    tests.push_back(LoadTest(path, scenario, *model, identification_options, common.import));
+    if (!common.quiet) DescribeLoadedTest(tests.back());
+  }
+  std::vector<updating::TestRecord> records;
+  for (const LoadedTest& test : tests) {
+    updating::TestRecord record =
+        updating::MakeTestRecord(test.path, test.record, test.excitation, settings);
+    WeighByIdentifiedNoise(test.identified, record);
+    records.push_back(std::move(record));
+  }
+
+  // The candidates: the full model first (its fit's noise weighs all), then each set of rigid
+  // coordinates, then the alternatives.
+  std::vector<updating::StructureCandidate> candidates;
+  std::string start;
+  candidates.push_back({"full",
+                        {},
+                        "",
+                        std::shared_ptr<const model::MechanicalModel>(model->Clone()),
+                        StartedOptions(*model, settings, tests.front(), &start),
+                        false});
+  for (const std::vector<std::string>& rigid : updating::EnumerateRigidSets(compliant, max_rigid)) {
+    // Starts at the full fit's estimates (settings.options: no Route 1 values in it).
+    candidates.push_back({fmt::format("rigid {}", fmt::join(rigid, ",")), rigid, "",
+                          std::make_shared<const model::MultibodyModel>(
+                              model::MakeCoordinatesRigid(*multibody, rigid)),
+                          settings.options, true});
+  }
+  for (size_t i = 0; i < scenario.structure_alternatives.size(); ++i) {
+    std::shared_ptr<const model::MechanicalModel> alternative = scenario.MakeAlternativeModel(i);
+    updating::UpdatingSettings own;
+    try {
+      own = scenario.ReadUpdating(*alternative);
+    } catch (const InputError& error) {
+      // The updating section names the scenario model's parameters; the alternative's are its
+      // own: it is fitted with the defaults.
+      own = updating::MakeDefaultUpdatingSettings(*alternative, scenario.simulation.integrator);
+      if (!common.quiet) {
+        std::cerr << fmt::format(
+            "mbid: {}: the updating section does not fit it ({}); default "
+            "updating settings\n",
+            scenario.structure_alternatives[i], error.what());
+      }
+    }
+    std::string alternative_start;
+    candidates.push_back({scenario.structure_alternatives[i],
+                          {},
+                          scenario.structure_alternatives[i],
+                          alternative,
+                          StartedOptions(*alternative, own, tests.front(), &alternative_start),
+                          false});
+  }
+  if (!common.quiet) {
+    std::cerr << fmt::format(
+        "mbid: {} candidate structures ({} compliant coordinates, up to {} "
+        "rigid), {} records, {} threads; the full model starts from {}\n",
+        candidates.size(), compliant.size(), max_rigid, records.size(), threads, start);
+  }
+
+  updating::StructureOptions options;
+  options.threads = threads;
+  options.search = scenario.ReadUpdating(*model).global_search;
+  options.quiet = common.quiet;
+  const updating::StructureRanking ranking = updating::RankStructures(candidates, records, options);
+
+  nlohmann::json summary = StructureRankingToJson(ranking, data_paths);
+  summary["max_rigid"] = max_rigid;
+  summary["start"] = start;
+  summary["release"] = nlohmann::json::array();
+  for (const LoadedTest& test : tests) {
+    nlohmann::json release = test.release.ToJson();
+    release["file"] = test.path;
+    summary["release"].push_back(release);
+  }
+  if (!common.json_path.empty()) WriteJson(summary, common.json_path);
+  if (file) {
+    file->WriteMeasurement(tests.front().record);
+    file->WriteScenarioYaml(scenario.yaml_text);
+    WriteStructureGroup(*file, ranking);
+    WriteStructureReport(ranking, scenario.name, data_paths, *report);
+    file->Commit();
+  }
+  if (common.json_path != "-") {
+    std::cout << StructureTable(ranking);
+    std::cout << fmt::format("{:.1f} s\n", ranking.wall_time_s);
+  }
+  return 0;
+}
+
+}  // namespace mbid::app
