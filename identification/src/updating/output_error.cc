@@ -671,6 +671,10 @@ bool UpdateOptions::IsValid(std::string* why) const {
     return fail("undetermined_relative_std: " + Format(undetermined_relative_std) +
                 "; expected > 0");
   }
+  if (!(max_chi_square_per_dof > 1)) {
+    return fail("max_chi_square_per_dof must be > 1 (1 is a fit at the noise)");
+  }
+  if (whiteness_lags < 1) return fail("whiteness_lags must be >= 1");
   if (!(rank_tolerance > 0 && rank_tolerance < 1)) {
     return fail("rank_tolerance: " + Format(rank_tolerance) + "; expected a value in (0, 1)");
   }

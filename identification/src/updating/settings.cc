@@ -140,6 +140,8 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
                                 "parameter_tolerance",
                                 "undetermined_relative_std",
                                 "rank_tolerance",
+                                "max_chi_square_per_dof",
+                                "whiteness_lags",
                                 "threads",
                                 "initial_trust_region_radius",
                                 "continuation_fractions",
@@ -243,6 +245,9 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
   options.undetermined_relative_std =
       node.PositiveDouble("undetermined_relative_std", options.undetermined_relative_std);
   options.rank_tolerance = node.PositiveDouble("rank_tolerance", options.rank_tolerance);
+  options.max_chi_square_per_dof =
+      node.PositiveDouble("max_chi_square_per_dof", options.max_chi_square_per_dof);
+  options.whiteness_lags = node.Int("whiteness_lags", options.whiteness_lags);
   options.threads = node.Int("threads", options.threads);
   options.initial_trust_region_radius =
       node.PositiveDouble("initial_trust_region_radius", options.initial_trust_region_radius);

@@ -42,6 +42,8 @@ namespace mbid::updating {
 //     undetermined_relative_std: 0.3       # relative std above which a parameter is reported
 //                                          #   as undetermined by the records
 //     rank_tolerance: 1.0e-7               # singular-value ratio of the numerical null space
+//     max_chi_square_per_dof: 4            # above: the fit does not explain the records
+//     whiteness_lags: 20                   # Ljung-Box lags of the residual's whiteness
 //     threads: 1                           # parallel simulations (tests, sensitivity groups)
 //     initial_trust_region_radius: 10      # Ceres LM; small = cautious first steps
 //     continuation_fractions: []           # e.g. [0.25]: fit the first quarter of each record
