@@ -39,8 +39,9 @@ struct RunTest {
   updating::UpdateResult tuned;         // its best minimum
   bool passed = false;                  // verdict == "passed"
   // "passed": the re-simulation correlates at least at the threshold on every channel, the
-  // identification is reliable, every tuned joint parameter is determined, the minimum is unique
-  // and the Fisher numbers are credible; "failed": some channel below the threshold;
+  // identification is reliable, every tuned joint parameter is determined (on the standard
+  // deviations its credibility check inflated) and the minimum is unique; "failed": some channel
+  // below the threshold;
   // "inconclusive": the correlations pass but something else is missing. `reasons` says why.
   std::string verdict = "failed";
   std::vector<std::string> reasons;

@@ -8,6 +8,7 @@
 #include <boost/math/distributions/fisher_f.hpp>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <random>
@@ -244,7 +245,9 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   local.quiet = true;
   local.threads = 1;
   primary.quiet = true;
-  primary.threads = std::max(options.threads, search.threads);
+  // The user's own thread count: the sensitivity groups change CVODES' error control, so a count
+  // tied to the search's would change the bits with it.
+  primary.threads = options.threads;
   std::vector<TestRecord> weighted = tests;
   bool all_given = true;
   for (const TestRecord& test : tests) {
@@ -294,17 +297,63 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     given.erase(given.begin());
   }
 
-  // The given starts on the whole records, in parallel.
+  // Only starts near the best known cost can end as alternatives: one iteration gives a start's
+  // cost, and those above kPromisingCostRatio times the best are left out (measured on the
+  // crane: other Route-1 sets and pole-equivalent sets whose shapes miss the record start
+  // thousands of times higher and end at far minima). Without a converged fit, all are fitted.
+  auto fit_promising = [&](const std::vector<SearchStart>& candidates, const std::string& what) {
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (const Run& run : full) {
+      if (!run.failed && Converged(run.fit)) best_cost = std::min(best_cost, run.fit.final_cost);
+    }
+    UpdateOptions probe = local;
+    probe.max_iterations = 1;
+    probe.refit_after_noise_estimate = false;
+    std::vector<Run> probes(candidates.size());
+    if (std::isfinite(best_cost)) {
+      RunParallel(static_cast<int>(candidates.size()), search.threads, [&](int i) {
+        const SearchStart& start = candidates[static_cast<size_t>(i)];
+        probes[static_cast<size_t>(i)] = fit_full(start.label, start.values, probe);
+      });
+    }
+    std::vector<SearchStart> promising;
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      if (!std::isfinite(best_cost) ||
+          (!probes[i].failed && probes[i].fit.initial_cost <= kPromisingCostRatio * best_cost)) {
+        promising.push_back(candidates[i]);
+      }
+    }
+    std::vector<Run> fitted(promising.size());
+    RunParallel(static_cast<int>(promising.size()), search.threads, [&](int i) {
+      const SearchStart& start = promising[static_cast<size_t>(i)];
+      fitted[static_cast<size_t>(i)] = fit_full(start.label, start.values, local);
+    });
+    full.insert(full.end(), fitted.begin(), fitted.end());
+    if (promising.size() < candidates.size()) {
+      result.notes.push_back(fmt::format(
+          "{} of {} {} start above {} times the best cost: not fitted",
+          candidates.size() - promising.size(), candidates.size(), what, kPromisingCostRatio));
+    }
+  };
+
+  // The primary start (unless it already ran for the weights) alone on every thread, then the
+  // other given starts that start near its cost.
   const auto batch_start = std::chrono::steady_clock::now();
-  if (!given.empty()) {
-    say(fmt::format("global search: {} given start(s) on the whole records", given.size()));
+  size_t others_begin = 0;
+  if (all_given && !given.empty()) {
+    say(fmt::format("global search: fit from {}", given.front().first));
+    full.push_back(fit_full(given.front().first, given.front().second, primary));
+    others_begin = 1;
   }
-  std::vector<Run> first(given.size());
-  RunParallel(static_cast<int>(given.size()), search.threads, [&](int i) {
-    const size_t index = static_cast<size_t>(i);
-    first[index] = fit_full(given[index].first, given[index].second, local);
-  });
-  full.insert(full.end(), first.begin(), first.end());
+  std::vector<SearchStart> others;
+  for (size_t i = others_begin; i < given.size(); ++i) {
+    others.push_back({given[i].first, given[i].second});
+  }
+  if (!others.empty()) {
+    say(fmt::format("global search: {} further given start(s) (Route 1's other sets)",
+                    others.size()));
+    fit_promising(others, "further given start(s)");
+  }
 
   // The design, unless the given starts settle the question: they hold every parameter set
   // that matches the identified poles (complete_starts) and the best of them explains the
@@ -426,37 +475,9 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
                       "whole records",
                       equivalent.size()));
     }
-    // Only sets that start near the best cost can end as alternatives: with the poles fixed,
-    // a set whose shapes miss the record starts thousands of times higher (measured) and the fit
-    // wanders off to a far minimum. One iteration gives the start's cost.
-    UpdateOptions probe = local;
-    probe.max_iterations = 1;
-    probe.refit_after_noise_estimate = false;
-    std::vector<Run> probes(equivalent.size());
-    RunParallel(static_cast<int>(equivalent.size()), search.threads, [&](int i) {
-      const SearchStart& start = equivalent[static_cast<size_t>(i)];
-      probes[static_cast<size_t>(i)] = fit_full(start.label, start.values, probe);
-    });
-    std::vector<SearchStart> promising;
-    for (size_t i = 0; i < equivalent.size(); ++i) {
-      if (!probes[i].failed &&
-          probes[i].fit.initial_cost <= kPromisingCostRatio * provisional->fit.final_cost) {
-        promising.push_back(equivalent[i]);
-      }
-    }
-    std::vector<Run> more(promising.size());
-    RunParallel(static_cast<int>(promising.size()), search.threads, [&](int i) {
-      const SearchStart& start = promising[static_cast<size_t>(i)];
-      more[static_cast<size_t>(i)] = fit_full(start.label, start.values, local);
-    });
-    full.insert(full.end(), more.begin(), more.end());
+    fit_promising(equivalent, "set(s) with the best end's poles");
     result.starts += static_cast<int>(equivalent.size());
     result.pole_equivalent = static_cast<int>(equivalent.size());
-    if (promising.size() < equivalent.size()) {
-      result.notes.push_back(fmt::format(
-          "{} of {} set(s) with the best end's poles start above {} times its cost: not fitted",
-          equivalent.size() - promising.size(), equivalent.size(), kPromisingCostRatio));
-    }
   }
   result.full_fits = static_cast<int>(full.size());
 
