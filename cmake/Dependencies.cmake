@@ -9,6 +9,8 @@ find_package(CLI11 CONFIG REQUIRED)
 find_package(fmt CONFIG REQUIRED)
 find_package(nlohmann_json 3.11 CONFIG REQUIRED)
 find_package(muparser 2.3 CONFIG REQUIRED)
+# Header-only: Boost.Math's F and chi-square distributions (global search, credibility).
+find_package(Boost 1.74 REQUIRED)
 
 # Trap 1 (docs/toolchain): libSimTKmath carries a private, incompatible copy of SUNDIALS'
 # N_V* symbols. Linking CVODES as a whole static archive with its symbols kept private makes

@@ -17,4 +17,4 @@ add_library(mbid_updating
 target_include_directories(mbid_updating PUBLIC "${MBID_UPDATING_DIR}/include")
 target_link_libraries(mbid_updating
   PUBLIC mbid_simulation mbid_model mbid_common
-  PRIVATE Ceres::ceres fmt::fmt mbid_simbody mbid_cvodes mbid_warnings)
+  PRIVATE Ceres::ceres fmt::fmt Boost::headers mbid_simbody mbid_cvodes mbid_warnings)
