@@ -38,10 +38,9 @@ const Setup& LoadDrop() {
     s.test = {"load drop",
               mbid::simulation::Simulate(*s.model, excitation, simulation, sensors).measured,
               excitation, sensors.noise_std};
-    const std::map<std::string, double> factor{{"c_alpha", 1.27}, {"d_alpha", 0.75},
-                                               {"c_gamma", 1.27}, {"d_gamma", 1.29},
-                                               {"c_eta", 0.73},   {"d_eta", 1.32},
-                                               {"c_theta", 0.78}, {"d_theta", 1.29}};
+    const std::map<std::string, double> factor{
+        {"c_alpha", 1.27}, {"d_alpha", 0.75}, {"c_gamma", 1.27}, {"d_gamma", 1.29},
+        {"c_eta", 0.73},   {"d_eta", 1.32},   {"c_theta", 0.78}, {"d_theta", 1.29}};
     for (const auto& [name, f] : factor) {
       s.options.parameters.push_back({name, f * s.model->GetParameter(name)});
     }
@@ -61,8 +60,8 @@ void BM_GlobalSearch(benchmark::State& state) {
   search.threads = 2;
   mbid::updating::GlobalSearchResult result;
   for (auto _ : state) {
-    result = mbid::updating::SearchGlobally(*setup.model, {setup.test}, setup.options, "design",
-                                            {}, search);
+    result = mbid::updating::SearchGlobally(*setup.model, {setup.test}, setup.options, "design", {},
+                                            search);
   }
   state.counters["cost"] = result.best.final_cost;
   state.counters["c_alpha_rel_error"] =
@@ -73,6 +72,4 @@ void BM_GlobalSearch(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_GlobalSearch)->Arg(0)->Arg(1)->Iterations(1)->UseRealTime()->Unit(
-    benchmark::kSecond);
-
+BENCHMARK(BM_GlobalSearch)->Arg(0)->Arg(1)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
