@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "mbid/common/json_io.h"
+
 namespace mbid::app {
 
 nlohmann::json MatrixToJson(const Eigen::MatrixXd& matrix) {
@@ -14,20 +16,10 @@ nlohmann::json MatrixToJson(const Eigen::MatrixXd& matrix) {
   return rows;
 }
 
-namespace {
-
-// A number, or null where it has no value (the damping ratio and half-life of a rigid-body
-// pole at 0).
-nlohmann::json FiniteOrNull(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
-
-}  // namespace
-
 nlohmann::json ModelModeToJson(const model::Mode& mode, const model::LinearModel& linear) {
   nlohmann::json json{{"frequency_hz", mode.frequency_hz()},
                       {"decay_rate_per_s", mode.decay_rate_per_s()},
-                      {"damping_ratio", FiniteOrNull(mode.damping_ratio())},
+                      {"damping_ratio", NumberOrNull(mode.damping_ratio())},
                       {"undamped_frequency_hz", mode.undamped_frequency_hz()}};
   // A free coordinate's rigid-body motion: a pole at 0, neither oscillating nor decaying.
   if (mode.lambda == 0.0) json["rigid_body"] = true;
@@ -37,7 +29,7 @@ nlohmann::json ModelModeToJson(const model::Mode& mode, const model::LinearModel
   } else {
     json["log_decrement"] = nullptr;
   }
-  json["half_life_s"] = FiniteOrNull(mode.half_life_s());
+  json["half_life_s"] = NumberOrNull(mode.half_life_s());
   nlohmann::json amplitude, phase, shape;
   for (size_t i = 0; i < linear.outputs.size(); ++i) {
     amplitude[linear.outputs[i]] = std::abs(mode.output_shape[i]);

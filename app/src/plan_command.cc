@@ -22,14 +22,10 @@
 namespace mbid::app {
 namespace {
 
-nlohmann::json Number(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
-
 nlohmann::json PerParameter(const std::vector<std::string>& names, const Eigen::VectorXd& values) {
   nlohmann::json out = nlohmann::json::object();
   for (size_t k = 0; k < names.size(); ++k) {
-    out[names[k]] = Number(values[static_cast<Eigen::Index>(k)]);
+    out[names[k]] = NumberOrNull(values[static_cast<Eigen::Index>(k)]);
   }
   return out;
 }
@@ -139,8 +135,8 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   for (const updating::CandidateScore& candidate : plan.candidates) {
     nlohmann::json item;
     item["name"] = candidate.name;
-    item["score"] = Number(candidate.score);
-    item["gain"] = Number(candidate.gain);
+    item["score"] = NumberOrNull(candidate.score);
+    item["gain"] = NumberOrNull(candidate.gain);
     item["expected_relative_std"] = PerParameter(plan.parameters, candidate.relative_std);
     nlohmann::json determined = nlohmann::json::object();
     for (size_t k = 0; k < plan.parameters.size(); ++k) {
@@ -148,7 +144,7 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
     }
     item["determined"] = determined;
     item["rank"] = candidate.rank;
-    item["ridge"] = Number(candidate.ridge);
+    item["ridge"] = NumberOrNull(candidate.ridge);
     for (size_t i = 0; i < file.candidates.size(); ++i) {
       if (file.candidates[i].name != candidate.name) continue;
       nlohmann::json noise = nlohmann::json::object();
@@ -163,7 +159,7 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   summary["estimate"] = PerParameter(plan.parameters, plan.values);
   summary["estimate_source"] = estimate_source;
   summary["recorded_tests"] = data_paths;
-  summary["recorded_score"] = Number(plan.recorded_score);
+  summary["recorded_score"] = NumberOrNull(plan.recorded_score);
   summary["recorded_undetermined"] = recorded_undetermined;
   summary["recorded_non_unique"] = non_unique;
   summary["current_relative_std"] = PerParameter(plan.parameters, plan.current_relative_std);

@@ -11,6 +11,7 @@
 #include "mbid/common/atomic_file.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
+#include "mbid/common/json_io.h"
 
 namespace mbid::app {
 namespace {
@@ -19,10 +20,6 @@ namespace fs = std::filesystem;
 
 // The first line of every structure report: how mbid tells its own report from a user's file.
 constexpr const char* kReportMarker = "<!-- mbid structure report -->";
-
-nlohmann::json Number(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
 
 std::string Cell(double value, const char* format = "{:.6g}") {
   return std::isfinite(value) ? fmt::format(fmt::runtime(format), value) : std::string("-");
@@ -58,21 +55,21 @@ nlohmann::json StructureRankingToJson(const updating::StructureRanking& ranking,
     for (const updating::ParameterEstimate& p : fit.fit.parameters) {
       // A nuisance parameter's name already carries its test ("<test>:payload_mass_kg").
       const std::string& name = p.name;
-      parameters[name] = Number(p.value);
-      parameter_std[name] = Number(p.std);
+      parameters[name] = NumberOrNull(p.value);
+      parameter_std[name] = NumberOrNull(p.std);
     }
     item["parameters"] = parameters;
     item["parameter_std"] = parameter_std;
     item["undetermined"] = fit.fit.undetermined;
     item["parameter_count"] = fit.parameter_count;
     item["residual_count"] = fit.residual_count;
-    item["cost"] = Number(fit.cost);
-    item["aic"] = Number(fit.aic);
-    item["bic"] = Number(fit.bic);
-    item["delta_bic"] = Number(fit.delta_bic);
-    item["prediction_error"] = Number(fit.prediction_error);
+    item["cost"] = NumberOrNull(fit.cost);
+    item["aic"] = NumberOrNull(fit.aic);
+    item["bic"] = NumberOrNull(fit.bic);
+    item["delta_bic"] = NumberOrNull(fit.delta_bic);
+    item["prediction_error"] = NumberOrNull(fit.prediction_error);
     nlohmann::json per_record = nlohmann::json::array();
-    for (double value : fit.prediction_error_per_record) per_record.push_back(Number(value));
+    for (double value : fit.prediction_error_per_record) per_record.push_back(NumberOrNull(value));
     item["prediction_error_per_record"] = per_record;
     item["termination"] = fit.skipped.empty() ? fit.fit.termination_name() : "skipped";
     if (!fit.skipped.empty()) item["skipped"] = fit.skipped;
@@ -80,7 +77,7 @@ nlohmann::json StructureRankingToJson(const updating::StructureRanking& ranking,
     for (const updating::TestFit& test : fit.fit.tests) {
       for (size_t c = 0; c < test.channels.size(); ++c) {
         correlation[test.name][test.channels[c]] =
-            Number(test.correlation[static_cast<Eigen::Index>(c)]);
+            NumberOrNull(test.correlation[static_cast<Eigen::Index>(c)]);
       }
     }
     item["correlation"] = correlation;

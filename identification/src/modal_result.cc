@@ -2,18 +2,15 @@
 
 #include <cmath>
 
+#include "mbid/common/json_io.h"
+
 namespace mbid::identification {
 namespace {
-
-// JSON has no NaN or infinity; the contract writes null for "not available".
-nlohmann::json Number(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
 
 nlohmann::json PerChannel(const std::vector<std::string>& channels, const Eigen::VectorXd& v) {
   nlohmann::json object = nlohmann::json::object();
   for (size_t c = 0; c < channels.size() && static_cast<Eigen::Index>(c) < v.size(); ++c) {
-    object[channels[c]] = Number(v(c));
+    object[channels[c]] = NumberOrNull(v(c));
   }
   return object;
 }
@@ -55,17 +52,17 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
   nlohmann::json modes = nlohmann::json::array();
   for (const IdentifiedMode& mode : result.modes) {
     nlohmann::json m;
-    m["frequency_hz"] = Number(mode.frequency_hz);
-    m["decay_rate_per_s"] = Number(mode.decay_rate_per_s);
-    m["damping_ratio"] = Number(mode.damping_ratio);
-    m["undamped_frequency_hz"] = Number(mode.undamped_frequency_hz);
-    m["log_decrement"] = Number(mode.log_decrement);
-    m["half_life_s"] = Number(mode.half_life_s);
+    m["frequency_hz"] = NumberOrNull(mode.frequency_hz);
+    m["decay_rate_per_s"] = NumberOrNull(mode.decay_rate_per_s);
+    m["damping_ratio"] = NumberOrNull(mode.damping_ratio);
+    m["undamped_frequency_hz"] = NumberOrNull(mode.undamped_frequency_hz);
+    m["log_decrement"] = NumberOrNull(mode.log_decrement);
+    m["half_life_s"] = NumberOrNull(mode.half_life_s);
     m["amplitude"] = PerChannel(result.channels, mode.amplitude);
     m["phase_rad"] = PerChannel(result.channels, mode.phase_rad);
-    m["std_frequency_hz"] = Number(mode.std_frequency_hz);
-    m["std_decay_rate_per_s"] = Number(mode.std_decay_rate_per_s);
-    m["significance"] = Number(mode.significance);
+    m["std_frequency_hz"] = NumberOrNull(mode.std_frequency_hz);
+    m["std_decay_rate_per_s"] = NumberOrNull(mode.std_decay_rate_per_s);
+    m["significance"] = NumberOrNull(mode.significance);
     m["significant"] = mode.significant;
     if (mode.backbone) {
       const Backbone& b = *mode.backbone;
@@ -90,8 +87,8 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
   json["release"] = result.release;
   json["start_time_s"] = result.start_time_s;
   json["decimation"] = result.decimation;
-  json["max_frequency_hz"] = Number(result.max_frequency_hz);
-  json["significance_threshold"] = Number(result.significance_threshold);
+  json["max_frequency_hz"] = NumberOrNull(result.max_frequency_hz);
+  json["significance_threshold"] = NumberOrNull(result.significance_threshold);
   json["offset"] = PerChannel(result.channels, result.offset);
   json["noise_std"] = PerChannel(result.channels, result.noise_std);
   json["termination"] = result.termination;
@@ -112,8 +109,8 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
       nlohmann::json frequency = nlohmann::json::array();
       nlohmann::json decay = nlohmann::json::array();
       for (const auto& lambda : order.lambda) {
-        frequency.push_back(Number(lambda.imag() / (2 * M_PI)));
-        decay.push_back(Number(-lambda.real()));
+        frequency.push_back(NumberOrNull(lambda.imag() / (2 * M_PI)));
+        decay.push_back(NumberOrNull(-lambda.real()));
       }
       orders.push_back({{"order", order.order},
                         {"frequency_hz", frequency},
@@ -127,7 +124,7 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
     for (Eigen::Index r = 0; r < result.eq2_coefficients.rows(); ++r) {
       nlohmann::json row = nlohmann::json::array();
       for (Eigen::Index c = 0; c < result.eq2_coefficients.cols(); ++c) {
-        row.push_back(Number(result.eq2_coefficients(r, c)));
+        row.push_back(NumberOrNull(result.eq2_coefficients(r, c)));
       }
       rows.push_back(row);
     }

@@ -7,20 +7,16 @@
 #include <sstream>
 #include <tuple>
 
+#include "mbid/common/json_io.h"
 #include "mbid/model/linear_model.h"
 
 namespace mbid::updating {
 namespace {
 
-// JSON has no NaN or infinity: undefined numbers are null.
-nlohmann::json Number(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
-
 nlohmann::json PerName(const std::vector<std::string>& names, const Eigen::VectorXd& values) {
   nlohmann::json json = nlohmann::json::object();
   for (size_t i = 0; i < names.size() && static_cast<Eigen::Index>(i) < values.size(); ++i) {
-    json[names[i]] = Number(values[static_cast<Eigen::Index>(i)]);
+    json[names[i]] = NumberOrNull(values[static_cast<Eigen::Index>(i)]);
   }
   return json;
 }
@@ -51,8 +47,9 @@ nlohmann::json BaselineTerm(const TestFit& test, const Eigen::VectorXd& value,
   for (size_t c = 0; c < test.channels.size() && static_cast<Eigen::Index>(c) < value.size(); ++c) {
     const Eigen::Index i = static_cast<Eigen::Index>(c);
     const std::string units = c < test.simulated.units.size() ? test.simulated.units[c] : "";
-    json[test.channels[c]] = {
-        {"value", Number(value[i])}, {"std", Number(deviation[i])}, {"units", units + per}};
+    json[test.channels[c]] = {{"value", NumberOrNull(value[i])},
+                              {"std", NumberOrNull(deviation[i])},
+                              {"units", units + per}};
   }
   return json;
 }
@@ -85,7 +82,7 @@ nlohmann::json CharacteristicResultToJson(const CharacteristicResult& result) {
   json["message"] = result.message;
   json["starts"] = result.starts;
   json["converged_starts"] = result.converged_starts;
-  json["best_residual"] = Number(result.best_residual);
+  json["best_residual"] = NumberOrNull(result.best_residual);
   json["chosen"] = result.chosen;
   json["ambiguous"] = result.ambiguous;
   json["poles"] = nlohmann::json::array();
@@ -100,14 +97,14 @@ nlohmann::json CharacteristicResultToJson(const CharacteristicResult& result) {
     nlohmann::json entry;
     entry["c"] = PerName(result.coordinates, set.c);
     entry["d"] = PerName(result.coordinates, set.d);
-    entry["residual"] = Number(set.residual);
+    entry["residual"] = NumberOrNull(set.residual);
     entry["hits"] = set.hits;
     entry["admissible"] = set.admissible;
     if (!set.reason.empty()) entry["reason"] = set.reason;
     if (set.admissible) {
-      entry["mismatch"] = Number(set.mismatch);
-      entry["displacement_mismatch"] = Number(set.displacement_mismatch);
-      entry["velocity_mismatch"] = Number(set.velocity_mismatch);
+      entry["mismatch"] = NumberOrNull(set.mismatch);
+      entry["displacement_mismatch"] = NumberOrNull(set.displacement_mismatch);
+      entry["velocity_mismatch"] = NumberOrNull(set.velocity_mismatch);
       if (set.initial_q.size() > 0) {
         entry["initial_q"] = PerName(result.coordinates, set.initial_q);
         entry["initial_u"] = PerName(result.coordinates, set.initial_u);
@@ -129,17 +126,17 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
   std::vector<std::string> names;
   for (const ParameterEstimate& p : result.parameters) {
     names.push_back(p.name);
-    nlohmann::json entry = {
-        {"value", Number(p.value)},
-        {"initial", Number(p.initial)},
-        {"lower", Number(p.lower)},
-        {"upper", Number(p.upper)},
-        {"std", Number(p.std)},
-        {"units", p.units},
-        {"relative_std", Number(p.relative_std)},
-        {"determined", p.determined},
-        {"at_bound", p.at_bound},
-        {"interval", nlohmann::json::array({Number(p.interval_lower), Number(p.interval_upper)})}};
+    nlohmann::json entry = {{"value", NumberOrNull(p.value)},
+                            {"initial", NumberOrNull(p.initial)},
+                            {"lower", NumberOrNull(p.lower)},
+                            {"upper", NumberOrNull(p.upper)},
+                            {"std", NumberOrNull(p.std)},
+                            {"units", p.units},
+                            {"relative_std", NumberOrNull(p.relative_std)},
+                            {"determined", p.determined},
+                            {"at_bound", p.at_bound},
+                            {"interval", nlohmann::json::array({NumberOrNull(p.interval_lower),
+                                                                NumberOrNull(p.interval_upper)})}};
     if (!p.test.empty()) entry["test"] = p.test;
     if (!p.why_undetermined.empty()) entry["why_undetermined"] = p.why_undetermined;
     parameters[p.name] = entry;
@@ -147,9 +144,10 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
   json["parameters"] = parameters;
   json["termination"] = result.termination_name();
   json["iterations"] = result.iterations;
-  json["cost"] = {{"initial", Number(result.initial_cost)}, {"final", Number(result.final_cost)}};
+  json["cost"] = {{"initial", NumberOrNull(result.initial_cost)},
+                  {"final", NumberOrNull(result.final_cost)}};
   nlohmann::json correlation = nlohmann::json::object();
-  for (const auto& [channel, k] : WorstCorrelation(result)) correlation[channel] = Number(k);
+  for (const auto& [channel, k] : WorstCorrelation(result)) correlation[channel] = NumberOrNull(k);
   json["correlation"] = correlation;
 
   json["message"] = result.message;
@@ -158,22 +156,22 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
   json["rank"] = result.rank;
   json["singular_values"] = nlohmann::json::array();
   for (Eigen::Index i = 0; i < result.singular_values.size(); ++i) {
-    json["singular_values"].push_back(Number(result.singular_values[i]));
+    json["singular_values"].push_back(NumberOrNull(result.singular_values[i]));
   }
   nlohmann::json matrix = nlohmann::json::array();
   for (Eigen::Index i = 0; i < result.correlation.rows(); ++i) {
     nlohmann::json row = nlohmann::json::array();
     for (Eigen::Index j = 0; j < result.correlation.cols(); ++j) {
-      row.push_back(Number(result.correlation(i, j)));
+      row.push_back(NumberOrNull(result.correlation(i, j)));
     }
     matrix.push_back(row);
   }
   json["parameter_correlation"] = {{"names", names}, {"matrix", matrix}};
   json["warnings"] = result.warnings;
   json["credibility"] = {{"credible", result.credible},
-                         {"chi_square_per_dof", Number(result.chi_square_per_dof)},
+                         {"chi_square_per_dof", NumberOrNull(result.chi_square_per_dof)},
                          {"weights_from_records", result.weights_from_records},
-                         {"std_inflation", Number(result.std_inflation)},
+                         {"std_inflation", NumberOrNull(result.std_inflation)},
                          {"reasons", result.credibility}};
   json["tests"] = nlohmann::json::array();
   for (const TestFit& test : result.tests) {
@@ -201,15 +199,15 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
   json["history"] = nlohmann::json::array();
   for (const IterationRecord& record : result.history) {
     json["history"].push_back({{"iteration", record.iteration},
-                               {"cost", Number(record.cost)},
-                               {"step_norm", Number(record.step_norm)},
-                               {"gradient_max_norm", Number(record.gradient_max_norm)},
+                               {"cost", NumberOrNull(record.cost)},
+                               {"step_norm", NumberOrNull(record.step_norm)},
+                               {"gradient_max_norm", NumberOrNull(record.gradient_max_norm)},
                                {"successful", record.successful}});
   }
   json["work"] = {{"simulations", result.simulations},
                   {"sensitivity_simulations", result.sensitivity_simulations},
                   {"rhs_evaluations", result.rhs_evaluations},
-                  {"wall_time_s", Number(result.wall_time_s)}};
+                  {"wall_time_s", NumberOrNull(result.wall_time_s)}};
   if (algebraic != nullptr) json["algebraic"] = CharacteristicResultToJson(*algebraic);
   return json;
 }
@@ -358,17 +356,17 @@ namespace {
 
 nlohmann::json MinimumToJson(const SearchMinimum& minimum) {
   nlohmann::json values = nlohmann::json::object();
-  for (const ParameterEstimate& p : minimum.fit.parameters) values[p.name] = Number(p.value);
+  for (const ParameterEstimate& p : minimum.fit.parameters) values[p.name] = NumberOrNull(p.value);
   return {{"parameters", values},
-          {"cost", Number(minimum.cost)},
-          {"initial_cost", Number(minimum.fit.initial_cost)},
-          {"f_statistic", Number(minimum.f_statistic)},
-          {"p_value", Number(minimum.p_value)},
+          {"cost", NumberOrNull(minimum.cost)},
+          {"initial_cost", NumberOrNull(minimum.fit.initial_cost)},
+          {"f_statistic", NumberOrNull(minimum.f_statistic)},
+          {"p_value", NumberOrNull(minimum.p_value)},
           {"starts", minimum.starts},
           {"differs_in", minimum.differs_in},
           {"alternative", minimum.alternative},
           {"iterations", minimum.fit.iterations},
-          {"wall_time_s", Number(minimum.fit.wall_time_s)}};
+          {"wall_time_s", NumberOrNull(minimum.fit.wall_time_s)}};
 }
 
 }  // namespace
@@ -386,8 +384,8 @@ void AddGlobalSearchToJson(const GlobalSearchResult& search, nlohmann::json& jso
                     {"screened", search.screened},
                     {"full_fits", search.full_fits},
                     {"residual_count", search.residual_count},
-                    {"wall_time_s", Number(search.wall_time_s)},
-                    {"screen_time_s", Number(search.screen_time_s)},
+                    {"wall_time_s", NumberOrNull(search.wall_time_s)},
+                    {"screen_time_s", NumberOrNull(search.screen_time_s)},
                     {"differing", search.differing},
                     {"notes", search.notes},
                     {"minima", minima}};
