@@ -57,4 +57,17 @@ void DescribeLoadedTest(const LoadedTest& test) {
                            test.identified.modes.size());
 }
 
+std::vector<LoadedTest> LoadTests(
+    const std::vector<std::string>& paths, const Scenario& scenario,
+    const model::MechanicalModel& model,
+    const identification::IdentificationOptions& identification_options,
+    const ImportOverrides& overrides, bool describe) {
+  std::vector<LoadedTest> tests;
+  for (const std::string& path : paths) {
+    tests.push_back(LoadTest(path, scenario, model, identification_options, overrides));
+    if (describe) DescribeLoadedTest(tests.back());
+  }
+  return tests;
+}
+
 }  // namespace mbid::app

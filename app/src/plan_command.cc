@@ -75,10 +75,8 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   CandidateFile file = ReadCandidateFile(candidates_path, scenario, *model);
   const identification::IdentificationOptions identification_options =
       scenario.ReadIdentification();
-  std::vector<LoadedTest> tests;
-  for (const std::string& path : data_paths) {
-    tests.push_back(LoadTest(path, scenario, *model, identification_options, common.import));
-  }
+  const std::vector<LoadedTest> tests =
+      LoadTests(data_paths, scenario, *model, identification_options, common.import, false);
 
   updating::PlanOptions options;
   options.sensitivity = settings.options.sensitivity;

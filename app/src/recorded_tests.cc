@@ -10,6 +10,19 @@
 #include "mbid/identification/identify.h"
 
 namespace mbid::app {
+
+std::vector<updating::TestRecord> MakeWeightedRecords(const std::vector<LoadedTest>& tests,
+                                                      const updating::UpdatingSettings& settings) {
+  std::vector<updating::TestRecord> records;
+  for (const LoadedTest& test : tests) {
+    updating::TestRecord record =
+        updating::MakeTestRecord(test.path, test.record, test.excitation, settings);
+    WeighByIdentifiedNoise(test.identified, record);
+    records.push_back(std::move(record));
+  }
+  return records;
+}
+
 RecordedUpdate UpdateFromTests(const model::MechanicalModel& model,
                                const std::vector<LoadedTest>& tests,
                                const updating::UpdatingSettings& settings,
@@ -19,12 +32,7 @@ RecordedUpdate UpdateFromTests(const model::MechanicalModel& model,
                                          tests.front().excitation, settings, &update.note);
   say(fmt::format("route 1: {}{}", update.algebraic ? update.algebraic->status_name() : "not run",
                   update.note.empty() ? "" : " (" + update.note + ")"));
-  for (const LoadedTest& test : tests) {
-    updating::TestRecord record =
-        updating::MakeTestRecord(test.path, test.record, test.excitation, settings);
-    WeighByIdentifiedNoise(test.identified, record);
-    update.records.push_back(std::move(record));
-  }
+  update.records = MakeWeightedRecords(tests, settings);
   update.search = TuneModel(model, update.records, settings, update.algebraic.get(), &update.start,
                             &update.note, say);
   return update;

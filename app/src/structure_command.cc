@@ -14,6 +14,7 @@
 
 #include "mbid/app/commands.h"
 #include "mbid/app/loaded_test.h"
+#include "mbid/app/recorded_tests.h"
 #include "mbid/app/scenario.h"
 #include "mbid/app/structure_report.h"
 #include "mbid/app/updating_glue.h"
@@ -78,18 +79,9 @@ int RunStructureCommand(const std::string& scenario_path,
   const updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
   const identification::IdentificationOptions identification_options =
       scenario.ReadIdentification();
-  std::vector<LoadedTest> tests;
-  for (const std::string& path : data_paths) {
-    tests.push_back(LoadTest(path, scenario, *model, identification_options, common.import));
-    if (!common.quiet) DescribeLoadedTest(tests.back());
-  }
-  std::vector<updating::TestRecord> records;
-  for (const LoadedTest& test : tests) {
-    updating::TestRecord record =
-        updating::MakeTestRecord(test.path, test.record, test.excitation, settings);
-    WeighByIdentifiedNoise(test.identified, record);
-    records.push_back(std::move(record));
-  }
+  const std::vector<LoadedTest> tests =
+      LoadTests(data_paths, scenario, *model, identification_options, common.import, !common.quiet);
+  const std::vector<updating::TestRecord> records = MakeWeightedRecords(tests, settings);
 
   // The candidates: the full model first (its fit's noise weighs all), then each set of rigid
   // coordinates, then the alternatives.

@@ -3,9 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <algorithm>
 #include <cmath>
-#include <complex>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -15,16 +13,13 @@
 #include "mbid/app/loaded_test.h"
 #include "mbid/app/recorded_tests.h"
 #include "mbid/app/scenario.h"
-#include "mbid/app/updating_glue.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
-#include "mbid/identification/identify.h"
 #include "mbid/identification/updating/characteristic.h"
 #include "mbid/identification/updating/output_error.h"
 #include "mbid/identification/updating/result_io.h"
 #include "mbid/identification/updating/settings.h"
-#include "mbid/records/records.h"
 
 namespace mbid::app {
 namespace {
@@ -90,11 +85,8 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
       scenario.ReadIdentification();
 
   // Every record is read and checked before any long work starts.
-  std::vector<LoadedTest> tests;
-  for (const std::string& path : data_paths) {
-    tests.push_back(LoadTest(path, scenario, *model, identification_options, common.import));
-    if (!common.quiet) DescribeLoadedTest(tests.back());
-  }
+  const std::vector<LoadedTest> tests =
+      LoadTests(data_paths, scenario, *model, identification_options, common.import, !common.quiet);
 
   const RecordedUpdate update =
       UpdateFromTests(*model, tests, settings, [&common](const std::string& line) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "mbid/app/record_import.h"
 #include "mbid/app/release_cut.h"
@@ -36,5 +37,13 @@ LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
 
 // One line per step on standard error: the import, the release, the record and its modes.
 void DescribeLoadedTest(const LoadedTest& test);
+
+// Every DATA file in order, each read and checked before any long work starts; with `describe`,
+// each is described as it is loaded.
+std::vector<LoadedTest> LoadTests(
+    const std::vector<std::string>& paths, const Scenario& scenario,
+    const model::MechanicalModel& model,
+    const identification::IdentificationOptions& identification_options,
+    const ImportOverrides& overrides, bool describe);
 
 }  // namespace mbid::app

@@ -22,6 +22,11 @@
 
 namespace mbid::app {
 
+// The tests as Route 2 takes them: the settings' noise and nuisance switches, and the
+// identification's residual noise where the settings give none.
+std::vector<updating::TestRecord> MakeWeightedRecords(const std::vector<LoadedTest>& tests,
+                                                      const updating::UpdatingSettings& settings);
+
 // Route 2 on the loaded tests as `mbid update` runs it.
 struct RecordedUpdate {
   std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, or null
