@@ -227,8 +227,7 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   }
   const std::vector<ParameterSetting> settings = ResolveParameterSettings(model, options);
 
-  // The primary start first, alone: its fit fixes the weights that the record does not give, so
-  // that every other fit's cost is in the same units. It may use every thread.
+  // The primary start: the options' own values (or the scenario's), fitted first and alone.
   UpdateOptions primary = StartOptions(options, settings, {});
   if (!search.enabled) {
     result.best = UpdateModel(model, tests, primary);
@@ -274,13 +273,13 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     return run;
   };
 
-  std::vector<std::pair<std::string, std::map<std::string, double>>> given;
-  given.emplace_back(primary_label, std::map<std::string, double>{});
-  for (const SearchStart& start : starts) given.emplace_back(start.label, start.values);
-
+  // The primary start first, alone. Where the records give no noise level, its fit estimates
+  // one, and every other fit is weighed by it so that all costs are in the same units.
+  const auto batch_start = std::chrono::steady_clock::now();
+  say(fmt::format("global search: fit from {}{}", primary_label,
+                  all_given ? "" : " to estimate the noise"));
+  full.push_back(fit_full(primary_label, {}, primary));
   if (!all_given) {
-    say(fmt::format("global search: fit from {} to estimate the noise", primary_label));
-    full.push_back(fit_full(primary_label, {}, primary));
     const UpdateResult& first = full.front().fit;
     for (size_t t = 0; t < weighted.size() && t < first.tests.size(); ++t) {
       const TestFit& fit = first.tests[t];
@@ -294,7 +293,6 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
       result.starts = result.full_fits = 1;
       return result;
     }
-    given.erase(given.begin());
   }
 
   // Only starts near the best known cost can end as alternatives: one iteration gives a start's
@@ -336,23 +334,11 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     }
   };
 
-  // The primary start (unless it already ran for the weights) alone on every thread, then the
-  // other given starts that start near its cost.
-  const auto batch_start = std::chrono::steady_clock::now();
-  size_t others_begin = 0;
-  if (all_given && !given.empty()) {
-    say(fmt::format("global search: fit from {}", given.front().first));
-    full.push_back(fit_full(given.front().first, given.front().second, primary));
-    others_begin = 1;
-  }
-  std::vector<SearchStart> others;
-  for (size_t i = others_begin; i < given.size(); ++i) {
-    others.push_back({given[i].first, given[i].second});
-  }
-  if (!others.empty()) {
+  // The other given starts (Route 1's other sets) that start near the primary's cost.
+  if (!starts.empty()) {
     say(fmt::format("global search: {} further given start(s) (Route 1's other sets)",
-                    others.size()));
-    fit_promising(others, "further given start(s)");
+                    starts.size()));
+    fit_promising(starts, "further given start(s)");
   }
 
   // The design, unless the given starts settle the question: they hold every parameter set
@@ -386,7 +372,7 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     }
     design.push_back(values);
   }
-  result.starts = static_cast<int>(given.size() + design.size()) + (all_given ? 0 : 1);
+  result.starts = static_cast<int>(1 + starts.size() + design.size());
 
   // Design points on the first part of each record, in parallel.
   if (!design.empty()) {

@@ -63,13 +63,17 @@ simulation::SensitivityOptions ReadSensitivity(const YamlReader& node,
   return o;
 }
 
+std::uint64_t ReadSeed(const YamlReader& node, std::uint64_t fallback) {
+  const int seed = node.Int("seed", static_cast<int>(fallback));
+  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
+  return static_cast<std::uint64_t>(seed);
+}
+
 CharacteristicOptions ReadAlgebraic(const YamlReader& node, CharacteristicOptions o) {
   node.ExpectMap({"starts", "seed", "start_spread", "max_iterations", "residual_tolerance",
                   "duplicate_tolerance", "fit_offset", "ambiguity_ratio"});
   o.starts = node.Int("starts", o.starts);
-  const int seed = node.Int("seed", static_cast<int>(o.seed));
-  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
-  o.seed = static_cast<std::uint64_t>(seed);
+  o.seed = ReadSeed(node, o.seed);
   o.start_spread = node.PositiveDouble("start_spread", o.start_spread);
   o.max_iterations = node.Int("max_iterations", o.max_iterations);
   o.residual_tolerance = node.PositiveDouble("residual_tolerance", o.residual_tolerance);
@@ -88,9 +92,7 @@ GlobalSearchOptions ReadGlobalSearch(const YamlReader& node, GlobalSearchOptions
   o.pole_equivalent_starts = node.Bool("pole_equivalent_starts", o.pole_equivalent_starts);
   o.enabled = node.Bool("enabled", o.enabled);
   o.design_starts = node.Int("design_starts", o.design_starts);
-  const int seed = node.Int("seed", static_cast<int>(o.seed));
-  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
-  o.seed = static_cast<std::uint64_t>(seed);
+  o.seed = ReadSeed(node, o.seed);
   o.screen_fraction = node.PositiveDouble("screen_fraction", o.screen_fraction);
   o.screen_iterations = node.Int("screen_iterations", o.screen_iterations);
   o.full_fits = node.Int("full_fits", o.full_fits);
