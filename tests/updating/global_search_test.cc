@@ -190,14 +190,30 @@ UpdateResult FitWithResidual(const Eigen::VectorXd& residual, TestRecord* test) 
   return result;
 }
 
-TEST(CredibilityTest, WhiteResidualAtTheNoiseIsCredible) {
-  std::mt19937_64 random(11);
+// `count` samples of AR(1) noise, x_j = rho x_(j-1) + sqrt(1 - rho^2) e_j, scaled to `std`:
+// white for rho = 0.
+Eigen::VectorXd Ar1Noise(Eigen::Index count, double rho, double std, std::uint64_t seed) {
+  std::mt19937_64 random(seed);
   std::normal_distribution<double> normal;
-  Eigen::VectorXd residual(4000);
-  for (Eigen::Index i = 0; i < residual.size(); ++i) residual[i] = normal(random);
+  Eigen::VectorXd noise(count);
+  double value = 0;
+  for (Eigen::Index i = 0; i < count; ++i) {
+    value = rho * value + std::sqrt(1 - rho * rho) * normal(random);
+    noise[i] = std * value;
+  }
+  return noise;
+}
+
+// The credibility check of a fit whose residual is `residual` against unit weights.
+UpdateResult AssessResidual(const Eigen::VectorXd& residual) {
   TestRecord test;
   UpdateResult result = FitWithResidual(residual, &test);
   AssessCredibility(result, {test}, UpdateOptions());
+  return result;
+}
+
+TEST(CredibilityTest, WhiteResidualAtTheNoiseIsCredible) {
+  const UpdateResult result = AssessResidual(Ar1Noise(4000, 0.0, 1.0, 11));
   // Unit-variance noise against unit weights: chi^2/dof within 5% of 1 (spread 2.2% at 4000).
   EXPECT_NEAR(result.chi_square_per_dof, 1.0, 0.05);
   EXPECT_TRUE(result.credible);
@@ -209,17 +225,7 @@ TEST(CredibilityTest, WhiteResidualAtTheNoiseIsCredible) {
 TEST(CredibilityTest, ColouredResidualInflatesTheStandardDeviations) {
   // AR(1) with rho = 0.8 at unit variance: correlation time 1 + 2 sum_{k<=20} 0.8^k = 8.9, so
   // the standard deviations are scaled by about 3.
-  std::mt19937_64 random(12);
-  std::normal_distribution<double> normal;
-  Eigen::VectorXd residual(20000);
-  double value = 0;
-  for (Eigen::Index i = 0; i < residual.size(); ++i) {
-    value = 0.8 * value + std::sqrt(1 - 0.64) * normal(random);
-    residual[i] = value;
-  }
-  TestRecord test;
-  UpdateResult result = FitWithResidual(residual, &test);
-  AssessCredibility(result, {test}, UpdateOptions());
+  const UpdateResult result = AssessResidual(Ar1Noise(20000, 0.8, 1.0, 12));
   EXPECT_NEAR(result.tests[0].correlation_time[0], 8.9, 1.0);
   EXPECT_NEAR(result.std_inflation, std::sqrt(8.9), 0.3);
   EXPECT_FALSE(result.credible);
@@ -229,13 +235,7 @@ TEST(CredibilityTest, ColouredResidualInflatesTheStandardDeviations) {
 TEST(CredibilityTest, ResidualFarAboveTheNoiseDeterminesNothing) {
   // A residual 3 times the records' noise (chi^2/dof 9 > 4): a local minimum or a missing
   // piece of the model; even a 1% std means nothing there.
-  std::mt19937_64 random(13);
-  std::normal_distribution<double> normal;
-  Eigen::VectorXd residual(4000);
-  for (Eigen::Index i = 0; i < residual.size(); ++i) residual[i] = 3 * normal(random);
-  TestRecord test;
-  UpdateResult result = FitWithResidual(residual, &test);
-  AssessCredibility(result, {test}, UpdateOptions());
+  const UpdateResult result = AssessResidual(Ar1Noise(4000, 0.0, 3.0, 13));
   EXPECT_NEAR(result.chi_square_per_dof, 9.0, 0.5);
   EXPECT_FALSE(result.credible);
   EXPECT_FALSE(result.parameters[0].determined);
