@@ -12,8 +12,7 @@
 
 #include "crane_fixture.h"
 #include "mbid/common/error.h"
-#include "mbid/common/yaml_reader.h"
-#include "mbid/model/model_factory.h"
+#include "oscillator_fixture.h"
 
 namespace mbid::updating {
 namespace {
@@ -27,25 +26,9 @@ constexpr double kDamping = 8.0;
 constexpr double kDeflection = 0.01;  // rad, released from rest
 constexpr double kNoise = 1e-4;       // rad: 40 dB below the release amplitude
 
-std::unique_ptr<model::MechanicalModel> MakeOscillator() {
-  return model::MakeModel(YamlReader::FromString(
-      "type: torsional_oscillator\ninertia_kgm2: 2.0\n"
-      "joints: {angle: {stiffness_Nm_per_rad: 800.0, damping_Nms_per_rad: 8.0}}\n",
-      "oscillator"));
-}
+using testing::MakeOscillator;
 
-TestDesign OscillatorDesign() {
-  TestDesign design;
-  design.name = "release";
-  design.excitation.type = simulation::Excitation::Type::kInitialDeflection;
-  design.excitation.deflection_rad["angle"] = kDeflection;
-  design.simulation.duration_s = 2.0;
-  design.simulation.integrator.method = simulation::IntegratorOptions::Method::kBdf;
-  design.sensors.sample_rate_hz = 100.0;
-  design.sensors.channels = {"angle"};
-  design.sensors.noise_std["angle"] = kNoise;
-  return design;
-}
+TestDesign OscillatorDesign() { return testing::OscillatorRelease("release", kDeflection, kNoise); }
 
 // The closed-form free decay from rest at theta0 (underdamped).
 double Angle(double t, double c, double d) {

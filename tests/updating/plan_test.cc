@@ -12,32 +12,15 @@
 
 #include "crane_fixture.h"
 #include "mbid/common/error.h"
-#include "mbid/common/yaml_reader.h"
-#include "mbid/model/model_factory.h"
+#include "oscillator_fixture.h"
 
 namespace mbid::updating {
 namespace {
 
-// The oscillator of fisher_test.cc: omega_0 = 20 rad/s, damping ratio 0.1, 2 s at 100 Hz.
-std::unique_ptr<model::MechanicalModel> MakeOscillator(double stiffness = 800.0) {
-  return model::MakeModel(
-      YamlReader::FromString("type: torsional_oscillator\ninertia_kgm2: 2.0\n"
-                             "joints: {angle: {stiffness_Nm_per_rad: " +
-                                 std::to_string(stiffness) + ", damping_Nms_per_rad: 8.0}}\n",
-                             "oscillator"));
-}
+using testing::MakeOscillator;
 
 TestDesign Release(const std::string& name, double deflection_rad, double noise_rad) {
-  TestDesign design;
-  design.name = name;
-  design.excitation.type = simulation::Excitation::Type::kInitialDeflection;
-  design.excitation.deflection_rad["angle"] = deflection_rad;
-  design.simulation.duration_s = 2.0;
-  design.simulation.integrator.method = simulation::IntegratorOptions::Method::kBdf;
-  design.sensors.sample_rate_hz = 100.0;
-  design.sensors.channels = {"angle"};
-  design.sensors.noise_std["angle"] = noise_rad;
-  return design;
+  return testing::OscillatorRelease(name, deflection_rad, noise_rad);
 }
 
 TEST(PlanTest, RanksByLogDetWithoutRecordedTests) {
