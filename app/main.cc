@@ -9,11 +9,11 @@
 
 #include "mbid/app/commands.h"
 #include "mbid/app/run_cycle.h"
-#include "mbid/app/scenario.h"
 #include "mbid/app/version.h"
 #include "mbid/common/error.h"
 #include "mbid/common/interrupt_cleanup.h"
 #include "mbid/identification/options.h"
+#include "mbid/validation/scenario.h"
 
 namespace {
 
@@ -52,14 +52,15 @@ void AddImportFlags(CLI::App* command, ImportFlags* flags) {
       ->excludes(release);
 }
 
-mbid::app::ImportOverrides MakeOverrides(const ImportFlags& flags) {
-  mbid::app::ImportOverrides overrides;
-  overrides.channel_columns = mbid::app::ParseAssignments(flags.channels, "--channel");
-  for (const auto& [column, unit] : mbid::app::ParseAssignments(flags.units, "--unit")) {
+mbid::validation::ImportOverrides MakeOverrides(const ImportFlags& flags) {
+  mbid::validation::ImportOverrides overrides;
+  overrides.channel_columns = mbid::validation::ParseAssignments(flags.channels, "--channel");
+  for (const auto& [column, unit] : mbid::validation::ParseAssignments(flags.units, "--unit")) {
     overrides.units[column] = unit;
   }
   if (!flags.fill_gaps.empty()) {
-    overrides.fill_gaps = mbid::app::ParseGapFill(flags.fill_gaps, "command line", "--fill-gaps");
+    overrides.fill_gaps =
+        mbid::validation::ParseGapFill(flags.fill_gaps, "command line", "--fill-gaps");
   }
   overrides.release_none = flags.release == "none";
   if (flags.release_time_s && !std::isfinite(*flags.release_time_s)) {
@@ -213,7 +214,7 @@ int Main(int argc, char** argv) {
   }
   common.import = MakeOverrides(import_flags);
   if (run->parsed()) {
-    if (scenario_path.empty()) scenario_path = mbid::app::DefaultScenarioPath();
+    if (scenario_path.empty()) scenario_path = mbid::validation::DefaultScenarioPath();
     return mbid::app::RunValidationCycle(scenario_path, output_dir, common);
   }
   if (campaign->parsed()) {

@@ -19,8 +19,8 @@
 #include <sstream>
 #include <string>
 
-#include "mbid/app/campaign.h"
-#include "mbid/app/campaign_runner.h"
+#include "mbid/campaign/campaign.h"
+#include "mbid/campaign/campaign_runner.h"
 
 namespace {
 
@@ -62,16 +62,17 @@ void Report(benchmark::State& state, int units, double cases_s, double total_s) 
 
 void BM_CampaignThreads(benchmark::State& state) {
   const int workers = static_cast<int>(state.range(0));
-  const mbid::app::Campaign campaign = mbid::app::LoadCampaign((WorkDir() / "bench.yaml").string());
+  const mbid::campaign::Campaign campaign =
+      mbid::campaign::LoadCampaign((WorkDir() / "bench.yaml").string());
   for (auto _ : state) {
     const fs::path out = WorkDir() / ("threads_" + std::to_string(workers));
     fs::remove_all(out);
-    mbid::app::CampaignRunOptions options;
+    mbid::campaign::CampaignRunOptions options;
     options.workers = workers;
     options.quiet = true;
     const auto start = std::chrono::steady_clock::now();
-    const mbid::app::CampaignRunSummary summary =
-        mbid::app::RunCampaign(campaign, out.string(), options);
+    const mbid::campaign::CampaignRunSummary summary =
+        mbid::campaign::RunCampaign(campaign, out.string(), options);
     const double total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     state.SetIterationTime(total);

@@ -12,10 +12,10 @@
 #include <memory>
 
 #include "mbid/common/yaml_reader.h"
-#include "mbid/identification/updating/global_search.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/simulation/scenario_sections.h"
 #include "mbid/simulation/simulate.h"
+#include "mbid/updating/global_search.h"
 
 namespace {
 

@@ -15,11 +15,11 @@
 #include <optional>
 
 #include "mbid/common/yaml_reader.h"
-#include "mbid/identification/updating/output_error.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/simulation/scenario_sections.h"
 #include "mbid/simulation/sensitivity.h"
 #include "mbid/simulation/simulate.h"
+#include "mbid/updating/output_error.h"
 
 namespace {
 

@@ -4,13 +4,17 @@
 #include <memory>
 #include <thread>
 
-#include "campaign/cluster.h"
-#include "mbid/app/campaign.h"
-#include "mbid/app/campaign_runner.h"
 #include "mbid/app/commands.h"
+#include "mbid/campaign/campaign.h"
+#include "mbid/campaign/campaign_runner.h"
 #include "mbid/common/error.h"
 
 namespace mbid::app {
+using campaign::Campaign;
+using campaign::CampaignRunOptions;
+using campaign::LoadCampaign;
+using campaign::RunCampaign;
+
 namespace {
 
 // Threads beyond a few per core only add memory and contention; 100000 would fail to start.
@@ -29,14 +33,14 @@ void CheckWorkerCount(int workers) {
 int RunCampaignCommand(const std::string& campaign_path, const std::string& output_dir, int workers,
                        bool resume, const CommonOptions& common) {
   // Under mpirun this starts MPI (and ends it on return); alone it is this process.
-  const std::unique_ptr<internal::Cluster> cluster = internal::JoinCluster();
+  const std::shared_ptr<campaign::internal::Cluster> cluster = campaign::JoinCampaignCluster();
   Campaign campaign;
   try {
     CheckWorkerCount(workers);
     campaign = LoadCampaign(campaign_path);
   } catch (const std::exception& error) {
     // Every rank finds the same mistake; rank 0 alone reports it.
-    if (!cluster->is_root()) return static_cast<int>(ExitCodeFor(error));
+    if (!campaign::IsClusterRoot(*cluster)) return static_cast<int>(ExitCodeFor(error));
     throw;
   }
   CampaignRunOptions options;

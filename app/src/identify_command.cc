@@ -10,6 +10,9 @@
 #include "mbid/records/records.h"
 
 namespace mbid::app {
+using validation::DescribeImport;
+using validation::ImportReportToJson;
+using validation::MergeImportOptions;
 
 int RunIdentifyCommand(const std::string& data_path,
                        const identification::IdentificationOptions& options,

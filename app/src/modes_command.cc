@@ -3,11 +3,14 @@
 #include <iostream>
 
 #include "mbid/app/commands.h"
-#include "mbid/app/json_summaries.h"
-#include "mbid/app/scenario.h"
 #include "mbid/common/json_io.h"
+#include "mbid/validation/json_summaries.h"
+#include "mbid/validation/scenario.h"
 
 namespace mbid::app {
+using validation::LinearModelToJson;
+using validation::LoadScenario;
+using validation::Scenario;
 
 int RunModesCommand(const std::string& scenario_path, const CommonOptions& common) {
   const Scenario scenario = LoadScenario(scenario_path);

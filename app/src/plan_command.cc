@@ -10,16 +10,26 @@
 #include <vector>
 
 #include "mbid/app/commands.h"
-#include "mbid/app/plan_candidates.h"
-#include "mbid/app/recorded_tests.h"
-#include "mbid/app/scenario.h"
 #include "mbid/common/error.h"
 #include "mbid/common/json_io.h"
-#include "mbid/identification/updating/fisher.h"
-#include "mbid/identification/updating/output_error.h"
-#include "mbid/identification/updating/plan.h"
+#include "mbid/updating/fisher.h"
+#include "mbid/updating/output_error.h"
+#include "mbid/updating/plan.h"
+#include "mbid/validation/plan_candidates.h"
+#include "mbid/validation/recorded_tests.h"
+#include "mbid/validation/scenario.h"
 
 namespace mbid::app {
+using validation::CandidateFile;
+using validation::FillCandidateNoise;
+using validation::LoadedTest;
+using validation::LoadScenario;
+using validation::LoadTests;
+using validation::ReadCandidateFile;
+using validation::RecordedUpdate;
+using validation::Scenario;
+using validation::UpdateFromTests;
+
 namespace {
 
 nlohmann::json PerParameter(const std::vector<std::string>& names, const Eigen::VectorXd& values) {

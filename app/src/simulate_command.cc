@@ -4,15 +4,22 @@
 #include <vector>
 
 #include "mbid/app/commands.h"
-#include "mbid/app/json_summaries.h"
-#include "mbid/app/result_writers.h"
-#include "mbid/app/scenario.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
 #include "mbid/records/records.h"
+#include "mbid/validation/json_summaries.h"
+#include "mbid/validation/result_writers.h"
+#include "mbid/validation/scenario.h"
 
 namespace mbid::app {
+using validation::IntegratorStatisticsToJson;
+using validation::LinearModelToJson;
+using validation::LoadScenario;
+using validation::Scenario;
+using validation::WriteSimulationInfo;
+using validation::WriteTruth;
+
 namespace {
 
 enum class ExportFormat { kUff, kUffBinary, kMat };

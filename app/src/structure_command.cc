@@ -13,20 +13,34 @@
 #include <vector>
 
 #include "mbid/app/commands.h"
-#include "mbid/app/loaded_test.h"
-#include "mbid/app/recorded_tests.h"
-#include "mbid/app/scenario.h"
-#include "mbid/app/structure_report.h"
-#include "mbid/app/updating_glue.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
-#include "mbid/identification/updating/settings.h"
-#include "mbid/identification/updating/structure.h"
 #include "mbid/model/multibody_model.h"
 #include "mbid/model/rigid_coordinates.h"
+#include "mbid/report/structure_report.h"
+#include "mbid/updating/settings.h"
+#include "mbid/updating/structure.h"
+#include "mbid/validation/loaded_test.h"
+#include "mbid/validation/recorded_tests.h"
+#include "mbid/validation/scenario.h"
+#include "mbid/validation/two_route_update.h"
 
 namespace mbid::app {
+using report::CheckReportPaths;
+using report::ReportPathsBeside;
+using report::StructureRankingToJson;
+using report::StructureReportPaths;
+using report::StructureTable;
+using report::WriteStructureGroup;
+using report::WriteStructureReport;
+using validation::LoadedTest;
+using validation::LoadScenario;
+using validation::LoadTests;
+using validation::MakeWeightedRecords;
+using validation::Scenario;
+using validation::SolveAlgebraicRoute;
+
 namespace {
 
 // Route 2's options for a model: the given settings, started from Route 1 on the first record

@@ -10,18 +10,26 @@
 #include <vector>
 
 #include "mbid/app/commands.h"
-#include "mbid/app/loaded_test.h"
-#include "mbid/app/recorded_tests.h"
-#include "mbid/app/scenario.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
-#include "mbid/identification/updating/characteristic.h"
-#include "mbid/identification/updating/output_error.h"
-#include "mbid/identification/updating/result_io.h"
-#include "mbid/identification/updating/settings.h"
+#include "mbid/updating/characteristic.h"
+#include "mbid/updating/output_error.h"
+#include "mbid/updating/result_io.h"
+#include "mbid/updating/settings.h"
+#include "mbid/validation/loaded_test.h"
+#include "mbid/validation/recorded_tests.h"
+#include "mbid/validation/scenario.h"
 
 namespace mbid::app {
+using validation::ImportReportToJson;
+using validation::LoadedTest;
+using validation::LoadScenario;
+using validation::LoadTests;
+using validation::RecordedUpdate;
+using validation::Scenario;
+using validation::UpdateFromTests;
+
 namespace {
 
 std::string FormatNumber(double value) {

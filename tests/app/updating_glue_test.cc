@@ -1,14 +1,16 @@
 // Route 1's glue: with more identified modes than coordinates, eq. 7 runs on the main ones (the
 // paper chose its four "main" modes among all it found).
-#include "mbid/app/updating_glue.h"
-
 #include <gtest/gtest.h>
 
 #include "../updating/crane_fixture.h"
-#include "mbid/identification/updating/settings.h"
 #include "mbid/model/linear_model.h"
+#include "mbid/updating/settings.h"
+#include "mbid/validation/two_route_update.h"
 
 namespace mbid::app {
+using validation::SelectMainModes;
+using validation::SolveAlgebraicRoute;
+
 namespace {
 
 identification::IdentifiedMode Mode(std::complex<double> lambda, double psi, double phi) {

@@ -1,6 +1,6 @@
 // The campaign library: sweeps, key paths, seeds, the settling time, polynomial laws with their
 // uncertainty, and damper sizing on the one-joint oscillator whose damping ratio is analytic.
-#include "mbid/app/campaign.h"
+#include "mbid/campaign/campaign.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -13,14 +13,24 @@
 #include <sstream>
 #include <string>
 
-#include "mbid/app/campaign_case.h"
-#include "mbid/app/campaign_runner.h"
-#include "mbid/app/damper_sizing.h"
-#include "mbid/app/laws.h"
+#include "mbid/campaign/campaign_case.h"
+#include "mbid/campaign/campaign_runner.h"
+#include "mbid/campaign/damper_sizing.h"
+#include "mbid/campaign/laws.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 
 namespace mbid::app {
+using campaign::ApplyAssignment;
+using campaign::CalcSettlingTime;
+using campaign::Campaign;
+using campaign::CampaignRunOptions;
+using campaign::CampaignRunSummary;
+using campaign::FitPolynomialLaw;
+using campaign::LoadCampaign;
+using campaign::PolynomialLaw;
+using campaign::RunCampaign;
+
 namespace {
 
 namespace fs = std::filesystem;

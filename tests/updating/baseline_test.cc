@@ -7,9 +7,9 @@
 #include <sstream>
 
 #include "crane_fixture.h"
-#include "mbid/identification/updating/output_error.h"
-#include "mbid/identification/updating/settings.h"
 #include "mbid/simulation/sensor.h"
+#include "mbid/updating/output_error.h"
+#include "mbid/updating/settings.h"
 
 namespace mbid::updating {
 namespace {

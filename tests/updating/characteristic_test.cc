@@ -1,6 +1,6 @@
 // Route 1 (method.md, eqs. 6-8) on the reference crane: exact poles of the model's own
 // linearization, so eq. 7 holds exactly at the true joint values.
-#include "mbid/identification/updating/characteristic.h"
+#include "mbid/updating/characteristic.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // torsional oscillator's closed-form free decay differentiated by central differences (no
 // CVODES at all), the Schur complement of an explicit offset column, and UpdateModel's own
 // covariance on the crane.
-#include "mbid/identification/updating/fisher.h"
+#include "mbid/updating/fisher.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // The global search of Route 2 (global_search.h) and the credibility of its numbers
 // (credibility.h), on the case that fooled the local fit: the paper's 650 kg load drop of the
 // reference crane with 1e-5 rad noise, started from a design model 22-36% off.
-#include "mbid/identification/updating/global_search.h"
+#include "mbid/updating/global_search.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <random>
 
 #include "crane_fixture.h"
-#include "mbid/identification/updating/credibility.h"
 #include "mbid/simulation/sensor.h"
+#include "mbid/updating/credibility.h"
 
 namespace mbid::updating {
 namespace {

@@ -7,8 +7,8 @@
 #include <string>
 
 #include "mbid/common/yaml_reader.h"
-#include "mbid/identification/updating/fisher.h"
 #include "mbid/model/model_factory.h"
+#include "mbid/updating/fisher.h"
 
 namespace mbid::updating::testing {
 

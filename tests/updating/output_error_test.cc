@@ -1,7 +1,7 @@
 // Route 2 (time-domain output error with Ceres) on records simulated from the reference crane:
 // known truth, so recovery, the reported uncertainty and the identifiability report can all be
 // checked against it.
-#include "mbid/identification/updating/output_error.h"
+#include "mbid/updating/output_error.h"
 
 #include <gtest/gtest.h>
 

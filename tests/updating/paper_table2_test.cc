@@ -9,9 +9,9 @@
 
 #include "../support/paper_table1.h"
 #include "crane_fixture.h"
-#include "mbid/identification/updating/characteristic.h"
 #include "mbid/model/linear_model.h"
 #include "mbid/simulation/modal_record.h"
+#include "mbid/updating/characteristic.h"
 
 namespace mbid::updating {
 namespace {

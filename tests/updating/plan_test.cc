@@ -1,7 +1,7 @@
 // Next-test planning (updating/plan.h): the D-optimal score's exact properties on the torsional
 // oscillator, and the reference crane's worked example of docs/planning.md: after the paper's
 // 650 kg load drop, which next test determines d_eta, checked by fitting that test's record.
-#include "mbid/identification/updating/plan.h"
+#include "mbid/updating/plan.h"
 
 #include <gtest/gtest.h>
 

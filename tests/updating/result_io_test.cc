@@ -1,5 +1,5 @@
 // The `update` JSON of docs/interfaces.md and the /updating HDF5 group.
-#include "mbid/identification/updating/result_io.h"
+#include "mbid/updating/result_io.h"
 
 #include <gtest/gtest.h>
 

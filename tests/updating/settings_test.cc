@@ -1,5 +1,5 @@
 // The `updating:` scenario section (read strictly) and the glue between Route 1 and Route 2.
-#include "mbid/identification/updating/settings.h"
+#include "mbid/updating/settings.h"
 
 #include <gtest/gtest.h>
 

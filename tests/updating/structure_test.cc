@@ -1,6 +1,6 @@
 // Structural identification (updating/structure.h): the ranking finds the joint a record's
 // machine did not have, and the leave-one-out prediction error reads in noise units.
-#include "mbid/identification/updating/structure.h"
+#include "mbid/updating/structure.h"
 
 #include <gtest/gtest.h>
 

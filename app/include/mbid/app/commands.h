@@ -3,8 +3,8 @@
 #include <string>
 #include <vector>
 
-#include "mbid/app/record_import.h"
 #include "mbid/identification/options.h"
+#include "mbid/validation/record_import.h"
 
 namespace mbid::app {
 
@@ -13,7 +13,7 @@ struct CommonOptions {
   bool quiet = false;      // no progress on standard error
   std::string json_path;   // "" = none, "-" = standard output
   bool overwrite = false;  // replace an output folder an earlier run of the command wrote
-  ImportOverrides import;  // --channel, --unit, --fill-gaps for measured files
+  validation::ImportOverrides import;  // --channel, --unit, --fill-gaps for measured files
 };
 
 // `mbid modes SCENARIO [--json FILE]`: the linearized model and its exact modes.

@@ -15,9 +15,4 @@ namespace mbid::app {
 int RunValidationCycle(const std::string& scenario_path, const std::string& output_dir,
                        const CommonOptions& common);
 
-// Whether `folder` holds the results of an earlier `mbid run` and nothing else: run.h5 and
-// summary.json (or the marker file of this version), report.md, PNG figures, and subfolders of
-// figures for several tests.
-bool IsRunFolder(const std::string& folder);
-
 }  // namespace mbid::app

@@ -1,0 +1,79 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "mbid/common/hdf5_io.h"
+#include "mbid/common/yaml_reader.h"
+
+namespace mbid::campaign {
+
+// `study: laws` (method.md, sub-problem 3): how stiffness and damping change with the operating
+// condition. Each quantity (a summary column: updated.c_theta, truth.d_theta,
+// identified.mode1.frequency_hz, ...) is fitted over the cases that have it as a polynomial of
+// total degree <= `degree` in the variables (summary columns, normally swept keys such as
+// model.configuration.boom_elevation_deg).
+struct LawsSpec {
+  std::vector<std::string> variables;
+  std::vector<std::string> quantities;
+  int degree = 1;
+};
+
+// Reads the `laws:` section. Variables must be swept keys; quantities must name a column the
+// steps produce (updated.* needs update, identified.* needs identify).
+LawsSpec ReadLaws(const YamlReader& section, const std::vector<std::string>& swept_keys,
+                  bool identify, bool update);
+
+// y = sum_j a_j prod_i x_i^e_ji over the monomials of total degree <= degree, fitted by least
+// squares. The fit runs on the variables scaled to [-1, 1] over the data (for conditioning)
+// and is expanded back to coefficients of the raw variables. Uncertainty: with s^2 = RSS /
+// (N - P) the residual variance, Cov(a) = s^2 (A^T A)^-1 (ordinary least squares with
+// independent errors of equal variance); with N = P the fit is exact and the std is NaN.
+struct PolynomialLaw {
+  std::string quantity;
+  std::string units;  // the quantity's unit (the model's, for c_ and d_ parameters)
+  std::vector<std::string> variables;
+  std::vector<std::vector<int>> exponents;  // per term, per variable; graded order
+  Eigen::VectorXd coefficients;             // of the raw variables
+  Eigen::VectorXd std;                      // one standard deviation of each coefficient
+  Eigen::MatrixXd covariance;               // of the raw coefficients
+  int samples = 0;
+  double residual_std = 0;  // s, in the quantity's unit (NaN when N = P)
+  double r_squared = 0;
+  std::string status = "ok";  // or why the law could not be fitted
+
+  // Scaled form, used for evaluation: u_i = (x_i - center_i) / half_range_i.
+  Eigen::VectorXd center, half_range;
+  Eigen::VectorXd scaled_coefficients;
+  Eigen::MatrixXd scaled_covariance;
+
+  double Evaluate(const Eigen::VectorXd& x) const;
+  // Standard deviation of the fitted value at x (the law's own uncertainty, not the scatter).
+  double CalcStd(const Eigen::VectorXd& x) const;
+  // "1", "x", "x^2*y" with the variables' names.
+  std::string TermName(int term) const;
+};
+
+// Fits y (N) over x (N x variables). Too few points or variables that do not vary enough to
+// determine the terms give a law with status saying so and NaN coefficients.
+PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int degree,
+                               const std::vector<std::string>& variables,
+                               const std::string& quantity);
+
+// The laws of every quantity from the summary rows (cases with status ok and the values).
+std::vector<PolynomialLaw> FitLaws(const LawsSpec& spec,
+                                   const std::vector<nlohmann::ordered_json>& rows);
+
+// /laws/<quantity>/: terms, coefficients, std, covariance, samples, residual_std, r_squared.
+void WriteLaws(H5Writer& file, const std::vector<PolynomialLaw>& laws);
+
+// The report section with one figure per quantity: the cases' values against the first
+// variable, the law (one curve per value of the other variables when they take few values,
+// otherwise at their mean) and its +-2 std band.
+std::string LawsReport(const LawsSpec& spec, const std::vector<PolynomialLaw>& laws,
+                       const std::vector<nlohmann::ordered_json>& rows, const std::string& folder,
+                       std::vector<std::string>* figures);
+
+}  // namespace mbid::campaign

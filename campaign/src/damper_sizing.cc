@@ -1,0 +1,451 @@
+#include "mbid/campaign/damper_sizing.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+
+#include "mbid/campaign/campaign.h"
+#include "mbid/campaign/campaign_case.h"
+#include "mbid/common/error.h"
+#include "mbid/report/gnuplot.h"
+
+namespace mbid::campaign {
+using report::DrawFigure;
+using report::Figure;
+using report::GnuplotAvailable;
+using report::PlotSeries;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kMaxBisections = 200;  // log2 of any range over any tolerance above 1e-15
+
+std::pair<double, double> ReadRange(const YamlReader& range) {
+  if (!range.node().IsSequence() || range.node().size() != 2) {
+    range.Fail("is not a pair", "[smallest, largest] damping in N*m*s/rad");
+  }
+  const double low = YamlReader(range.node()[0], range.source(), range.field() + "[0]").AsDouble();
+  const double high = YamlReader(range.node()[1], range.source(), range.field() + "[1]").AsDouble();
+  if (!(low >= 0 && low < high)) {
+    range.Fail(fmt::format("[{}, {}]", low, high), "0 <= smallest < largest");
+  }
+  return {low, high};
+}
+
+// The sweep point's metrics against one target.
+struct Point {
+  double min_damping_ratio = kNaN;
+  double settling_time_s = kNaN;
+};
+
+bool Meets(const DamperSizingSpec& spec, const std::string& target, const Point& point) {
+  const bool ratio = point.min_damping_ratio >= spec.min_damping_ratio;
+  const bool settling = point.settling_time_s <= spec.max_settling_time_s;
+  if (target == "min_damping_ratio") return ratio;
+  if (target == "max_settling_time_s") return settling;
+  return ratio && settling;
+}
+
+// Evaluates the model with d_joint = damping: an ad-hoc case of the campaign.
+class Evaluator {
+ public:
+  Evaluator(const Campaign& campaign, const std::string& joint) : campaign_(campaign) {
+    campaign_.cases.clear();
+    key_ = DamperSizingSpec::DampingKey(joint);
+    // The damping ratio alone needs no simulation.
+    if (!campaign.damper_sizing.has_settling_target()) campaign_.steps = {false, false, false};
+  }
+  // Targets bisect over the same brackets ("all" repeats another target's): each damping is
+  // evaluated once.
+  Point operator()(double damping, int* evaluations, std::string* failure) const {
+    ++*evaluations;
+    const auto cached = cache_.find(damping);
+    if (cached != cache_.end()) return cached->second;
+    const CampaignCase one_case = MakeAdHocCase(
+        campaign_, {{key_, NumberNode(damping), "damper_sizing.range_Nms_per_rad"}}, "sizing");
+    const CaseOutcome outcome = ComputeCase(campaign_, one_case);
+    Point point;
+    if (!outcome.ok()) {
+      *failure = outcome.reason;
+      return point;
+    }
+    point.min_damping_ratio =
+        *std::min_element(outcome.exact_damping_ratios.begin(), outcome.exact_damping_ratios.end());
+    point.settling_time_s = outcome.settling_time_s;
+    cache_.emplace(damping, point);
+    return point;
+  }
+
+ private:
+  Campaign campaign_;
+  std::string key_;
+  mutable std::map<double, Point> cache_;
+};
+
+Eigen::VectorXd ToVector(const std::vector<double>& values) {
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+}  // namespace
+
+std::string DamperSizingSpec::DampingKey(const std::string& joint) {
+  return "model.joints." + joint + ".damping_Nms_per_rad";
+}
+
+DamperSizingSpec ReadDamperSizing(const YamlReader& section, const YAML::Node& base) {
+  section.ExpectMap(
+      {"joints", "range_Nms_per_rad", "points", "spacing", "targets", "relative_tolerance"});
+  DamperSizingSpec spec;
+  spec.joints = section.StringList("joints");
+  if (spec.joints.empty())
+    section.FailAt("joints", "empty list", "the joints whose dampers to size");
+  const YAML::Node joints = base["model"]["joints"];
+  std::vector<std::string> known;
+  if (joints.IsMap()) {
+    for (const auto& item : joints) known.push_back(item.first.Scalar());
+  }
+  for (const std::string& joint : spec.joints) {
+    if (std::find(known.begin(), known.end(), joint) == known.end()) {
+      section.FailAt("joints", "unknown joint '" + joint + "'",
+                     fmt::format("joints of the base scenario's model: {}; did you mean '{}'?",
+                                 fmt::join(known, ", "), ClosestMatch(joint, known)));
+    }
+  }
+  const YamlReader range = section.Child("range_Nms_per_rad");
+  if (range.node().IsMap()) {
+    range.ExpectMap(spec.joints);
+    for (const std::string& joint : spec.joints) {
+      spec.range_Nms_per_rad[joint] = ReadRange(range.Child(joint));
+    }
+  } else {
+    const auto both = ReadRange(range);
+    for (const std::string& joint : spec.joints) spec.range_Nms_per_rad[joint] = both;
+  }
+  spec.points = section.Int("points", spec.points);
+  if (spec.points < 2 || spec.points > 10000) {
+    section.FailAt("points", std::to_string(spec.points), "an integer between 2 and 10000");
+  }
+  spec.log_spacing = section.Choice("spacing", {"log", "linear"}, "log") == "log";
+  if (spec.log_spacing) {
+    for (const auto& [joint, bounds] : spec.range_Nms_per_rad) {
+      if (!(bounds.first > 0)) {
+        section.FailAt("range_Nms_per_rad", fmt::format("{} starts at 0", joint),
+                       "a positive smallest damping for spacing: log");
+      }
+    }
+  }
+  const YamlReader targets = section.Child("targets");
+  targets.ExpectMap(
+      {"min_damping_ratio", "max_settling_time_s", "settling_band_fraction", "settling_band_rad"});
+  spec.min_damping_ratio = targets.Double("min_damping_ratio", 0.0);
+  spec.max_settling_time_s = targets.Double("max_settling_time_s", 0.0);
+  if (spec.min_damping_ratio < 0 || spec.min_damping_ratio > 1) {
+    targets.FailAt("min_damping_ratio", fmt::format("{}", spec.min_damping_ratio),
+                   "a damping ratio in (0, 1]");
+  }
+  if (spec.max_settling_time_s < 0) {
+    targets.FailAt("max_settling_time_s", fmt::format("{}", spec.max_settling_time_s),
+                   "a positive time in s");
+  }
+  if (spec.min_damping_ratio == 0 && spec.max_settling_time_s == 0) {
+    targets.Fail("no target", "min_damping_ratio and/or max_settling_time_s");
+  }
+  spec.settling_band_fraction = targets.Double("settling_band_fraction", 0.02);
+  if (!(spec.settling_band_fraction > 0 && spec.settling_band_fraction < 1)) {
+    targets.FailAt("settling_band_fraction", fmt::format("{}", spec.settling_band_fraction),
+                   "a fraction in (0, 1)");
+  }
+  spec.settling_band_rad = targets.Double("settling_band_rad", 0.0);
+  if (spec.settling_band_rad < 0) {
+    targets.FailAt("settling_band_rad", fmt::format("{}", spec.settling_band_rad),
+                   "a positive band in rad (or none: a fraction of the peak)");
+  }
+  if (spec.has_settling_target() && !base["excitation"].IsDefined()) {
+    targets.FailAt("max_settling_time_s", "a settling target without an excitation",
+                   "an excitation in the base scenario (the test that settles)");
+  }
+  spec.relative_tolerance = section.PositiveDouble("relative_tolerance", spec.relative_tolerance);
+  return spec;
+}
+
+std::vector<std::vector<Assignment>> DamperSizingCases(const DamperSizingSpec& spec,
+                                                       const std::string& field) {
+  std::vector<std::vector<Assignment>> cases;
+  for (const std::string& joint : spec.joints) {
+    const auto [low, high] = spec.range_Nms_per_rad.at(joint);
+    for (int k = 0; k < spec.points; ++k) {
+      const double u = static_cast<double>(k) / (spec.points - 1);
+      const double value = k == spec.points - 1 ? high
+                           : spec.log_spacing   ? low * std::pow(high / low, u)
+                                                : low + u * (high - low);
+      cases.push_back(
+          {{DamperSizingSpec::DampingKey(joint), NumberNode(value), field + ".range_Nms_per_rad"}});
+    }
+  }
+  return cases;
+}
+
+double CalcSettlingTime(const Measurement& exact, double after_s, double band_fraction,
+                        double band_rad) {
+  const Eigen::VectorXd t = exact.CalcTime();
+  Eigen::Index first = 0;
+  while (first < t.size() && t[first] < after_s - 1e-12) ++first;
+  if (first >= t.size()) return kNaN;
+  Eigen::Index last_outside = -1;
+  for (int c = 0; c < exact.channel_count(); ++c) {
+    const auto y = exact.values.col(c).tail(t.size() - first);
+    const double band = band_rad > 0 ? band_rad : band_fraction * y.cwiseAbs().maxCoeff();
+    for (Eigen::Index j = y.size() - 1; j >= 0; --j) {
+      if (std::abs(y[j]) > band) {
+        last_outside = std::max(last_outside, first + j);
+        break;
+      }
+    }
+  }
+  if (last_outside < 0) return 0.0;
+  if (last_outside == t.size() - 1) return kInf;
+  return t[last_outside + 1] - after_s;
+}
+
+DamperSizingResult SizeDampers(const Campaign& campaign,
+                               const std::vector<nlohmann::ordered_json>& rows) {
+  const DamperSizingSpec& spec = campaign.damper_sizing;
+  DamperSizingResult result;
+  std::vector<std::string> targets;
+  if (spec.min_damping_ratio > 0) targets.push_back("min_damping_ratio");
+  if (spec.has_settling_target()) targets.push_back("max_settling_time_s");
+  if (targets.size() == 2) targets.push_back("all");
+
+  for (const std::string& joint : spec.joints) {
+    const std::string key = DamperSizingSpec::DampingKey(joint);
+    JointSizing sizing;
+    sizing.joint = joint;
+    std::vector<double> damping;
+    std::vector<Point> points;
+    std::vector<std::vector<double>> ratios;
+    size_t modes = 0;
+    for (const auto& row : rows) {
+      if (!row.contains(key)) continue;
+      damping.push_back(RowNumber(row, key));
+      Point point;
+      std::vector<double> mode_ratios;
+      if (row["status"] == "ok") {
+        point.min_damping_ratio = RowNumber(row, "exact.min_damping_ratio");
+        point.settling_time_s = RowNumber(row, "settling_time_s");
+        if (row.contains("settling_time_s") && row["settling_time_s"].is_null()) {
+          point.settling_time_s = kInf;  // not settled within the record
+        }
+        for (int k = 1; row.contains(fmt::format("exact.mode{}.damping_ratio", k)); ++k) {
+          mode_ratios.push_back(RowNumber(row, fmt::format("exact.mode{}.damping_ratio", k)));
+        }
+      }
+      modes = std::max(modes, mode_ratios.size());
+      points.push_back(point);
+      ratios.push_back(mode_ratios);
+    }
+    const Eigen::Index n = static_cast<Eigen::Index>(damping.size());
+    sizing.damping_Nms_per_rad = ToVector(damping);
+    sizing.damping_ratio = Eigen::MatrixXd::Constant(n, static_cast<Eigen::Index>(modes), kNaN);
+    sizing.min_damping_ratio.resize(n);
+    sizing.settling_time_s.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const auto& mode_ratios = ratios[static_cast<size_t>(i)];
+      for (size_t k = 0; k < mode_ratios.size(); ++k) {
+        sizing.damping_ratio(i, static_cast<Eigen::Index>(k)) = mode_ratios[k];
+      }
+      sizing.min_damping_ratio[i] = points[static_cast<size_t>(i)].min_damping_ratio;
+      sizing.settling_time_s[i] = points[static_cast<size_t>(i)].settling_time_s;
+    }
+
+    const Evaluator evaluate(campaign, joint);
+    for (const std::string& target : targets) {
+      sizing.targets.push_back(target);
+      size_t first = 0;
+      while (first < points.size() && !Meets(spec, target, points[first])) ++first;
+      if (first == points.size()) {
+        sizing.smallest_Nms_per_rad.push_back(kNaN);
+        sizing.notes.push_back(fmt::format("not met by any damping up to {:.6g} N*m*s/rad",
+                                           damping.empty() ? kNaN : damping.back()));
+        continue;
+      }
+      if (first == 0) {
+        sizing.smallest_Nms_per_rad.push_back(damping[0]);
+        sizing.notes.push_back("met at the smallest damping of the range; smaller not tried");
+        continue;
+      }
+      // Bisection between the last failing and the first admissible sweep point: it finds the
+      // smallest admissible damping when the target holds on one side of a single crossing,
+      // and a crossing inside the bracket otherwise.
+      double low = damping[first - 1];
+      double high = damping[first];
+      int evaluations = 0;
+      std::string failure;
+      for (int i = 0; i < kMaxBisections && (high - low) > spec.relative_tolerance * high; ++i) {
+        const double middle =
+            spec.log_spacing && low > 0 ? std::sqrt(low * high) : 0.5 * (low + high);
+        (Meets(spec, target, evaluate(middle, &evaluations, &failure)) ? high : low) = middle;
+      }
+      result.refinement_evaluations += evaluations;
+      sizing.smallest_Nms_per_rad.push_back(high);
+      std::string note = fmt::format("bisection between {:.6g} and {:.6g} N*m*s/rad ({} steps)",
+                                     damping[first - 1], damping[first], evaluations);
+      if (!failure.empty()) note += "; some evaluations failed: " + failure;
+      sizing.notes.push_back(note);
+    }
+    result.joints.push_back(std::move(sizing));
+  }
+  return result;
+}
+
+void WriteDamperSizing(H5Writer& file, const DamperSizingSpec& spec,
+                       const DamperSizingResult& result) {
+  const std::string root = "/damper_sizing";
+  file.WriteDoubleAttribute(root, "min_damping_ratio", spec.min_damping_ratio);
+  file.WriteDoubleAttribute(root, "max_settling_time_s", spec.max_settling_time_s);
+  file.WriteDoubleAttribute(root, "settling_band_fraction", spec.settling_band_fraction);
+  file.WriteDoubleAttribute(root, "settling_band_rad", spec.settling_band_rad);
+  file.WriteDoubleAttribute(root, "relative_tolerance", spec.relative_tolerance);
+  for (const JointSizing& joint : result.joints) {
+    const std::string group = root + "/" + joint.joint;
+    file.WriteVector(group, "damping_Nms_per_rad", joint.damping_Nms_per_rad, "N*m*s/rad");
+    file.WriteMatrix(group, "damping_ratio", joint.damping_ratio, "1");
+    file.WriteVector(group, "min_damping_ratio", joint.min_damping_ratio, "1");
+    if (spec.has_settling_target()) {
+      file.WriteVector(group, "settling_time_s", joint.settling_time_s, "s");
+    }
+    file.WriteStrings(group, "targets", joint.targets);
+    file.WriteVector(group, "smallest_Nms_per_rad", ToVector(joint.smallest_Nms_per_rad),
+                     "N*m*s/rad");
+    file.WriteStrings(group, "notes", joint.notes);
+  }
+}
+
+std::string DamperSizingReport(const DamperSizingSpec& spec, const DamperSizingResult& result,
+                               const std::string& folder, std::vector<std::string>* figures) {
+  std::ostringstream md;
+  md << "## Damper sizing\n\n";
+  md << "Each joint's damping `d_k` alone is swept over its range (the other joints keep the "
+        "base scenario's values); the smallest admissible `d_k` is refined by bisection between "
+        "the last sweep point that fails a target and the first that meets it.\n\nTargets: ";
+  std::vector<std::string> targets;
+  if (spec.min_damping_ratio > 0) {
+    targets.push_back(fmt::format("smallest modal damping ratio >= {}", spec.min_damping_ratio));
+  }
+  if (spec.has_settling_target()) {
+    targets.push_back(fmt::format(
+        "settling time <= {} s (band: {})", spec.max_settling_time_s,
+        spec.settling_band_rad > 0
+            ? fmt::format("{} rad", spec.settling_band_rad)
+            : fmt::format("{} of each output's peak deviation", spec.settling_band_fraction)));
+  }
+  md << fmt::format("{}.\n\n", fmt::join(targets, "; "));
+  md << "| joint | target | smallest d, N*m*s/rad | how |\n|---|---|---|---|\n";
+  for (const JointSizing& joint : result.joints) {
+    for (size_t t = 0; t < joint.targets.size(); ++t) {
+      const double d = joint.smallest_Nms_per_rad[t];
+      md << fmt::format("| {} | {} | {} | {} |\n", joint.joint, joint.targets[t],
+                        std::isfinite(d) ? fmt::format("{:.6g}", d) : "not met", joint.notes[t]);
+    }
+  }
+  md << "\n";
+  if (!GnuplotAvailable()) {
+    md << "gnuplot with pngcairo was not found: no figures.\n\n";
+    return md.str();
+  }
+  for (const JointSizing& joint : result.joints) {
+    const Eigen::Index n = joint.damping_Nms_per_rad.size();
+    if (n == 0) continue;
+    const double d_low = joint.damping_Nms_per_rad.minCoeff();
+    const double d_high = joint.damping_Nms_per_rad.maxCoeff();
+    const std::string x_range = spec.log_spacing
+                                    ? fmt::format("[{}:{}]", d_low / 1.25, d_high * 1.25)
+                                    : fmt::format("[{}:{}]", d_low, d_high);
+    const auto marker = [&](const std::string& target, double y_low, double y_high,
+                            std::vector<PlotSeries>& series) {
+      for (size_t t = 0; t < joint.targets.size(); ++t) {
+        if (joint.targets[t] != target || !std::isfinite(joint.smallest_Nms_per_rad[t])) continue;
+        const double d = joint.smallest_Nms_per_rad[t];
+        series.push_back({fmt::format("smallest d = {:.4g} N*m*s/rad", d), Eigen::Vector2d(d, d),
+                          Eigen::Vector2d(y_low, y_high), "lines dt 2 lw 2 lc rgb '#2ca02c'"});
+      }
+    };
+    {
+      Figure figure;
+      figure.title = fmt::format("Damping ratio of every mode vs d_{}", joint.joint);
+      figure.x_label = fmt::format("d_{}, N*m*s/rad", joint.joint);
+      figure.y_label = "damping ratio, 1";
+      figure.log_x = spec.log_spacing;
+      figure.x_range = x_range;
+      figure.y_range = "[0:*]";
+      figure.key = "outside right top box";
+      for (Eigen::Index k = 0; k < joint.damping_ratio.cols(); ++k) {
+        std::vector<double> x, y;
+        for (Eigen::Index i = 0; i < n; ++i) {
+          if (!std::isfinite(joint.damping_ratio(i, k))) continue;
+          x.push_back(joint.damping_Nms_per_rad[i]);
+          y.push_back(joint.damping_ratio(i, k));
+        }
+        if (x.empty()) continue;
+        figure.series.push_back(
+            {fmt::format("mode {}", k + 1), ToVector(x), ToVector(y), "linespoints pt 7 ps 0.6"});
+      }
+      if (spec.min_damping_ratio > 0) {
+        figure.series.push_back(
+            {fmt::format("target {}", spec.min_damping_ratio), Eigen::Vector2d(d_low, d_high),
+             Eigen::Vector2d::Constant(spec.min_damping_ratio), "lines dt 3 lw 2 lc rgb 'black'"});
+        double top = spec.min_damping_ratio;
+        for (Eigen::Index i = 0; i < joint.damping_ratio.size(); ++i) {
+          if (std::isfinite(joint.damping_ratio.data()[i])) {
+            top = std::max(top, joint.damping_ratio.data()[i]);
+          }
+        }
+        marker("min_damping_ratio", 0.0, top, figure.series);
+      }
+      const std::string name = fmt::format("damping_ratio_vs_d_{}.png", joint.joint);
+      DrawFigure(figure, (fs::path(folder) / name).string());
+      figures->push_back(name);
+      md << "![Damping ratio vs d_" << joint.joint << "](" << name << ")\n\n";
+    }
+    if (spec.has_settling_target()) {
+      Figure figure;
+      figure.title = fmt::format("Settling time of the outputs vs d_{}", joint.joint);
+      figure.x_label = fmt::format("d_{}, N*m*s/rad", joint.joint);
+      figure.y_label = "settling time, s";
+      figure.log_x = spec.log_spacing;
+      figure.x_range = x_range;
+      figure.y_range = "[0:*]";
+      figure.key = "outside right top box";
+      std::vector<double> x, y;
+      double y_max = spec.max_settling_time_s;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (!std::isfinite(joint.settling_time_s[i])) continue;
+        x.push_back(joint.damping_Nms_per_rad[i]);
+        y.push_back(joint.settling_time_s[i]);
+        y_max = std::max(y_max, y.back());
+      }
+      figure.series.push_back({"settling time (cases)", ToVector(x), ToVector(y),
+                               "linespoints pt 7 ps 0.6 lc rgb '#1f77b4'"});
+      figure.series.push_back(
+          {fmt::format("target {} s", spec.max_settling_time_s), Eigen::Vector2d(d_low, d_high),
+           Eigen::Vector2d::Constant(spec.max_settling_time_s), "lines dt 3 lw 2 lc rgb 'black'"});
+      marker("max_settling_time_s", 0.0, y_max, figure.series);
+      const std::string name = fmt::format("settling_time_vs_d_{}.png", joint.joint);
+      DrawFigure(figure, (fs::path(folder) / name).string());
+      figures->push_back(name);
+      md << "![Settling time vs d_" << joint.joint << "](" << name << ")\n\n";
+      if (static_cast<Eigen::Index>(x.size()) < n) {
+        md << "Dampings whose outputs did not settle within the record are not plotted.\n\n";
+      }
+    }
+  }
+  return md.str();
+}
+
+}  // namespace mbid::campaign

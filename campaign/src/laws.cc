@@ -1,0 +1,384 @@
+#include "mbid/campaign/laws.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "mbid/campaign/campaign_case.h"
+#include "mbid/report/gnuplot.h"
+#include "units.h"
+
+namespace mbid::campaign {
+using report::DrawFigure;
+using report::Figure;
+using report::GnuplotAvailable;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr int kMaxDegree = 4;
+// Singular values of the scaled design matrix below this fraction of the largest mean the
+// cases do not determine the terms (variables that do not vary, too few distinct values).
+constexpr double kRankTolerance = 1e-10;
+constexpr int kMaxCurves = 4;  // curves per figure for the other variables' values
+constexpr int kCurvePoints = 101;
+
+// Monomials of total degree <= degree in `variables` variables: by total degree, then by
+// decreasing exponent of the first variable (1, x, y, x^2, x*y, y^2).
+std::vector<std::vector<int>> Monomials(int variables, int degree) {
+  std::vector<std::vector<int>> terms;
+  std::vector<int> exponents(static_cast<size_t>(variables), 0);
+  std::function<void(int, int)> fill = [&](int variable, int left) {
+    if (variable == variables - 1) {
+      exponents[static_cast<size_t>(variable)] = left;
+      terms.push_back(exponents);
+      return;
+    }
+    for (int e = left; e >= 0; --e) {
+      exponents[static_cast<size_t>(variable)] = e;
+      fill(variable + 1, left - e);
+    }
+  };
+  for (int total = 0; total <= degree; ++total) fill(0, total);
+  return terms;
+}
+
+double Monomial(const std::vector<int>& exponents, const Eigen::VectorXd& u) {
+  double value = 1;
+  for (size_t i = 0; i < exponents.size(); ++i) {
+    value *= std::pow(u[static_cast<Eigen::Index>(i)], exponents[i]);
+  }
+  return value;
+}
+
+double Binomial(int n, int k) {
+  double value = 1;
+  for (int i = 1; i <= k; ++i) value = value * (n - k + i) / i;
+  return value;
+}
+
+// T with raw = T * scaled: expands each prod_i ((x_i - c_i) / h_i)^e_i by the binomial theorem.
+Eigen::MatrixXd ScaledToRaw(const std::vector<std::vector<int>>& terms,
+                            const Eigen::VectorXd& center, const Eigen::VectorXd& half_range) {
+  const Eigen::Index p = static_cast<Eigen::Index>(terms.size());
+  Eigen::MatrixXd transform = Eigen::MatrixXd::Zero(p, p);
+  std::map<std::vector<int>, Eigen::Index> index;
+  for (Eigen::Index j = 0; j < p; ++j) index[terms[static_cast<size_t>(j)]] = j;
+  for (Eigen::Index j = 0; j < p; ++j) {
+    const std::vector<int>& e = terms[static_cast<size_t>(j)];
+    std::vector<int> k(e.size(), 0);
+    while (true) {
+      double coefficient = 1;
+      for (size_t i = 0; i < e.size(); ++i) {
+        const double a = 1.0 / half_range[static_cast<Eigen::Index>(i)];
+        const double b = -center[static_cast<Eigen::Index>(i)] * a;
+        coefficient *= Binomial(e[i], k[i]) * std::pow(a, k[i]) * std::pow(b, e[i] - k[i]);
+      }
+      transform(index.at(k), j) += coefficient;
+      size_t i = 0;
+      while (i < k.size() && k[i] == e[i]) k[i++] = 0;
+      if (i == k.size()) break;
+      ++k[i];
+    }
+  }
+  return transform;
+}
+
+PolynomialLaw Unfitted(PolynomialLaw law, const std::string& why) {
+  law.status = why;
+  const Eigen::Index p = static_cast<Eigen::Index>(law.exponents.size());
+  law.coefficients = law.std = law.scaled_coefficients = Eigen::VectorXd::Constant(p, kNaN);
+  law.covariance = law.scaled_covariance = Eigen::MatrixXd::Constant(p, p, kNaN);
+  law.residual_std = law.r_squared = kNaN;
+  return law;
+}
+
+Eigen::VectorXd ToVector(const std::vector<double>& values) {
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+}  // namespace
+
+double PolynomialLaw::Evaluate(const Eigen::VectorXd& x) const {
+  const Eigen::VectorXd u = (x - center).cwiseQuotient(half_range);
+  double value = 0;
+  for (size_t j = 0; j < exponents.size(); ++j) {
+    value += scaled_coefficients[static_cast<Eigen::Index>(j)] * Monomial(exponents[j], u);
+  }
+  return value;
+}
+
+double PolynomialLaw::CalcStd(const Eigen::VectorXd& x) const {
+  const Eigen::VectorXd u = (x - center).cwiseQuotient(half_range);
+  Eigen::VectorXd phi(static_cast<Eigen::Index>(exponents.size()));
+  for (size_t j = 0; j < exponents.size(); ++j) {
+    phi[static_cast<Eigen::Index>(j)] = Monomial(exponents[j], u);
+  }
+  return std::sqrt(phi.dot(scaled_covariance * phi));
+}
+
+std::string PolynomialLaw::TermName(int term) const {
+  std::vector<std::string> factors;
+  const std::vector<int>& e = exponents[static_cast<size_t>(term)];
+  for (size_t i = 0; i < e.size(); ++i) {
+    if (e[i] == 0) continue;
+    const std::string name = internal::ShortName(variables[i]);
+    factors.push_back(e[i] == 1 ? name : fmt::format("{}^{}", name, e[i]));
+  }
+  return factors.empty() ? "1" : fmt::format("{}", fmt::join(factors, "*"));
+}
+
+PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int degree,
+                               const std::vector<std::string>& variables,
+                               const std::string& quantity) {
+  PolynomialLaw law;
+  law.quantity = quantity;
+  law.variables = variables;
+  law.exponents = Monomials(static_cast<int>(variables.size()), degree);
+  law.samples = static_cast<int>(y.size());
+  const Eigen::Index n = y.size();
+  const Eigen::Index p = static_cast<Eigen::Index>(law.exponents.size());
+  if (n < p) {
+    return Unfitted(law, fmt::format("{} cases with values, fewer than the {} terms", n, p));
+  }
+  law.center = 0.5 * (x.colwise().maxCoeff() + x.colwise().minCoeff()).transpose();
+  law.half_range = 0.5 * (x.colwise().maxCoeff() - x.colwise().minCoeff()).transpose();
+  for (Eigen::Index i = 0; i < law.half_range.size(); ++i) {
+    if (!(law.half_range[i] > 0)) law.half_range[i] = 1;  // caught by the rank test below
+  }
+  Eigen::MatrixXd design(n, p);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const Eigen::VectorXd u = (x.row(r).transpose() - law.center).cwiseQuotient(law.half_range);
+    for (Eigen::Index j = 0; j < p; ++j) {
+      design(r, j) = Monomial(law.exponents[static_cast<size_t>(j)], u);
+    }
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(design, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd& s = svd.singularValues();
+  if (!(s[p - 1] > kRankTolerance * s[0])) {
+    return Unfitted(law,
+                    "the cases do not determine the terms (variables that do not vary, or "
+                    "too few distinct values for the degree)");
+  }
+  law.scaled_coefficients = svd.solve(y);
+  const Eigen::VectorXd residual = y - design * law.scaled_coefficients;
+  const double rss = residual.squaredNorm();
+  const double tss = (y.array() - y.mean()).matrix().squaredNorm();
+  law.r_squared = tss > 0 ? 1 - rss / tss : kNaN;
+  const Eigen::MatrixXd inverse_normal =
+      svd.matrixV() * s.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
+  const double variance = n > p ? rss / static_cast<double>(n - p) : kNaN;
+  law.residual_std = std::sqrt(variance);
+  law.scaled_covariance = variance * inverse_normal;
+  const Eigen::MatrixXd transform = ScaledToRaw(law.exponents, law.center, law.half_range);
+  law.coefficients = transform * law.scaled_coefficients;
+  law.covariance = transform * law.scaled_covariance * transform.transpose();
+  law.std = law.covariance.diagonal().cwiseSqrt();
+  return law;
+}
+
+LawsSpec ReadLaws(const YamlReader& section, const std::vector<std::string>& swept_keys,
+                  bool identify, bool update) {
+  section.ExpectMap({"variables", "quantities", "degree"});
+  LawsSpec spec;
+  spec.variables = section.StringList("variables");
+  if (spec.variables.empty()) section.FailAt("variables", "empty list", "swept keys");
+  for (const std::string& variable : spec.variables) {
+    if (std::find(swept_keys.begin(), swept_keys.end(), variable) == swept_keys.end()) {
+      section.FailAt("variables", "'" + variable + "' is not swept",
+                     swept_keys.empty()
+                         ? std::string("a sweep: the laws' variables are swept keys")
+                         : fmt::format("one of the swept keys: {}", fmt::join(swept_keys, ", ")));
+    }
+  }
+  spec.quantities = section.StringList("quantities");
+  if (spec.quantities.empty()) {
+    section.FailAt("quantities", "empty list", "summary columns such as updated.c_theta");
+  }
+  for (const std::string& quantity : spec.quantities) {
+    const auto starts = [&](const char* prefix) { return quantity.rfind(prefix, 0) == 0; };
+    if (!starts("truth.") && !starts("exact.") && !starts("identified.") && !starts("updated.") &&
+        !starts("simulation.")) {
+      section.FailAt("quantities", "'" + quantity + "' is not a result column",
+                     "a summary column: truth.<parameter>, exact.mode<k>.<quantity>, "
+                     "identified.mode<k>.<quantity>, updated.<parameter>");
+    }
+    if (starts("identified.") && !identify) {
+      section.FailAt("quantities", "'" + quantity + "' needs the identify step",
+                     "steps: [identify] (or all)");
+    }
+    if (starts("updated.") && !update) {
+      section.FailAt("quantities", "'" + quantity + "' needs the update step",
+                     "steps: [update] (or all)");
+    }
+  }
+  spec.degree = section.Int("degree", 1);
+  if (spec.degree < 0 || spec.degree > kMaxDegree) {
+    section.FailAt("degree", std::to_string(spec.degree), "an integer from 0 to 4");
+  }
+  return spec;
+}
+
+std::vector<PolynomialLaw> FitLaws(const LawsSpec& spec,
+                                   const std::vector<nlohmann::ordered_json>& rows) {
+  std::vector<PolynomialLaw> laws;
+  for (const std::string& quantity : spec.quantities) {
+    std::vector<Eigen::VectorXd> xs;
+    std::vector<double> ys;
+    for (const auto& row : rows) {
+      if (row["status"] != "ok") continue;
+      Eigen::VectorXd x(static_cast<Eigen::Index>(spec.variables.size()));
+      for (size_t i = 0; i < spec.variables.size(); ++i) {
+        x[static_cast<Eigen::Index>(i)] = RowNumber(row, spec.variables[i]);
+      }
+      const double y = RowNumber(row, quantity);
+      if (!x.allFinite() || !std::isfinite(y)) continue;
+      xs.push_back(x);
+      ys.push_back(y);
+    }
+    Eigen::MatrixXd x(static_cast<Eigen::Index>(xs.size()),
+                      static_cast<Eigen::Index>(spec.variables.size()));
+    for (size_t r = 0; r < xs.size(); ++r) x.row(static_cast<Eigen::Index>(r)) = xs[r];
+    laws.push_back(FitPolynomialLaw(x, ToVector(ys), spec.degree, spec.variables, quantity));
+  }
+  return laws;
+}
+
+void WriteLaws(H5Writer& file, const std::vector<PolynomialLaw>& laws) {
+  for (const PolynomialLaw& law : laws) {
+    const std::string group = "/laws/" + law.quantity;
+    const std::string unit = law.units.empty() ? internal::UnitOfColumn(law.quantity) : law.units;
+    file.WriteStringAttribute(group, "status", law.status);
+    file.WriteStrings(group, "variables", law.variables);
+    std::vector<std::string> terms, units;
+    Eigen::MatrixXd exponents(static_cast<Eigen::Index>(law.exponents.size()),
+                              static_cast<Eigen::Index>(law.variables.size()));
+    for (size_t j = 0; j < law.exponents.size(); ++j) {
+      terms.push_back(law.TermName(static_cast<int>(j)));
+      std::string term_unit = unit;
+      for (size_t i = 0; i < law.variables.size(); ++i) {
+        exponents(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = law.exponents[j][i];
+        const int e = law.exponents[j][i];
+        if (e > 0) {
+          term_unit +=
+              "/" + internal::UnitOfColumn(law.variables[i]) + (e > 1 ? fmt::format("^{}", e) : "");
+        }
+      }
+      units.push_back(term_unit);
+    }
+    file.WriteStrings(group, "terms", terms);
+    file.WriteStrings(group, "coefficient_units", units);
+    file.WriteMatrix(group, "exponents", exponents, "1");
+    file.WriteVector(group, "coefficients", law.coefficients, "see coefficient_units");
+    file.WriteVector(group, "std", law.std, "see coefficient_units");
+    file.WriteMatrix(group, "covariance", law.covariance, "products of coefficient_units");
+    file.WriteScalar(group, "samples", law.samples, "1");
+    file.WriteScalar(group, "residual_std", law.residual_std, unit);
+    file.WriteScalar(group, "r_squared", law.r_squared, "1");
+  }
+}
+
+std::string LawsReport(const LawsSpec& spec, const std::vector<PolynomialLaw>& laws,
+                       const std::vector<nlohmann::ordered_json>& rows, const std::string& folder,
+                       std::vector<std::string>* figures) {
+  std::ostringstream md;
+  md << "## Laws: how the parameters change with the operating condition\n\n";
+  md << fmt::format(
+      "Each quantity is fitted over the successful cases as a polynomial of total degree {} in "
+      "`{}` by least squares; the standard deviations assume independent errors of equal "
+      "variance, estimated from the residuals (s^2 = RSS / (N - P)).\n\n",
+      spec.degree, fmt::join(spec.variables, "`, `"));
+  const bool gnuplot = GnuplotAvailable();
+  for (size_t q = 0; q < laws.size(); ++q) {
+    const PolynomialLaw& law = laws[q];
+    const std::string unit = law.units.empty() ? internal::UnitOfColumn(law.quantity) : law.units;
+    md << "### " << law.quantity << " (" << unit << ")\n\n";
+    if (law.status != "ok") {
+      md << "Not fitted: " << law.status << ".\n\n";
+      continue;
+    }
+    md << "| term | coefficient | std |\n|---|---|---|\n";
+    for (Eigen::Index j = 0; j < law.coefficients.size(); ++j) {
+      md << fmt::format("| {} | {:.6g} | {:.3g} |\n", law.TermName(static_cast<int>(j)),
+                        law.coefficients[j], law.std[j]);
+    }
+    md << fmt::format("\n{} cases; residual std {:.4g} {}; R^2 = {:.6f}.\n\n", law.samples,
+                      law.residual_std, unit, law.r_squared);
+    if (!gnuplot) continue;
+
+    // Data against the first variable; curves for the other variables' values.
+    const std::string& x_key = law.variables.front();
+    std::vector<double> data_x, data_y;
+    std::vector<Eigen::VectorXd> others;  // distinct values of the other variables
+    for (const auto& row : rows) {
+      if (row["status"] != "ok") continue;
+      Eigen::VectorXd x(static_cast<Eigen::Index>(law.variables.size()));
+      for (size_t i = 0; i < law.variables.size(); ++i) {
+        x[static_cast<Eigen::Index>(i)] = RowNumber(row, law.variables[i]);
+      }
+      const double y = RowNumber(row, law.quantity);
+      if (!x.allFinite() || !std::isfinite(y)) continue;
+      data_x.push_back(x[0]);
+      data_y.push_back(y);
+      const Eigen::VectorXd rest = x.tail(x.size() - 1);
+      const bool seen = std::any_of(others.begin(), others.end(),
+                                    [&](const Eigen::VectorXd& o) { return o == rest; });
+      if (!seen) others.push_back(rest);
+    }
+    if (others.size() > static_cast<size_t>(kMaxCurves)) {
+      Eigen::VectorXd mean = Eigen::VectorXd::Zero(others.front().size());
+      for (const auto& o : others) mean += o / static_cast<double>(others.size());
+      others = {mean};
+    }
+    Figure figure;
+    figure.title = fmt::format("{} vs {}: cases and fitted law (degree {})", law.quantity,
+                               internal::ShortName(x_key), spec.degree);
+    figure.x_label = fmt::format("{}, {}", x_key, internal::UnitOfColumn(x_key));
+    figure.y_label = fmt::format("{}, {}", law.quantity, unit);
+    figure.pad_x = true;
+    figure.series.push_back(
+        {"cases", ToVector(data_x), ToVector(data_y), "points pt 7 ps 0.8 lc rgb '#1f77b4'"});
+    const double low = *std::min_element(data_x.begin(), data_x.end());
+    const double high = *std::max_element(data_x.begin(), data_x.end());
+    for (const Eigen::VectorXd& rest : others) {
+      Eigen::VectorXd xs(kCurvePoints), fit(kCurvePoints), lower(kCurvePoints), upper(kCurvePoints);
+      for (int i = 0; i < kCurvePoints; ++i) {
+        Eigen::VectorXd x(static_cast<Eigen::Index>(law.variables.size()));
+        x[0] = low + (high - low) * i / (kCurvePoints - 1);
+        x.tail(x.size() - 1) = rest;
+        xs[i] = x[0];
+        fit[i] = law.Evaluate(x);
+        const double std = law.CalcStd(x);
+        lower[i] = fit[i] - 2 * std;
+        upper[i] = fit[i] + 2 * std;
+      }
+      std::string label = "law";
+      for (Eigen::Index i = 0; i < rest.size(); ++i) {
+        label +=
+            fmt::format(" at {} = {:.4g}",
+                        internal::ShortName(law.variables[static_cast<size_t>(i + 1)]), rest[i]);
+      }
+      figure.series.push_back({label, xs, fit, "lines lw 2"});
+      if (others.size() == 1 && std::isfinite(upper[0])) {
+        figure.series.push_back({"law +- 2 std", xs, lower, "lines dt 2 lc rgb 'gray40'"});
+        figure.series.push_back({"", xs, upper, "lines dt 2 lc rgb 'gray40'"});
+      }
+    }
+    const std::string name = fmt::format("law_{}.png", q + 1);
+    DrawFigure(figure, (fs::path(folder) / name).string());
+    figures->push_back(name);
+    md << "![" << law.quantity << "](" << name << ")\n\n";
+  }
+  return md.str();
+}
+
+}  // namespace mbid::campaign

@@ -1,0 +1,25 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "mbid/campaign/campaign.h"
+
+namespace mbid::campaign::internal {
+
+// A study's part of the report: Markdown and the figures it drew.
+struct StudyReport {
+  std::string markdown;
+  std::vector<std::string> figures;
+};
+
+// report.md in `folder` (atomically): the campaign, its cases by status, the failed cases with
+// their reasons, the modes across the campaign against the first numeric swept key (exact and,
+// if identified, identified), then the study's section. Figures need gnuplot; without it the
+// report says so. Returns the names of all figures.
+std::vector<std::string> WriteCampaignReport(const Campaign& campaign,
+                                             const std::vector<nlohmann::ordered_json>& rows,
+                                             const std::string& folder, const StudyReport& study);
+
+}  // namespace mbid::campaign::internal

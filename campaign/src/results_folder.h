@@ -1,0 +1,46 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mbid/campaign/campaign.h"
+
+namespace mbid::campaign::internal {
+
+// The output folder of a campaign and the rules that make it safe to kill and resume:
+//
+//   DIR/campaign.json      manifest: the campaign's name, fingerprint and case count; written
+//                          first, so that --resume can refuse a different campaign
+//   DIR/cases/<id>.h5      one file per finished case, written under a temporary name and
+//                          renamed when complete: a case exists entirely or not at all
+//   DIR/campaign.h5        the merged results, renamed into place last: it exists only when
+//                          the campaign is complete (then cases/ is removed)
+//   DIR/summary.csv, DIR/report.md, DIR/*.png   written just before campaign.h5
+//
+// After kill -9 at any moment, the folder holds committed cases and perhaps temporaries;
+// --resume deletes the temporaries, checks that each committed case reads back, and runs the
+// rest. rename() within one folder is atomic on POSIX file systems.
+class ResultsFolder {
+ public:
+  enum class State { kNew, kResumed, kComplete };
+
+  explicit ResultsFolder(std::string dir) : dir_(std::move(dir)) {}
+
+  // Creates the folder and its manifest for a new campaign, or checks that a resumed folder
+  // belongs to this campaign. Errors (a folder holding something else, another campaign, a
+  // campaign without --resume) are InputErrors naming the folder.
+  State Prepare(const Campaign& campaign, bool resume) const;
+  // Which cases are committed, after removing temporaries and case files that do not read
+  // back (a file system that lost data). One flag per case of the campaign.
+  std::vector<bool> ScanCommitted(const Campaign& campaign) const;
+
+  std::string CasePath(const std::string& case_id) const;
+  std::string Path(const std::string& name) const;  // DIR/<name>
+  // Removes cases/ once campaign.h5 holds them.
+  void RemoveCases() const;
+
+ private:
+  std::string dir_;
+};
+
+}  // namespace mbid::campaign::internal

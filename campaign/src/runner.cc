@@ -1,0 +1,300 @@
+#include <fmt/format.h>
+#include <malloc.h>
+
+#include <algorithm>
+#include <condition_variable>
+#include <exception>
+#include <filesystem>
+#include <mutex>
+#include <system_error>
+#include <thread>
+
+#include "cluster.h"
+#include "h5_merge.h"
+#include "mbid/campaign/campaign_case.h"
+#include "mbid/campaign/campaign_runner.h"
+#include "mbid/common/atomic_file.h"
+#include "mbid/common/hdf5_io.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/validation/scenario.h"
+#include "progress.h"
+#include "report.h"
+#include "results_folder.h"
+#include "summary_table.h"
+#include "units.h"
+
+namespace mbid::campaign {
+using validation::LoadScenarioFromText;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Rank 0's verdict on the folder, broadcast before any case runs.
+enum Decision : int { kRun = 0, kAlreadyComplete = 1, kStop = 2 };
+
+// Every case builds a model, integrates and writes a file: the same allocations case after case.
+// glibc returns freed memory above 128 KiB to the kernel and maps large blocks one by one, so
+// each case faults its pages in again (about 2000 page faults per case of the reference crane),
+// and worker threads queue for the address-space lock those faults and mappings take. Keeping
+// freed memory in the process (at most the campaign's peak) removes 96% of the faults.
+void KeepFreedMemory() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  });
+}
+
+// The campaign's own metadata (/campaign): what ran and with which settings, without paths (a
+// local run and an MPI run from another folder give the same file).
+void WriteCampaignInfo(const Campaign& campaign, const std::vector<nlohmann::ordered_json>& rows,
+                       const std::string& path) {
+  H5Writer file(path);
+  file.WriteStringAttribute("/campaign", "name", campaign.name);
+  file.WriteStringAttribute("/campaign", "yaml", campaign.text);
+  file.WriteStringAttribute("/campaign", "base_yaml", campaign.base_text);
+  file.WriteStringAttribute("/campaign", "fingerprint", campaign.Fingerprint());
+  file.WriteDoubleAttribute("/campaign", "seed", static_cast<double>(campaign.seed));
+  std::vector<std::string> steps{"modes"};
+  if (campaign.steps.simulate) steps.push_back("simulate");
+  if (campaign.steps.identify) steps.push_back("identify");
+  if (campaign.steps.update) steps.push_back("update");
+  file.WriteStrings("/campaign", "steps", steps);
+  file.WriteStrings("/campaign", "swept_keys", campaign.swept_keys);
+  std::vector<std::string> ids, status;
+  for (const auto& row : rows) {
+    ids.push_back(row["case_id"].get<std::string>());
+    status.push_back(row["status"].get<std::string>());
+  }
+  file.WriteStrings("/campaign", "case_ids", ids);
+  file.WriteStrings("/campaign", "status", status);
+  file.Commit();
+}
+
+// Everything after the last case: summary.csv, the study, report.md with figures, and last
+// campaign.h5, whose rename completes the campaign.
+int FinishCampaign(const Campaign& campaign, const internal::ResultsFolder& folder,
+                   const internal::CampaignProgress& progress) {
+  std::vector<nlohmann::ordered_json> rows;
+  rows.reserve(campaign.cases.size());
+  int failed = 0;
+  for (const CampaignCase& one_case : campaign.cases) {
+    rows.push_back(ReadCaseRow(folder.CasePath(one_case.id)));
+    if (rows.back()["status"] != "ok") ++failed;
+  }
+  internal::WriteSummaryCsv(rows, folder.Path("summary.csv"));
+
+  const std::string info_path = folder.Path(".campaign-info.h5");
+  const std::string study_path = folder.Path(".study.h5");
+  WriteCampaignInfo(campaign, rows, info_path);
+  internal::StudyReport study;
+  if (campaign.study == CampaignStudy::kDamperSizing) {
+    progress.Say("sizing dampers (curves and bisection)");
+    const DamperSizingResult result = SizeDampers(campaign, rows);
+    H5Writer file(study_path);
+    WriteDamperSizing(file, campaign.damper_sizing, result);
+    file.Commit();
+    study.markdown =
+        DamperSizingReport(campaign.damper_sizing, result, folder.Path(""), &study.figures);
+  } else if (campaign.study == CampaignStudy::kLaws) {
+    progress.Say("fitting the laws");
+    std::vector<PolynomialLaw> laws = FitLaws(campaign.laws, rows);
+    // Stiffness and damping units from the base model: N*m/rad on pins, N/m on slides.
+    const std::vector<model::Parameter> parameters =
+        LoadScenarioFromText(YAML::Dump(campaign.base), campaign.base_source)
+            .MakeModel()
+            ->parameters();
+    for (PolynomialLaw& law : laws) {
+      for (const model::Parameter& parameter : parameters) {
+        if (internal::ShortName(law.quantity) == parameter.name) law.units = parameter.units;
+      }
+    }
+    H5Writer file(study_path);
+    WriteLaws(file, laws);
+    file.Commit();
+    study.markdown = LawsReport(campaign.laws, laws, rows, folder.Path(""), &study.figures);
+  }
+  const std::vector<std::string> figures =
+      internal::WriteCampaignReport(campaign, rows, folder.Path(""), study);
+
+  AtomicFile merged(folder.Path("campaign.h5"));
+  {
+    internal::DeterministicH5File file(merged.temp_path());
+    file.CopyTree(info_path, "/", {});
+    file.CreateGroup("/cases");
+    for (const CampaignCase& one_case : campaign.cases) {
+      file.CopyTree(folder.CasePath(one_case.id), "/cases/" + one_case.id,
+                    {"format", "format_version", "row"});
+    }
+    if (fs::exists(study_path)) file.CopyTree(study_path, "/", {"format", "format_version"});
+    file.Close();
+  }
+  merged.Commit();
+  std::error_code ignored;
+  fs::remove(info_path, ignored);
+  fs::remove(study_path, ignored);
+  folder.RemoveCases();
+  progress.Say(fmt::format("wrote campaign.h5, summary.csv and report.md ({} figures) in {}",
+                           figures.size(), folder.Path("")));
+  return failed;
+}
+
+}  // namespace
+
+CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& output_dir,
+                               const CampaignRunOptions& options, internal::Cluster* cluster_in) {
+  std::unique_ptr<internal::Cluster> own_cluster;
+  if (cluster_in == nullptr) own_cluster = internal::MakeSingleProcess();
+  internal::Cluster& cluster = cluster_in != nullptr ? *cluster_in : *own_cluster;
+  const auto start = std::chrono::steady_clock::now();
+  KeepFreedMemory();
+
+  CampaignRunSummary summary;
+  summary.cases = static_cast<int>(campaign.cases.size());
+  summary.ranks = cluster.size();
+  summary.workers =
+      options.workers > 0
+          ? options.workers
+          : (cluster.distributed()
+                 ? 1  // mpirun placed one rank per core
+                 : std::max(1, static_cast<int>(std::thread::hardware_concurrency())));
+
+  const internal::ResultsFolder folder(output_dir);
+  std::vector<int> pending;
+  std::exception_ptr folder_error;
+  int decision = kRun;
+  if (cluster.is_root()) {
+    try {
+      if (folder.Prepare(campaign, options.resume) == internal::ResultsFolder::State::kComplete) {
+        decision = kAlreadyComplete;
+        // A kill between the final rename and the clean-up leaves the case files behind.
+        folder.RemoveCases();
+        std::error_code ignored;
+        fs::remove(folder.Path(".campaign-info.h5"), ignored);
+        fs::remove(folder.Path(".study.h5"), ignored);
+      } else {
+        const std::vector<bool> committed = folder.ScanCommitted(campaign);
+        for (size_t i = 0; i < committed.size(); ++i) {
+          if (!committed[i]) pending.push_back(static_cast<int>(i));
+        }
+      }
+    } catch (...) {
+      folder_error = std::current_exception();
+      decision = kStop;
+    }
+  }
+  decision = cluster.Broadcast(decision);
+  if (decision == kStop) {
+    if (folder_error) std::rethrow_exception(folder_error);
+    summary.exit_code = 2;
+    return summary;
+  }
+  summary.already_committed = summary.cases - static_cast<int>(pending.size());
+  internal::CampaignProgress progress(campaign.name, summary.cases, summary.already_committed,
+                                      options.quiet || !cluster.is_root());
+  if (decision == kAlreadyComplete) {
+    summary.was_complete = true;
+    summary.already_committed = summary.cases;
+    progress.Say("already complete (" + folder.Path("campaign.h5") + "); nothing to do");
+    return summary;
+  }
+  progress.Say(
+      fmt::format("{} cases{}; running {} on {} rank{} x {} worker{}", summary.cases,
+                  summary.already_committed > 0
+                      ? fmt::format(", resuming: {} already committed", summary.already_committed)
+                      : "",
+                  pending.size(), cluster.size(), cluster.size() > 1 ? "s" : "", summary.workers,
+                  summary.workers > 1 ? "s" : ""));
+
+  std::condition_variable wakeup;
+  std::mutex wakeup_mutex;
+  internal::WorkQueue queue(wakeup, summary.workers);
+  internal::Tally tally;
+  std::atomic<int> running{summary.workers};
+  std::mutex error_mutex;
+  std::exception_ptr worker_error;
+  // Taking the mutex before notifying makes the main thread's predicate wait race-free.
+  const auto notify_main = [&] {
+    std::lock_guard<std::mutex> lock(wakeup_mutex);
+    wakeup.notify_all();
+  };
+  std::vector<std::thread> workers;
+  const auto work = [&] {
+    try {
+      while (const std::optional<int> index = queue.Pop()) {
+        const CaseOutcome outcome =
+            ComputeCase(campaign, campaign.cases[static_cast<size_t>(*index)]);
+        WriteCaseFile(outcome, folder.CasePath(outcome.id));
+        if (!outcome.ok()) ++tally.failed;
+        ++tally.done;
+        notify_main();
+      }
+    } catch (...) {
+      // Not a case's failure (those are results) but the campaign's: its files cannot be
+      // written. Stop taking cases.
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!worker_error) worker_error = std::current_exception();
+      queue.Close();
+    }
+    --running;
+    notify_main();
+  };
+  try {
+    for (int w = 0; w < summary.workers; ++w) workers.emplace_back(work);
+  } catch (const std::system_error& error) {
+    // Out of threads or memory for their stacks: stop the ones that started, then fail like any
+    // other campaign error (a joinable std::thread left behind would call std::terminate).
+    const auto started = workers.size();
+    running -= summary.workers - static_cast<int>(started);
+    queue.Close();
+    for (std::thread& worker : workers) worker.join();
+    const std::string message = fmt::format("cannot start worker thread {} of {}: {}", started + 1,
+                                            summary.workers, error.what());
+    if (cluster.size() > 1) {
+      std::fprintf(stderr, "mbid: failure: rank %d: %s\n", cluster.rank(), message.c_str());
+      cluster.Abort(1);
+    }
+    throw std::runtime_error(message);
+  }
+  const auto cases_start = std::chrono::steady_clock::now();
+  size_t cursor = 0;
+  const auto next = [&]() { return cursor < pending.size() ? pending[cursor++] : -1; };
+  while (true) {
+    const bool over = cluster.Pump(next, queue, tally, running.load() > 0);
+    {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (worker_error && cluster.size() > 1) {
+        try {
+          std::rethrow_exception(worker_error);
+        } catch (const std::exception& error) {
+          std::fprintf(stderr, "mbid: failure: rank %d: %s\n", cluster.rank(), error.what());
+        }
+        cluster.Abort(1);
+      }
+    }
+    if (over) break;
+    const int seen_done = tally.done;
+    progress.Update(seen_done + cluster.remote_done(), tally.failed + cluster.remote_failed());
+    std::unique_lock<std::mutex> lock(wakeup_mutex);
+    wakeup.wait_for(lock, cluster.poll_interval(),
+                    [&] { return running.load() == 0 || tally.done.load() != seen_done; });
+  }
+  for (std::thread& worker : workers) worker.join();
+  if (worker_error) std::rethrow_exception(worker_error);
+  summary.ran = tally.done + cluster.remote_done();
+  summary.cases_wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - cases_start).count();
+  if (!cluster.is_root()) return summary;
+  progress.Finish(summary.ran, tally.failed + cluster.remote_failed());
+
+  summary.failed = FinishCampaign(campaign, folder, progress);
+  summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+std::shared_ptr<internal::Cluster> JoinCampaignCluster() { return internal::JoinCluster(); }
+
+bool IsClusterRoot(const internal::Cluster& cluster) { return cluster.is_root(); }
+
+}  // namespace mbid::campaign

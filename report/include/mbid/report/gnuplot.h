@@ -1,0 +1,40 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace mbid::report {
+
+// One curve or point set of a figure.
+struct PlotSeries {
+  std::string title;
+  Eigen::VectorXd x;
+  Eigen::VectorXd y;
+  std::string style = "lines";  // gnuplot "with" clause: "lines", "points pt 7 ps 0.6", ...
+};
+
+// A 2-D figure drawn by gnuplot (Debian gnuplot-nox, pngcairo terminal). Axis labels carry the
+// unit, e.g. "time, s".
+struct Figure {
+  std::string title;
+  std::string x_label;
+  std::string y_label;
+  std::vector<PlotSeries> series;
+  bool log_y = false;
+  bool log_x = false;
+  bool pad_x = false;  // leave a margin at both ends of x (points on the edges stay visible)
+  std::string key = "top right box opaque";  // gnuplot `set key` options
+  std::string x_range, y_range;              // gnuplot ranges ("[0:*]"); empty = automatic
+  int width_px = 1000;
+  int height_px = 420;
+};
+
+// Draws `figure` into `png_path` (atomically: a failed plot leaves no file). Throws
+// std::runtime_error naming gnuplot's complaint if it fails or is not installed.
+void DrawFigure(const Figure& figure, const std::string& png_path);
+
+// True if a gnuplot with the pngcairo terminal is on PATH.
+bool GnuplotAvailable();
+
+}  // namespace mbid::report

@@ -1,0 +1,148 @@
+#include "mbid/report/gnuplot.h"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "mbid/common/atomic_file.h"
+#include "mbid/common/interrupt_cleanup.h"
+
+extern char** environ;
+
+namespace mbid::report {
+namespace {
+
+// A gnuplot string literal. Single quotes: gnuplot interprets backslash escapes in double-quoted
+// strings and runs `backquoted` commands in anything but single-quoted ones; here only a quote
+// needs doubling. A line break would end the command, so control characters become spaces.
+std::string Quote(const std::string& text) {
+  std::string quoted = "'";
+  for (const char c : text) {
+    if (c == '\'') quoted += '\'';
+    quoted += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? ' ' : c;
+  }
+  return quoted + "'";
+}
+
+// Runs `arguments` (arguments[0] looked up on PATH) without a shell, so that nothing in them is
+// interpreted, with standard input from /dev/null and standard output and error into
+// `log_path`. Returns the wait status, or -1 with errno set when the program cannot start.
+int Spawn(const std::vector<std::string>& arguments, const std::string& log_path) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  // mbid blocks SIGINT/SIGTERM in its threads (interrupt_cleanup.h); the child must not inherit
+  // that, or Ctrl-C would not stop it.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t none;
+  sigemptyset(&none);
+  posix_spawnattr_setsigmask(&attributes, &none);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
+  std::vector<char*> argv;
+  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int error = posix_spawnp(&pid, argv[0], &actions, &attributes, argv.data(), environ);
+  posix_spawnattr_destroy(&attributes);
+  posix_spawn_file_actions_destroy(&actions);
+  if (error != 0) {
+    errno = error;
+    return -1;
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return -1;
+  }
+  return status;
+}
+
+// A path gnuplot cannot take for an option.
+std::string AsArgument(const std::string& path) {
+  return !path.empty() && path[0] == '-' ? "./" + path : path;
+}
+
+// Temporary files beside the figure, removed on every exit and on SIGINT/SIGTERM.
+class ScratchFile {
+ public:
+  explicit ScratchFile(std::string path) : path_(std::move(path)), cleanup_(path_) {}
+  ~ScratchFile() {
+    std::error_code ignored;
+    std::filesystem::remove(path_, ignored);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  RemoveOnInterrupt cleanup_;
+};
+
+}  // namespace
+
+bool GnuplotAvailable() {
+  return Spawn({"gnuplot", "-e", "set terminal pngcairo"}, "/dev/null") == 0;
+}
+
+void DrawFigure(const Figure& figure, const std::string& png_path) {
+  AtomicFile png(png_path);
+  const ScratchFile data(png.temp_path() + ".dat");
+  const ScratchFile script_file(png.temp_path() + ".gp");
+  const ScratchFile log(png.temp_path() + ".log");
+  {
+    // One data block per series, separated by two blank lines (gnuplot's "index").
+    std::ofstream out(data.path());
+    for (const PlotSeries& series : figure.series) {
+      for (Eigen::Index i = 0; i < series.x.size(); ++i) {
+        out << fmt::format("{:.10g} {:.10g}\n", series.x[i], series.y[i]);
+      }
+      out << "\n\n";
+    }
+  }
+  {
+    std::ofstream script(script_file.path());
+    script << fmt::format("set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n",
+                          figure.width_px, figure.height_px);
+    script << "set output " << Quote(png.temp_path()) << "\n";
+    script << "set title " << Quote(figure.title) << "\n";
+    script << "set xlabel " << Quote(figure.x_label) << "\n";
+    script << "set ylabel " << Quote(figure.y_label) << "\n";
+    script << "set grid\nset key " << figure.key << "\nset offsets 0, 0, graph 0.05, graph 0.05\n";
+    if (figure.log_y) script << "set logscale y\nset format y '%.0e'\n";
+    if (figure.log_x) script << "set logscale x\nset format x '%g'\n";
+    if (!figure.x_range.empty()) script << "set xrange " << figure.x_range << "\n";
+    if (!figure.y_range.empty()) script << "set yrange " << figure.y_range << "\n";
+    if (figure.pad_x) script << "set offsets graph 0.03, graph 0.03, graph 0.05, graph 0.05\n";
+    script << "plot ";
+    for (size_t k = 0; k < figure.series.size(); ++k) {
+      if (k > 0) script << ", \\\n     ";
+      script << Quote(data.path()) << " index " << k << " using 1:2 with " << figure.series[k].style
+             << " title " << Quote(figure.series[k].title);
+    }
+    script << "\n";
+  }
+  const int status = Spawn({"gnuplot", AsArgument(script_file.path())}, log.path());
+  if (status < 0) {
+    throw std::runtime_error("cannot start gnuplot for " + png_path + ": " + std::strerror(errno));
+  }
+  if (status != 0) {
+    std::ifstream in(log.path());
+    std::stringstream text;
+    text << in.rdbuf();
+    throw std::runtime_error("gnuplot failed on " + png_path + ": " + text.str());
+  }
+  png.Commit();
+}
+
+}  // namespace mbid::report

@@ -1,0 +1,144 @@
+#include "run_document.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "mbid/report/gnuplot.h"
+#include "mbid/report/run_report.h"
+
+namespace mbid::report {
+using validation::RecordSource;
+using validation::RunTest;
+using validation::Scenario;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct TestFigures {
+  std::vector<std::string> record, identification, updating;
+};
+
+TestFigures DrawTestFigures(const std::string& folder, const std::string& prefix,
+                            const RunTest& test) {
+  TestFigures figures;
+  const auto add = [&prefix](std::vector<std::string>& list, const std::string& file) {
+    if (!file.empty()) list.push_back(prefix + file);
+  };
+  const Measurement* exact = test.exact ? &*test.exact : nullptr;
+  for (int c = 0; c < test.measured.channel_count(); ++c) {
+    add(figures.record,
+        DrawRecordFigure(folder, test.measured, exact,
+                         test.simulation ? "exact model output (no sensor errors)"
+                                         : "noise-free record (before the noise was added)",
+                         c));
+  }
+  add(figures.identification, DrawSpectrumFigure(folder, test.identified));
+  for (int c = 0; c < static_cast<int>(test.identified.channels.size()); ++c) {
+    add(figures.identification,
+        DrawReconstructionFigure(folder, test.measured, test.identified, c));
+  }
+  add(figures.identification, DrawStabilizationFigure(folder, test.identified));
+  const updating::TestFit& fit = test.tuned.tests.front();
+  for (int c = 0; c < static_cast<int>(fit.channels.size()); ++c) {
+    add(figures.updating, DrawResimulationFigure(folder, test.measured, fit, c));
+  }
+  add(figures.updating, DrawConvergenceFigure(folder, test.tuned));
+  return figures;
+}
+
+void Embed(std::ostream& out, const std::vector<std::string>& figures) {
+  for (const std::string& figure : figures) out << "![" << figure << "](" << figure << ")\n\n";
+}
+
+// The modes the record is known to contain: the model's (simulated) or the synthetic record's.
+std::vector<ReferenceMode> KnownModes(const Scenario& scenario, const RunTest& test,
+                                      const std::vector<model::Mode>& exact_modes,
+                                      std::string* label) {
+  std::vector<ReferenceMode> known;
+  if (test.simulation) {
+    *label = "model's exact";
+    for (const model::Mode& mode : exact_modes) {
+      known.push_back({mode.frequency_hz(), mode.decay_rate_per_s(), {}});
+    }
+    return known;
+  }
+  for (const RecordSource& source : scenario.records) {
+    if (source.name != test.name || !source.synthetic) continue;
+    *label = "record's true";
+    for (const simulation::ModalComponent& mode : source.synthetic->modes) {
+      known.push_back({mode.frequency_hz, mode.decay_rate_per_s, mode.amplitude});
+    }
+  }
+  return known;
+}
+
+}  // namespace
+
+int WriteRunReport(const std::string& folder, const Scenario& scenario,
+                   const model::MechanicalModel& model, const std::vector<model::Mode>& exact_modes,
+                   const std::vector<RunTest>& tests, const std::string& verdict,
+                   const std::function<void(const std::string&)>& say) {
+  const bool several = tests.size() > 1;
+  const bool draw = GnuplotAvailable();
+  if (!draw) say("gnuplot with pngcairo not found: the report has no figures");
+  int figure_count = 0;
+
+  std::ofstream report(fs::path(folder) / "report.md");
+  report << "# mbid run: " << scenario.name << "\n\n";
+  report << fmt::format("Scenario `{}`; model `{}`; excitation `{}`; ", scenario.path, model.type(),
+                        scenario.RequireExcitation().type_name());
+  report << (scenario.records.empty() ? std::string("the test is simulated from the model.\n\n")
+                                      : fmt::format("{} recorded test(s).\n\n", tests.size()));
+  const std::string heading = several ? "###" : "##";
+  for (const RunTest& test : tests) {
+    TestFigures figures;
+    if (draw) {
+      const std::string prefix = several ? test.name + "/" : "";
+      const fs::path test_folder = fs::path(folder) / prefix;
+      fs::create_directories(test_folder);
+      figures = DrawTestFigures((test_folder / "").string(), prefix, test);
+      figure_count += static_cast<int>(figures.record.size() + figures.identification.size() +
+                                       figures.updating.size());
+    }
+    if (several) report << "## Test " << test.name << "\n\n";
+    report << heading << " The test record\n\n";
+    report << fmt::format("{}: {} samples at {} Hz on channels {}.\n\n", test.origin,
+                          test.measured.samples(), 1.0 / test.measured.sample_interval_s,
+                          fmt::join(test.measured.channels, ", "));
+    Embed(report, figures.record);
+    std::string label;
+    const std::vector<ReferenceMode> known = KnownModes(scenario, test, exact_modes, &label);
+    report << heading << " Identified modes (the paper's Table 1)"
+           << (known.empty() ? "" : ", with the " + label + " modes") << "\n\n";
+    report << ModalTableMarkdown(test.identified, known.empty() ? nullptr : &known, label) << "\n";
+    for (const std::string& warning : test.identified.warnings) report << "> " << warning << "\n\n";
+    Embed(report, figures.identification);
+    report << heading << " Tuned joint parameters (the paper's Table 2)\n\n";
+    report << "Start: " << test.start_note << ". "
+           << TunedParametersMarkdown(test.tuned, model,
+                                      test.simulation ? "model (truth of the simulated test)"
+                                                      : "scenario (design values)")
+           << "\n";
+    if (test.algebraic) report << AlgebraicSetsMarkdown(*test.algebraic) << "\n";
+    Embed(report, figures.updating);
+  }
+  if (several) {
+    std::vector<std::string> names;
+    std::vector<const updating::UpdateResult*> results;
+    for (const RunTest& test : tests) {
+      names.push_back(test.name);
+      results.push_back(&test.tuned);
+    }
+    report << "## All tests (the paper's Table 2 with its spread row)\n\n"
+           << TestsTableMarkdown(names, results) << "\n";
+  }
+  report << "## Verdict\n\n**" << verdict << "**\n";
+  if (draw) say(fmt::format("drew {} figures", figure_count));
+  return figure_count;
+}
+
+}  // namespace mbid::report

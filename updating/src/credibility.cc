@@ -1,0 +1,129 @@
+#include "mbid/updating/credibility.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+
+namespace mbid::updating {
+namespace {
+
+// Ljung-Box Q of `r` over `lags` lags, and the integrated autocorrelation time.
+void Whiteness(const Eigen::VectorXd& residual, int lags, double* q, double* p, double* time) {
+  const Eigen::VectorXd r = residual.array() - residual.mean();
+  const double n = static_cast<double>(r.size());
+  const double power = r.squaredNorm();
+  const int count = std::min<int>(lags, static_cast<int>(r.size()) / 4);
+  *q = 0;
+  *time = 1;
+  *p = 1;
+  if (count < 1 || !(power > 0)) return;
+  for (int k = 1; k <= count; ++k) {
+    const double rho = r.head(r.size() - k).dot(r.tail(r.size() - k)) / power;
+    *q += rho * rho / (n - k);
+    *time += 2 * rho;
+  }
+  *q *= n * (n + 2);
+  *time = std::max(1.0, *time);
+  *p = boost::math::cdf(boost::math::complement(boost::math::chi_squared(count), *q));
+}
+
+}  // namespace
+
+void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& tests,
+                       const UpdateOptions& options) {
+  if (result.tests.size() != tests.size()) return;
+  double residuals = 0, baseline_terms = 0;
+  bool from_records = true;
+  double worst_time = 1;
+  std::string worst_channel;
+  for (size_t t = 0; t < tests.size(); ++t) {
+    TestFit& fit = result.tests[t];
+    const Measurement& record = tests[t].record;
+    const int m = record.channel_count();
+    if (fit.simulated.values.rows() != record.samples() || fit.noise_std.size() != m) return;
+    fit.whiteness_q.resize(m);
+    fit.whiteness_p.resize(m);
+    fit.correlation_time.resize(m);
+    residuals += static_cast<double>(record.samples()) * m;
+    baseline_terms += static_cast<double>(fit.offset.size() + fit.drift.size());
+    for (int c = 0; c < m; ++c) {
+      from_records = from_records && !fit.noise_estimated[static_cast<size_t>(c)];
+      const Eigen::VectorXd r =
+          (fit.simulated.values.col(c) - record.values.col(c)) / fit.noise_std[c];
+      Whiteness(r, options.whiteness_lags, &fit.whiteness_q[c], &fit.whiteness_p[c],
+                &fit.correlation_time[c]);
+      // A residual white at the 0.1% level is not inflated for its sampling wiggle.
+      if (fit.whiteness_p[c] < 1e-3 && fit.correlation_time[c] > worst_time) {
+        worst_time = fit.correlation_time[c];
+        worst_channel = fit.channels[static_cast<size_t>(c)] + " of " + fit.name;
+      }
+    }
+  }
+  const double k = static_cast<double>(result.parameters.size()) + baseline_terms;
+  result.chi_square_per_dof = 2 * result.final_cost / std::max(1.0, residuals - k);
+  result.weights_from_records = from_records;
+  const double excess = from_records ? std::max(1.0, result.chi_square_per_dof) : 1.0;
+  result.std_inflation = std::sqrt(excess * worst_time);
+  result.credibility.clear();
+  const bool misfit = from_records && result.chi_square_per_dof > options.max_chi_square_per_dof;
+  if (misfit) {
+    result.credibility.push_back(fmt::format(
+        "the re-simulation misses the records by {:.3g} times their noise (chi^2/dof = {:.4g} > "
+        "{}): a local minimum, or a model that lacks something; no parameter is determined by "
+        "this fit",
+        std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof,
+        options.max_chi_square_per_dof));
+  } else {
+    if (excess > 1.2) {
+      result.credibility.push_back(fmt::format(
+          "the residual is {:.3g} times the records' noise (chi^2/dof = {:.4g}): standard "
+          "deviations scaled up by {:.3g}",
+          std::sqrt(excess), result.chi_square_per_dof, std::sqrt(excess)));
+    }
+    if (worst_time > 1.2) {
+      result.credibility.push_back(fmt::format(
+          "the residual is not white (correlation time {:.3g} samples on {}): the Fisher "
+          "standard deviations assume white noise and are scaled up by {:.3g}",
+          worst_time, worst_channel, std::sqrt(worst_time)));
+    }
+  }
+  if (!from_records) {
+    result.credibility.push_back(
+        "the noise was estimated from this fit's own residual: a misfit cannot be told from "
+        "noise except by the residual's whiteness");
+  }
+  result.credible = !misfit && result.std_inflation <= std::sqrt(1.2 * 1.2);
+
+  result.undetermined.clear();
+  for (ParameterEstimate& p : result.parameters) {
+    const double relative = p.relative_std * result.std_inflation;
+    if (std::isfinite(relative)) {
+      if (p.log_scale) {
+        p.interval_lower = p.value * std::exp(-2 * relative);
+        p.interval_upper = p.value * std::exp(2 * relative);
+      } else {
+        p.interval_lower = p.value - 2 * p.std * result.std_inflation;
+        p.interval_upper = p.value + 2 * p.std * result.std_inflation;
+      }
+    }
+    if (misfit && p.test.empty()) {
+      p.determined = false;
+      p.why_undetermined = "the fit does not explain the records (chi^2/dof too large)";
+    } else if (!std::isfinite(relative)) {
+      p.determined = false;
+      p.why_undetermined = "no standard deviation: the records leave it in a flat direction";
+    } else if (relative > options.undetermined_relative_std) {
+      p.determined = false;
+      p.why_undetermined = fmt::format("relative std {:.3g}{} above {}", relative,
+                                       result.std_inflation > 1 ? " (inflated)" : "",
+                                       options.undetermined_relative_std);
+    } else if (!p.determined && p.why_undetermined.empty()) {
+      p.why_undetermined = "marked by the caller";
+    }
+    if (!p.determined) result.undetermined.push_back(p.name);
+  }
+}
+
+}  // namespace mbid::updating

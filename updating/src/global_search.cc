@@ -1,0 +1,557 @@
+#include "mbid/updating/global_search.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <atomic>
+#include <boost/math/distributions/fisher_f.hpp>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <random>
+#include <set>
+#include <thread>
+
+#include "mbid/common/error.h"
+#include "mbid/model/linear_model.h"
+#include "mbid/updating/characteristic.h"
+
+namespace mbid::updating {
+namespace {
+
+// A start (or screened end) is worth a whole-record fit when its cost is within this factor of
+// the best known: alternatives end within a few percent of the best cost.
+constexpr double kPromisingCostRatio = 3.0;
+
+// Runs jobs(0..count-1) on up to `threads` threads; each job writes only its own slot, so the
+// outcome does not depend on the thread count.
+void RunParallel(int count, int threads, const std::function<void(int)>& job) {
+  std::atomic<int> next{0};
+  auto worker = [&] {
+    for (int i = next++; i < count; i = next++) job(i);
+  };
+  const int workers = std::max(1, std::min(threads, count));
+  std::vector<std::thread> pool;
+  for (int w = 1; w < workers; ++w) pool.emplace_back(worker);
+  worker();
+  for (std::thread& thread : pool) thread.join();
+}
+
+// Radical inverse of i in `base` with the digits permuted by `permutation` (a scrambled Halton
+// sequence: the plain one has correlated projections in the higher bases).
+double ScrambledRadicalInverse(unsigned i, unsigned base,
+                               const std::vector<unsigned>& permutation) {
+  double value = 0, weight = 1.0 / base;
+  for (; i > 0; i /= base, weight /= base) value += weight * permutation[i % base];
+  return value;
+}
+
+// `count` points of the unit cube in `dimension` dimensions, seeded.
+std::vector<std::vector<double>> SpaceFillingDesign(int count, int dimension, std::uint64_t seed) {
+  static const unsigned kPrimes[] = {2,  3,  5,  7,  11, 13, 17, 19, 23, 29, 31, 37,  41, 43,
+                                     47, 53, 59, 61, 67, 71, 73, 79, 83, 89, 97, 101, 103};
+  const int available = static_cast<int>(sizeof(kPrimes) / sizeof(kPrimes[0]));
+  std::mt19937_64 random(seed);
+  std::vector<std::vector<unsigned>> permutations;
+  std::vector<double> shift;
+  for (int d = 0; d < dimension; ++d) {
+    const unsigned base = kPrimes[d % available];
+    std::vector<unsigned> permutation(base);
+    for (unsigned k = 0; k < base; ++k) permutation[k] = k;
+    // Zero stays zero: the sequence keeps its low-discrepancy structure.
+    std::shuffle(permutation.begin() + 1, permutation.end(), random);
+    permutations.push_back(permutation);
+    // Beyond the primes, a random shift per dimension keeps repeated bases apart.
+    shift.push_back(d < available ? 0.0 : std::uniform_real_distribution<double>(0, 1)(random));
+  }
+  std::vector<std::vector<double>> points;
+  for (int i = 0; i < count; ++i) {
+    std::vector<double> point;
+    for (int d = 0; d < dimension; ++d) {
+      const unsigned base = kPrimes[d % available];
+      // Index from 1: point 0 of every Halton sequence is the corner.
+      double u = ScrambledRadicalInverse(static_cast<unsigned>(i + 1), base, permutations[d]);
+      u = std::fmod(u + shift[d], 1.0);
+      point.push_back(u);
+    }
+    points.push_back(point);
+  }
+  return points;
+}
+
+// Ceres' coordinate of a parameter and the relative size of a difference in it.
+double Internal(const ParameterEstimate& p, double value) {
+  return p.log_scale ? std::log(value) : value / std::max(std::abs(p.value), 1e-6);
+}
+
+// Parameters (shared, tuned) in which two end points differ beyond the clustering tolerance
+// and 3 standard deviations: both ends' combined (one minimum reached twice), or only `a`'s
+// (`a` the best: is the other end inside its confidence interval?).
+std::vector<std::string> Differences(const UpdateResult& a, const UpdateResult& b, double tolerance,
+                                     bool combined_std = true) {
+  std::vector<std::string> differ;
+  for (const ParameterEstimate& p : a.parameters) {
+    if (!p.test.empty()) continue;
+    const ParameterEstimate& q = b.Find(p.name);
+    const double distance = std::abs(Internal(p, p.value) - Internal(p, q.value));
+    double allowed = tolerance;
+    const double std = combined_std ? std::hypot(p.relative_std, q.relative_std) : p.relative_std;
+    if (std::isfinite(std)) allowed = std::max(allowed, 3 * std);
+    if (distance > allowed) differ.push_back(p.name);
+  }
+  return differ;
+}
+
+std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double fraction) {
+  std::vector<TestRecord> window = tests;
+  for (TestRecord& test : window) {
+    const int samples = test.record.samples();
+    const int kept = std::min(samples, std::max(std::max(50, test.fit_drift ? 3 : 2),
+                                                static_cast<int>(std::ceil(fraction * samples))));
+    test.record.values = test.record.values.topRows(kept).eval();
+  }
+  return window;
+}
+
+UpdateOptions StartOptions(const UpdateOptions& options,
+                           const std::vector<ParameterSetting>& settings,
+                           const std::map<std::string, double>& values) {
+  UpdateOptions start = options;
+  start.parameters = settings;
+  for (ParameterSetting& setting : start.parameters) {
+    const auto found = values.find(setting.name);
+    if (found != values.end() && std::isfinite(found->second)) {
+      setting.initial = std::clamp(found->second, setting.lower, setting.upper);
+    }
+  }
+  return start;
+}
+
+bool Converged(const UpdateResult& result) {
+  return result.termination == UpdateResult::Termination::kConverged;
+}
+
+// Every other admissible solution of eq. 7 for the exact poles of `model` carrying `fit`'s
+// values, as starts; none unless every coordinate has a tuned spring and damper and all its
+// modes oscillate.
+std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& model,
+                                              const UpdateResult& fit, std::uint64_t seed) {
+  std::vector<SearchStart> starts;
+  if (!FindFreeCoordinate(model).empty()) return starts;
+  std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
+  ApplyEstimates(fit, *tuned);
+  const model::LinearModel linear = tuned->Linearize();
+  for (const std::string& coordinate : linear.coordinates) {
+    for (const std::string& name : {"c_" + coordinate, "d_" + coordinate}) {
+      bool found = false;
+      for (const ParameterEstimate& p : fit.parameters) found = found || p.name == name;
+      if (!found) return starts;
+    }
+  }
+  std::vector<std::complex<double>> lambda;
+  for (const model::Mode& mode : model::CalcModes(linear)) {
+    if (mode.lambda.imag() > 0) lambda.push_back(mode.lambda);
+  }
+  if (static_cast<int>(lambda.size()) != tuned->coordinate_count()) return starts;
+  CharacteristicOptions options;
+  options.seed = seed;
+  const CharacteristicResult sets = SolveCharacteristicEquation(
+      MakeCharacteristicProblem(*tuned, lambda, std::nullopt, std::nullopt), options);
+  for (size_t s = 0; s < sets.solutions.size(); ++s) {
+    const CharacteristicSolution& set = sets.solutions[s];
+    if (!set.admissible) continue;
+    SearchStart start;
+    start.label = fmt::format("pole-equivalent set {}", s);
+    bool same = true;  // the tuned set itself (to eq. 7's convergence)
+    for (size_t i = 0; i < sets.coordinates.size(); ++i) {
+      const Eigen::Index k = static_cast<Eigen::Index>(i);
+      const std::string c = "c_" + sets.coordinates[i], d = "d_" + sets.coordinates[i];
+      start.values[c] = set.c[k];
+      start.values[d] = set.d[k];
+      same = same && std::abs(set.c[k] / fit.Find(c).value - 1) < 1e-3 &&
+             std::abs(set.d[k] / fit.Find(d).value - 1) < 1e-3;
+    }
+    if (!same) starts.push_back(start);
+  }
+  return starts;
+}
+
+}  // namespace
+
+double FQuantile(double alpha, double d1, double d2) {
+  return boost::math::quantile(boost::math::complement(boost::math::fisher_f(d1, d2), alpha));
+}
+
+double FSurvival(double f, double d1, double d2) {
+  if (!(f > 0)) return 1.0;
+  return boost::math::cdf(boost::math::complement(boost::math::fisher_f(d1, d2), f));
+}
+
+bool GlobalSearchOptions::IsValid(std::string* why) const {
+  auto fail = [why](const std::string& reason) {
+    if (why != nullptr) *why = reason;
+    return false;
+  };
+  if (design_starts < 0) return fail("design_starts must be >= 0");
+  if (!(screen_fraction > 0 && screen_fraction <= 1)) return fail("screen_fraction in (0, 1]");
+  if (screen_iterations < 1) return fail("screen_iterations must be >= 1");
+  if (full_fits < 0) return fail("full_fits must be >= 0");
+  if (!(cluster_tolerance > 0 && cluster_tolerance < 1)) {
+    return fail("cluster_tolerance in (0, 1)");
+  }
+  if (!(significance > 0 && significance < 1)) return fail("significance in (0, 1)");
+  if (threads < 1) return fail("threads must be >= 1");
+  return true;
+}
+
+GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
+                                  const std::vector<TestRecord>& tests,
+                                  const UpdateOptions& options, const std::string& primary_label,
+                                  const std::vector<SearchStart>& starts,
+                                  const GlobalSearchOptions& search,
+                                  const std::function<void(const std::string&)>& progress) {
+  const auto start_time = std::chrono::steady_clock::now();
+  std::string why;
+  if (!search.IsValid(&why)) {
+    throw InputError("updating", "global_search", why, "valid global search options");
+  }
+  auto say = [&progress](const std::string& line) {
+    if (progress) progress(line);
+  };
+  GlobalSearchResult result;
+  for (const TestRecord& test : tests) {
+    result.residual_count += test.record.samples() * test.record.channel_count();
+  }
+  const std::vector<ParameterSetting> settings = ResolveParameterSettings(model, options);
+
+  // The primary start: the options' own values (or the scenario's), fitted first and alone.
+  UpdateOptions primary = StartOptions(options, settings, {});
+  if (!search.enabled) {
+    result.best = UpdateModel(model, tests, primary);
+    SearchMinimum only;
+    only.fit = result.best;
+    only.starts = {primary_label};
+    only.cost = result.best.final_cost;
+    result.minima.push_back(only);
+    result.starts = result.full_fits = 1;
+    result.wall_time_s = result.best.wall_time_s;
+    return result;
+  }
+  UpdateOptions local = options;
+  local.quiet = true;
+  local.threads = 1;
+  primary.quiet = true;
+  // The user's own thread count: the sensitivity groups change CVODES' error control, so a count
+  // tied to the search's would change the bits with it.
+  primary.threads = options.threads;
+  std::vector<TestRecord> weighted = tests;
+  bool all_given = true;
+  for (const TestRecord& test : tests) {
+    for (const std::string& channel : test.record.channels) {
+      all_given = all_given && test.noise_std.count(channel) > 0;
+    }
+  }
+
+  struct Run {
+    std::string label;
+    UpdateResult fit;
+    bool failed = false;
+  };
+  std::vector<Run> full;
+  auto fit_full = [&](const std::string& label, const std::map<std::string, double>& values,
+                      const UpdateOptions& base) {
+    Run run{label, {}, false};
+    try {
+      run.fit = UpdateModel(model, weighted, StartOptions(base, settings, values));
+    } catch (const std::exception& e) {
+      run.failed = true;
+      run.fit.message = e.what();
+    }
+    return run;
+  };
+
+  // The primary start first, alone. Where the records give no noise level, its fit estimates
+  // one, and every other fit is weighed by it so that all costs are in the same units.
+  const auto batch_start = std::chrono::steady_clock::now();
+  say(fmt::format("global search: fit from {}{}", primary_label,
+                  all_given ? "" : " to estimate the noise"));
+  full.push_back(fit_full(primary_label, {}, primary));
+  if (!all_given) {
+    const UpdateResult& first = full.front().fit;
+    for (size_t t = 0; t < weighted.size() && t < first.tests.size(); ++t) {
+      const TestFit& fit = first.tests[t];
+      for (size_t c = 0; c < fit.channels.size(); ++c) {
+        weighted[t].noise_std.emplace(fit.channels[c], fit.noise_std[static_cast<Eigen::Index>(c)]);
+      }
+    }
+    if (full.front().failed) {
+      // The search cannot weigh its fits; the primary fit's failure is the answer.
+      result.best = full.front().fit;
+      result.starts = result.full_fits = 1;
+      return result;
+    }
+  }
+
+  // Only starts near the best known cost can end as alternatives: one iteration gives a start's
+  // cost, and those above kPromisingCostRatio times the best are left out (measured on the
+  // crane: other Route-1 sets and pole-equivalent sets whose shapes miss the record start
+  // thousands of times higher and end at far minima). Without a converged fit, all are fitted.
+  auto fit_promising = [&](const std::vector<SearchStart>& candidates, const std::string& what) {
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (const Run& run : full) {
+      if (!run.failed && Converged(run.fit)) best_cost = std::min(best_cost, run.fit.final_cost);
+    }
+    UpdateOptions probe = local;
+    probe.max_iterations = 1;
+    probe.refit_after_noise_estimate = false;
+    std::vector<Run> probes(candidates.size());
+    if (std::isfinite(best_cost)) {
+      RunParallel(static_cast<int>(candidates.size()), search.threads, [&](int i) {
+        const SearchStart& start = candidates[static_cast<size_t>(i)];
+        probes[static_cast<size_t>(i)] = fit_full(start.label, start.values, probe);
+      });
+    }
+    std::vector<SearchStart> promising;
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      if (!std::isfinite(best_cost) ||
+          (!probes[i].failed && probes[i].fit.initial_cost <= kPromisingCostRatio * best_cost)) {
+        promising.push_back(candidates[i]);
+      }
+    }
+    std::vector<Run> fitted(promising.size());
+    RunParallel(static_cast<int>(promising.size()), search.threads, [&](int i) {
+      const SearchStart& start = promising[static_cast<size_t>(i)];
+      fitted[static_cast<size_t>(i)] = fit_full(start.label, start.values, local);
+    });
+    full.insert(full.end(), fitted.begin(), fitted.end());
+    if (promising.size() < candidates.size()) {
+      result.notes.push_back(fmt::format(
+          "{} of {} {} start above {} times the best cost: not fitted",
+          candidates.size() - promising.size(), candidates.size(), what, kPromisingCostRatio));
+    }
+  };
+
+  // The other given starts (Route 1's other sets) that start near the primary's cost.
+  if (!starts.empty()) {
+    say(fmt::format("global search: {} further given start(s) (Route 1's other sets)",
+                    starts.size()));
+    fit_promising(starts, "further given start(s)");
+  }
+
+  // The design, unless the given starts settle the question: they hold every parameter set
+  // that matches the identified poles (complete_starts) and the best of them explains the
+  // records to their noise, so that no other minimum can fit better and an equally good one
+  // would be among them.
+  bool settled = false;
+  if (search.complete_starts) {
+    for (const Run& run : full) {
+      settled = settled || (!run.failed && Converged(run.fit) && run.fit.weights_from_records &&
+                            run.fit.chi_square_per_dof <= options.max_chi_square_per_dof);
+    }
+  }
+  const int design_count = settled ? 0 : search.design_starts;
+  if (settled) {
+    result.notes.push_back(
+        "no space-filling design: the given starts hold every set that matches the identified "
+        "poles, and the best of them fits the records to their noise");
+  }
+  std::vector<std::map<std::string, double>> design;
+  for (const std::vector<double>& point :
+       SpaceFillingDesign(design_count, static_cast<int>(settings.size()), search.seed)) {
+    std::map<std::string, double> values;
+    for (size_t k = 0; k < settings.size(); ++k) {
+      const ParameterSetting& s = settings[k];
+      // Uniform in Ceres' coordinates over the bounds.
+      values[s.name] =
+          s.log_scale
+              ? std::exp(std::log(s.lower) + point[k] * (std::log(s.upper) - std::log(s.lower)))
+              : s.lower + point[k] * (s.upper - s.lower);
+    }
+    design.push_back(values);
+  }
+  result.starts = static_cast<int>(1 + starts.size() + design.size());
+
+  // Design points on the first part of each record, in parallel.
+  if (!design.empty()) {
+    say(fmt::format("global search: {} design points on the first {:.0f}% of each record",
+                    design.size(), 100 * search.screen_fraction));
+  }
+  const std::vector<TestRecord> windows = Window(weighted, search.screen_fraction);
+  UpdateOptions screen = local;
+  screen.max_iterations = search.screen_iterations;
+  screen.continuation_fractions.clear();
+  std::vector<Run> batch(design.size());
+  RunParallel(static_cast<int>(batch.size()), search.threads, [&](int i) {
+    const size_t d = static_cast<size_t>(i);
+    Run run{fmt::format("design {}", d + 1), {}, false};
+    try {
+      run.fit = UpdateModel(model, windows, StartOptions(screen, settings, design[d]));
+    } catch (const std::exception& e) {
+      run.failed = true;
+    }
+    batch[d] = run;
+  });
+  result.screen_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - batch_start).count();
+  result.screened = static_cast<int>(design.size());
+
+  // The best distinct screened ends (a failed window fit has nothing to offer), minus those
+  // already reached by a whole-record fit.
+  std::vector<size_t> order;
+  for (size_t i = 0; i < batch.size(); ++i) {
+    if (!batch[i].failed && batch[i].fit.termination != UpdateResult::Termination::kFailure &&
+        std::isfinite(batch[i].fit.final_cost)) {
+      order.push_back(i);
+    }
+  }
+  std::stable_sort(order.begin(), order.end(), [&batch](size_t a, size_t b) {
+    return batch[a].fit.final_cost < batch[b].fit.final_cost;
+  });
+  std::vector<size_t> chosen;
+  for (size_t i : order) {
+    if (static_cast<int>(chosen.size()) >= search.full_fits) break;
+    // Ends far above the best screened cost lead to far minima (measured on the crane's load
+    // drop: window costs 6 times the best end 6 times above the best whole-record cost).
+    if (batch[i].fit.final_cost > kPromisingCostRatio * batch[order.front()].fit.final_cost) {
+      break;
+    }
+    bool known = false;
+    for (size_t j : chosen) {
+      known = known || Differences(batch[i].fit, batch[j].fit, search.cluster_tolerance).empty();
+    }
+    if (!known) chosen.push_back(i);
+  }
+  if (!chosen.empty()) {
+    say(fmt::format("global search: {} screened end(s) fitted on the whole records",
+                    chosen.size()));
+  }
+  std::vector<Run> refits(chosen.size());
+  RunParallel(static_cast<int>(chosen.size()), search.threads, [&](int i) {
+    const Run& screened = batch[chosen[static_cast<size_t>(i)]];
+    std::map<std::string, double> values;
+    for (const ParameterEstimate& p : screened.fit.parameters) {
+      if (p.test.empty()) values[p.name] = p.value;
+    }
+    refits[static_cast<size_t>(i)] = fit_full(screened.label, values, local);
+  });
+  full.insert(full.end(), refits.begin(), refits.end());
+
+  // The sets with the best end's own poles (eq. 7 on the tuned model's exact modes): joints
+  // trading roles give the same frequencies and dampings and differ only in what the record's
+  // mode shapes show, so a poorly excited mode leaves such a set as good a fit. The design
+  // finds them by chance; eq. 7 lists them.
+  if (search.pole_equivalent_starts && !search.complete_starts) {
+    const Run* provisional = nullptr;
+    for (const Run& run : full) {
+      if (run.failed || !Converged(run.fit)) continue;
+      if (provisional == nullptr || run.fit.final_cost < provisional->fit.final_cost) {
+        provisional = &run;
+      }
+    }
+    std::vector<SearchStart> equivalent;
+    if (provisional != nullptr) {
+      equivalent = PoleEquivalentStarts(model, provisional->fit, search.seed);
+    }
+    if (!equivalent.empty()) {
+      say(
+          fmt::format("global search: {} set(s) with the best end's poles (eq. 7) fitted on the "
+                      "whole records",
+                      equivalent.size()));
+    }
+    fit_promising(equivalent, "set(s) with the best end's poles");
+    result.starts += static_cast<int>(equivalent.size());
+    result.pole_equivalent = static_cast<int>(equivalent.size());
+  }
+  result.full_fits = static_cast<int>(full.size());
+
+  // Distinct minima among the converged whole-record fits, by ascending cost (ties: start
+  // order, so the given starts win).
+  std::vector<size_t> converged;
+  for (size_t i = 0; i < full.size(); ++i) {
+    if (!full[i].failed && Converged(full[i].fit)) converged.push_back(i);
+  }
+  std::stable_sort(converged.begin(), converged.end(), [&full](size_t a, size_t b) {
+    return full[a].fit.final_cost < full[b].fit.final_cost;
+  });
+  for (size_t i : converged) {
+    bool merged = false;
+    for (SearchMinimum& minimum : result.minima) {
+      if (Differences(minimum.fit, full[i].fit, search.cluster_tolerance).empty()) {
+        minimum.starts.push_back(full[i].label);
+        merged = true;
+        break;
+      }
+    }
+    if (!merged) {
+      SearchMinimum minimum;
+      minimum.fit = full[i].fit;
+      minimum.starts = {full[i].label};
+      minimum.cost = full[i].fit.final_cost;
+      result.minima.push_back(minimum);
+    }
+  }
+  if (result.minima.empty()) {
+    // Nothing converged: the primary start's fit carries the failure.
+    result.best = full.front().fit;
+    if (full.front().failed) result.best.termination = UpdateResult::Termination::kFailure;
+    result.notes.push_back("no local fit converged");
+  } else {
+    const SearchMinimum& best = result.minima.front();
+    const double k = static_cast<double>(best.fit.parameters.size());
+    const double dof = std::max(1.0, result.residual_count - k);
+    const double scale = std::max(2 * best.cost / dof, 1e-300);
+    for (size_t m = 1; m < result.minima.size(); ++m) {
+      SearchMinimum& minimum = result.minima[m];
+      minimum.f_statistic = 2 * (minimum.cost - best.cost) / k / scale;
+      minimum.p_value = FSurvival(minimum.f_statistic, k, dof);
+      minimum.alternative = minimum.p_value > search.significance;
+      minimum.differs_in = Differences(best.fit, minimum.fit, search.cluster_tolerance, false);
+    }
+    result.best = best.fit;
+    std::set<std::string> differing;
+    int alternatives = 0;
+    for (const SearchMinimum& minimum : result.minima) {
+      if (!minimum.alternative) continue;
+      ++alternatives;
+      differing.insert(minimum.differs_in.begin(), minimum.differs_in.end());
+    }
+    result.non_unique = alternatives > 0;
+    for (const ParameterEstimate& p : result.best.parameters) {
+      if (differing.count(p.name) > 0) result.differing.push_back(p.name);
+    }
+    for (ParameterEstimate& p : result.best.parameters) {
+      if (differing.count(p.name) == 0) continue;
+      p.determined = false;
+      p.why_undetermined = "the alternative minima differ in it";
+      if (std::find(result.best.undetermined.begin(), result.best.undetermined.end(), p.name) ==
+          result.best.undetermined.end()) {
+        result.best.undetermined.push_back(p.name);
+      }
+    }
+    if (result.non_unique) {
+      result.best.warnings.push_back(fmt::format(
+          "non-unique: {} other minimum(s) fit the records as well as the best (F-test at {}); "
+          "they differ in {}",
+          alternatives, search.significance, fmt::join(result.differing, ", ")));
+    }
+    result.notes.push_back(fmt::format(
+        "global search: {} starts ({} given, {} design, {} with the best end's poles), {} "
+        "whole-record fits, {} distinct minima, {} alternative(s)",
+        result.starts, result.starts - result.screened - result.pole_equivalent, result.screened,
+        result.pole_equivalent, result.full_fits, result.minima.size(), alternatives));
+    if (best.starts.front() != primary_label) {
+      result.notes.push_back(fmt::format("the best minimum was reached from {}, not from {}",
+                                         fmt::join(best.starts, ", "), primary_label));
+    }
+  }
+  if (!result.notes.empty())
+    result.best.message += fmt::format("; {}", fmt::join(result.notes, "; "));
+  result.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  return result;
+}
+
+}  // namespace mbid::updating

@@ -1,0 +1,27 @@
+#pragma once
+
+#include "mbid/common/yaml_reader.h"
+#include "mbid/identification/options.h"
+#include "mbid/simulation/excitation.h"
+
+namespace mbid::validation {
+
+// The `identification:` section of a scenario, read strictly into the identifier's options
+// (mbid/identification/options.h; every key is optional and defaults to the option's default):
+//   method: hankel-nls | prony-svd      window_start_s, window_end_s (s)
+//   channels: [psi, phi]                offset: none | mean | fit       decimation: 1
+//   min_frequency_hz, max_frequency_hz  min_damping_ratio, max_damping_ratio
+//   max_decay_rate_per_s                max_modes                        significance_false_alarm
+//   min_significance                    drop_insignificant               compute_spectrum
+//   compute_stabilization               compute_uncertainty              prony: {order,
+//   rank_tolerance}
+// Errors name the file and field; options out of range are reported as IdentificationOptions::
+// IsValid says.
+identification::IdentificationOptions ReadIdentificationSettings(const YamlReader& section);
+
+// Only the free decay is identified: without an explicit window start, the window opens at the
+// excitation's forcing end (impulse, burst).
+identification::IdentificationOptions FreeDecayOptions(
+    identification::IdentificationOptions options, const simulation::Excitation& excitation);
+
+}  // namespace mbid::validation

@@ -1,0 +1,46 @@
+#pragma once
+
+// The time origin of a measured test is the release (docs/identification.md): update and run cut
+// an imported record there before the test is simulated and fitted.
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "mbid/common/measurement.h"
+#include "mbid/common/yaml_reader.h"
+#include "mbid/simulation/excitation.h"
+#include "mbid/validation/record_import.h"
+
+namespace mbid::validation {
+
+// What the user said: `release: none` / `release_time_s: T` in a record entry, or
+// --release none / --release-time-s T (which win).
+struct ReleaseChoice {
+  bool none = false;
+  std::optional<double> time_s;  // in the record's own time
+};
+
+// The record entry's `release` and `release_time_s` keys (exclusive).
+ReleaseChoice ReadReleaseChoice(const YamlReader& entry);
+// `entry` with the command line's --release none / --release-time-s on top.
+ReleaseChoice OverrideRelease(const ReleaseChoice& entry, const ImportOverrides& overrides);
+
+struct AppliedRelease {
+  double release_time_s = 0;  // in the record's own time, as read from the file
+  // "detected", "given", "record start" (nothing at rest before the decay, or a record mbid
+  // simulated), "none" (--release none) or "forced test" (the excitation forces the structure
+  // from t = 0, which is then the origin).
+  std::string how;
+  nlohmann::json ToJson() const;
+};
+
+// Cuts `record` at its release with the release as time origin (start_time_s in [0, tau)):
+// given, or found (identification/release.h) in records mbid did not simulate when the excitation
+// is a release (a load drop or an initial deflection). Forced tests and --release none are left
+// whole.
+AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin,
+                                  const ReleaseChoice& choice,
+                                  const simulation::Excitation& excitation);
+
+}  // namespace mbid::validation

@@ -1,0 +1,31 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "mbid/common/hdf5_io.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/simulate.h"
+
+namespace mbid::validation {
+
+// /truth of a simulated measurement file (docs/interfaces.md): the model's parameters
+// (/truth/parameters/<name>, units attribute), the linear model (/truth/linear_model/M, D, C, H),
+// its exact modes (/truth/modes/<field>, one entry per mode), the initial coordinates and the
+// noise-free record (/truth/exact/<channel>).
+void WriteTruth(H5Writer& file, const model::MechanicalModel& model,
+                const simulation::SimulationResult& result);
+
+// The model's part of /truth alone (parameters, linear model, exact modes): what a campaign case
+// that does not simulate keeps. WriteTruth writes it too.
+void WriteModelTruth(H5Writer& file, const model::MechanicalModel& model);
+
+// /simulation: excitation type, forcing end, integrator settings and statistics.
+void WriteSimulationInfo(H5Writer& file, const simulation::Excitation& excitation,
+                         const simulation::SimulationOptions& options,
+                         const simulation::SimulationResult& result);
+
+// The JSON form of the integrator statistics.
+nlohmann::json IntegratorStatisticsToJson(const simulation::IntegratorStatistics& statistics);
+
+}  // namespace mbid::validation

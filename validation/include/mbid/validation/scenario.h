@@ -1,0 +1,62 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbid/common/yaml_reader.h"
+#include "mbid/identification/options.h"
+#include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/excitation.h"
+#include "mbid/simulation/sensor.h"
+#include "mbid/simulation/simulate.h"
+#include "mbid/updating/settings.h"
+#include "mbid/validation/record_source.h"
+
+namespace mbid::validation {
+
+// A scenario file (docs/scenarios.md), read strictly: unknown keys anywhere are errors.
+struct Scenario {
+  std::string path;
+  std::string name;
+  std::string yaml_text;  // the file as given, stored with every result
+  YamlReader root;
+  bool has_excitation = false;
+  simulation::Excitation excitation;
+  simulation::SimulationOptions simulation;  // defaults where the section is absent
+  simulation::SensorOptions sensors;         // defaults where the section is absent
+  // `record:`: the tests' records when they are measured (or made from modes) rather than
+  // simulated from the model; empty: `mbid run` simulates the test.
+  std::vector<RecordSource> records;
+  // `validation: {min_correlation: K}`: the run passes when the re-simulation with the tuned
+  // parameters correlates with the record at least this well on every channel.
+  double validation_min_correlation = 0.95;
+  // `structure: {alternatives: [file, ...]}`: other descriptions of the machine for
+  // `mbid structure` to rank beside the model's own rigid variants; paths resolved against the
+  // scenario's folder, each a YAML file with a `model:` section (a scenario file will do).
+  std::vector<std::string> structure_alternatives;
+
+  // A fresh model instance (one per worker).
+  std::unique_ptr<model::MechanicalModel> MakeModel() const;
+  // The model of structure_alternatives[index], checked as the scenario's own.
+  std::unique_ptr<model::MechanicalModel> MakeAlternativeModel(size_t index) const;
+  // The `identification:` section, or the identifier's defaults.
+  identification::IdentificationOptions ReadIdentification() const;
+  // The `updating:` section for `model`, or the defaults; the fits integrate with the
+  // scenario's integrator unless the section says otherwise.
+  updating::UpdatingSettings ReadUpdating(const model::MechanicalModel& model) const;
+  // The excitation; an InputError if the scenario has none.
+  const simulation::Excitation& RequireExcitation() const;
+};
+
+Scenario LoadScenario(const std::string& path);
+
+// The same from scenario text already in memory (a campaign's case); `source` names it in errors
+// and becomes Scenario::path.
+Scenario LoadScenarioFromText(const std::string& text, const std::string& source);
+
+// The built-in reference scenario: scenarios/reference-crane.yaml of the source tree, or of the
+// installed share directory.
+std::string DefaultScenarioPath();
+
+}  // namespace mbid::validation

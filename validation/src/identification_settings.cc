@@ -1,0 +1,92 @@
+#include "mbid/validation/identification_settings.h"
+
+#include <cmath>
+#include <limits>
+
+#include "mbid/common/error.h"
+
+namespace mbid::validation {
+
+identification::IdentificationOptions ReadIdentificationSettings(const YamlReader& section) {
+  identification::IdentificationOptions options;
+  if (section.node().IsNull()) return options;
+  section.ExpectMap({"method",
+                     "window_start_s",
+                     "window_end_s",
+                     "channels",
+                     "offset",
+                     "decimation",
+                     "min_frequency_hz",
+                     "max_frequency_hz",
+                     "min_damping_ratio",
+                     "max_damping_ratio",
+                     "max_decay_rate_per_s",
+                     "max_modes",
+                     "significance_false_alarm",
+                     "min_significance",
+                     "drop_insignificant",
+                     "compute_spectrum",
+                     "compute_stabilization",
+                     "compute_uncertainty",
+                     "extra_orders",
+                     "min_correlation",
+                     "prony"});
+  const std::string method = section.Choice("method", {"hankel-nls", "prony-svd"}, "hankel-nls");
+  identification::ParseMethod(method, &options.method);
+  options.window_start_s = section.Double("window_start_s", options.window_start_s);
+  options.window_end_s = section.Double("window_end_s", options.window_end_s);
+  if (section.Has("channels")) options.channels = section.StringList("channels");
+  const std::string offset = section.Choice("offset", {"none", "mean", "fit"}, "fit");
+  options.offset = offset == "none"   ? identification::OffsetRemoval::kNone
+                   : offset == "mean" ? identification::OffsetRemoval::kMean
+                                      : identification::OffsetRemoval::kFit;
+  options.decimation = section.Int("decimation", options.decimation);
+  options.min_correlation = section.Double("min_correlation", options.min_correlation);
+  options.min_frequency_hz = section.Double("min_frequency_hz", options.min_frequency_hz);
+  options.max_frequency_hz = section.Double("max_frequency_hz", options.max_frequency_hz);
+  options.min_damping_ratio = section.Double("min_damping_ratio", options.min_damping_ratio);
+  options.max_damping_ratio = section.Double("max_damping_ratio", options.max_damping_ratio);
+  options.max_decay_rate_per_s =
+      section.Double("max_decay_rate_per_s", options.max_decay_rate_per_s);
+  options.max_modes = section.Int("max_modes", options.max_modes);
+  options.hankel.extra_orders = section.Int("extra_orders", options.hankel.extra_orders);
+  options.significance_false_alarm =
+      section.Double("significance_false_alarm", options.significance_false_alarm);
+  options.min_significance = section.Double("min_significance", options.min_significance);
+  options.drop_insignificant = section.Bool("drop_insignificant", options.drop_insignificant);
+  options.compute_spectrum = section.Bool("compute_spectrum", options.compute_spectrum);
+  options.compute_stabilization =
+      section.Bool("compute_stabilization", options.compute_stabilization);
+  options.compute_uncertainty = section.Bool("compute_uncertainty", options.compute_uncertainty);
+  if (section.Has("prony")) {
+    const YamlReader prony = section.Child("prony");
+    prony.ExpectMap({"order", "rank_tolerance", "noise_floor_factor"});
+    options.prony.order = prony.Int("order", options.prony.order);
+    options.prony.noise_floor_factor =
+        prony.Double("noise_floor_factor", options.prony.noise_floor_factor);
+    options.prony.rank_tolerance = prony.Double("rank_tolerance", options.prony.rank_tolerance);
+  }
+  std::string why;
+  if (!options.IsValid(&why)) {
+    // IsValid names the option ("max_modes: 0 is out of range; expected ..."); keep its words.
+    const size_t colon = why.find(": ");
+    const size_t expected = why.find("; expected ");
+    if (colon != std::string::npos && expected != std::string::npos) {
+      throw InputError(section.source(), section.field() + "." + why.substr(0, colon),
+                       why.substr(colon + 2, expected - colon - 2), why.substr(expected + 11));
+    }
+    section.Fail(why, "identification options in range");
+  }
+  return options;
+}
+
+identification::IdentificationOptions FreeDecayOptions(
+    identification::IdentificationOptions options, const simulation::Excitation& excitation) {
+  const double forcing_end = excitation.CalcForcingEndTime();
+  if (forcing_end > 0 && !std::isfinite(options.window_start_s)) {
+    options.window_start_s = forcing_end;
+  }
+  return options;
+}
+
+}  // namespace mbid::validation

@@ -1,0 +1,73 @@
+#include "mbid/validation/loaded_test.h"
+
+#include <fmt/format.h>
+
+#include <iostream>
+#include <optional>
+
+#include "mbid/identification/identify.h"
+#include "mbid/validation/identification_settings.h"
+#include "mbid/validation/record_source.h"
+
+namespace mbid::validation {
+namespace {
+
+bool IsHdf5(const std::string& path) {
+  const auto ends_with = [&](const std::string& tail) {
+    return path.size() >= tail.size() &&
+           path.compare(path.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  return ends_with(".h5") || ends_with(".hdf5");
+}
+
+}  // namespace
+
+LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
+                    const model::MechanicalModel& model,
+                    const identification::IdentificationOptions& identification_options,
+                    const ImportOverrides& overrides) {
+  LoadedTest test;
+  test.path = path;
+  test.record =
+      records::ImportMeasurement(path, MergeImportOptions({}, overrides, &model), &test.import);
+  // Checked here rather than left to the fit: identification would run first on any channels.
+  RequireModelOutputs(test.record, path, model);
+  // A simulated test carries its own scenario: its excitation is the one of this record (a load
+  // drop and an initial deflection can then be fitted together).
+  std::optional<simulation::Excitation> own =
+      IsHdf5(path) ? ReadStoredExcitation(path) : std::nullopt;
+  test.excitation = own ? *own : scenario.RequireExcitation();
+  test.excitation_source = own ? path : "scenario";
+  // The simulation of the test starts at the release: the record is cut there.
+  test.release =
+      CutRecordAtRelease(&test.record, path, OverrideRelease({}, overrides), test.excitation);
+
+  test.identified = identification::Identify(
+      test.record, FreeDecayOptions(identification_options, test.excitation), path);
+  return test;
+}
+
+void DescribeLoadedTest(const LoadedTest& test) {
+  std::cerr << fmt::format("mbid: {}: {}\n", test.path, DescribeImport(test.import));
+  std::cerr << fmt::format("mbid: {}: free decay from {:.6g} s of the record ({}); t = 0 there\n",
+                           test.path, test.release.release_time_s, test.release.how);
+  std::cerr << fmt::format("mbid: {}: {} samples x {} channels, {} ({}), {} modes identified\n",
+                           test.path, test.record.samples(), test.record.channel_count(),
+                           test.excitation.type_name(), test.excitation_source,
+                           test.identified.modes.size());
+}
+
+std::vector<LoadedTest> LoadTests(
+    const std::vector<std::string>& paths, const Scenario& scenario,
+    const model::MechanicalModel& model,
+    const identification::IdentificationOptions& identification_options,
+    const ImportOverrides& overrides, bool describe) {
+  std::vector<LoadedTest> tests;
+  for (const std::string& path : paths) {
+    tests.push_back(LoadTest(path, scenario, model, identification_options, overrides));
+    if (describe) DescribeLoadedTest(tests.back());
+  }
+  return tests;
+}
+
+}  // namespace mbid::validation

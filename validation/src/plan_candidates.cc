@@ -1,0 +1,154 @@
+#include "mbid/validation/plan_candidates.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <set>
+
+#include "mbid/common/error.h"
+#include "mbid/common/yaml_reader.h"
+#include "mbid/model/model_factory.h"
+#include "mbid/simulation/scenario_sections.h"
+
+namespace mbid::validation {
+namespace {
+
+// As the scenario's limit: 1e8 samples per channel is beyond any test this tool is for.
+constexpr double kMaxSamples = 1e8;
+
+bool IsSensorEffectKey(const std::string& key) {
+  for (const char* base : {"noise_std", "bias", "quantization_step"}) {
+    for (const std::string& known : simulation::UnitKeys(base)) {
+      if (key == known) return true;
+    }
+  }
+  return false;
+}
+
+// The scenario's section `key` (or an empty map) with the candidate's over it.
+YAML::Node MergedSection(const Scenario& scenario, const YamlReader& candidate,
+                         const std::string& key, bool drop_sensor_effects) {
+  YAML::Node base(YAML::NodeType::Map);
+  if (scenario.root.Has(key)) base = YAML::Clone(scenario.root.Child(key).node());
+  if (drop_sensor_effects && base.IsMap()) {
+    YAML::Node kept(YAML::NodeType::Map);
+    for (const auto& item : base) {
+      const std::string name = item.first.as<std::string>();
+      if (!IsSensorEffectKey(name)) kept[name] = item.second;
+    }
+    base = kept;
+  }
+  return MergeYaml(base, candidate.Child(key).node());
+}
+
+}  // namespace
+
+YAML::Node MergeYaml(const YAML::Node& base, const YAML::Node& override) {
+  if (!base.IsMap() || !override.IsMap()) return YAML::Clone(override);
+  YAML::Node merged = YAML::Clone(base);
+  for (const auto& item : override) {
+    const std::string key = item.first.as<std::string>();
+    const YAML::Node& mine = merged;  // const lookup does not insert
+    merged[key] =
+        mine[key].IsDefined() ? MergeYaml(mine[key], item.second) : YAML::Clone(item.second);
+  }
+  return merged;
+}
+
+CandidateFile ReadCandidateFile(const std::string& path, const Scenario& scenario,
+                                const model::MechanicalModel& model) {
+  const YamlReader root = YamlReader::FromFile(path);
+  root.ExpectMap({"candidates"});
+  const YamlReader list = root.Child("candidates");
+  if (!list.node().IsSequence() || list.node().size() == 0) {
+    list.Fail("not a non-empty list", "a list of candidate tests [{name, excitation, ...}]");
+  }
+  CandidateFile file;
+  file.path = path;
+  std::set<std::string> names;
+  for (size_t i = 0; i < list.node().size(); ++i) {
+    const YamlReader entry(list.node()[i], path, fmt::format("candidates[{}]", i));
+    if (!entry.IsMap()) entry.Fail("not a map", "a map {name, excitation, ...}");
+    entry.ExpectMap({"name", "excitation", "simulation", "sensors", "model"});
+    updating::PlanCandidate candidate;
+    candidate.name = entry.String("name");
+    if (candidate.name.empty()) entry.FailAt("name", "''", "a non-empty name");
+    if (!names.insert(candidate.name).second) {
+      entry.FailAt("name", "'" + candidate.name + "' given twice", "unique candidate names");
+    }
+    const model::MechanicalModel* own = &model;
+    if (entry.Has("model")) {
+      const YamlReader merged(MergedSection(scenario, entry, "model", false), path,
+                              entry.field() + ".model");
+      candidate.model = model::MakeModel(merged);
+      own = candidate.model.get();
+    }
+    candidate.test.name = candidate.name;
+    candidate.test.excitation = simulation::ReadExcitation(entry.Child("excitation"), *own);
+    candidate.test.simulation = scenario.simulation;
+    if (entry.Has("simulation")) {
+      candidate.test.simulation = simulation::ReadSimulationOptions(
+          YamlReader(MergedSection(scenario, entry, "simulation", false), path,
+                     entry.field() + ".simulation"));
+    }
+    std::vector<std::string> own_noise;
+    if (entry.Has("sensors")) {
+      candidate.test.sensors =
+          simulation::ReadSensorOptions(YamlReader(MergedSection(scenario, entry, "sensors", true),
+                                                   path, entry.field() + ".sensors"),
+                                        *own);
+      for (const auto& [channel, value] : candidate.test.sensors.noise_std) {
+        if (value > 0) own_noise.push_back(channel);
+      }
+    } else {
+      candidate.test.sensors = scenario.sensors;
+    }
+    // Only the candidate's own noise until FillCandidateNoise; no sensor effects otherwise.
+    std::map<std::string, double> noise;
+    for (const std::string& channel : own_noise) {
+      noise[channel] = candidate.test.sensors.noise_std.at(channel);
+    }
+    candidate.test.sensors.noise_std = noise;
+    candidate.test.sensors.bias.clear();
+    candidate.test.sensors.quantization_step.clear();
+    const double samples =
+        std::floor(candidate.test.simulation.duration_s * candidate.test.sensors.sample_rate_hz +
+                   1e-9) +
+        1;
+    if (!(samples <= kMaxSamples && samples >= 2)) {
+      throw InputError(
+          path, entry.field() + ".simulation.duration_s, sensors.sample_rate_hz",
+          fmt::format("{:g} s at {:g} Hz is {:.3g} samples per channel",
+                      candidate.test.simulation.duration_s, candidate.test.sensors.sample_rate_hz,
+                      samples),
+          fmt::format("2 to {:g} samples (duration_s x sample_rate_hz + 1)", kMaxSamples));
+    }
+    file.candidates.push_back(std::move(candidate));
+    file.own_noise.push_back(own_noise);
+  }
+  return file;
+}
+
+void FillCandidateNoise(CandidateFile& file, const std::map<std::string, double>& recorded,
+                        const std::map<std::string, double>& scenario_noise) {
+  for (size_t i = 0; i < file.candidates.size(); ++i) {
+    updating::TestDesign& test = file.candidates[i].test;
+    for (const std::string& channel : test.sensors.channels) {
+      if (test.sensors.noise_std.count(channel) > 0) continue;
+      const auto from_records = recorded.find(channel);
+      const auto from_scenario = scenario_noise.find(channel);
+      if (from_records != recorded.end() && from_records->second > 0) {
+        test.sensors.noise_std[channel] = from_records->second;
+      } else if (from_scenario != scenario_noise.end() && from_scenario->second > 0) {
+        test.sensors.noise_std[channel] = from_scenario->second;
+      } else {
+        throw InputError(file.path, fmt::format("candidates[{}].sensors", i),
+                         "no noise level for channel '" + channel +
+                             "' (not in the recorded tests, none in the scenario's sensors)",
+                         "sensors.noise_std_rad (or the channel unit's key) for the channel");
+      }
+    }
+  }
+}
+
+}  // namespace mbid::validation

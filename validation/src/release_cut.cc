@@ -1,0 +1,70 @@
+#include "mbid/validation/release_cut.h"
+
+#include "mbid/common/error.h"
+#include "mbid/identification/identify.h"
+#include "mbid/identification/release.h"
+
+namespace mbid::validation {
+
+ReleaseChoice ReadReleaseChoice(const YamlReader& entry) {
+  ReleaseChoice choice;
+  if (entry.Has("release") && entry.Has("release_time_s")) {
+    entry.Fail("both release and release_time_s",
+               "at most one of release: none and release_time_s");
+  }
+  if (entry.Has("release")) choice.none = entry.Choice("release", {"none", "detect"}, "") == "none";
+  if (entry.Has("release_time_s")) choice.time_s = entry.Double("release_time_s");
+  return choice;
+}
+
+ReleaseChoice OverrideRelease(const ReleaseChoice& entry, const ImportOverrides& overrides) {
+  if (overrides.release_none) return {true, std::nullopt};
+  if (overrides.release_time_s) return {false, overrides.release_time_s};
+  return entry;
+}
+
+nlohmann::json AppliedRelease::ToJson() const {
+  return {{"release_time_s", release_time_s}, {"release", how}};
+}
+
+AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin,
+                                  const ReleaseChoice& choice,
+                                  const simulation::Excitation& excitation) {
+  AppliedRelease applied;
+  applied.release_time_s = record->start_time_s;
+  if (choice.time_s) {
+    applied.how = "given";
+    applied.release_time_s = *choice.time_s;
+  } else if (choice.none) {
+    applied.how = "none";
+    return applied;
+  } else if (excitation.CalcForcingEndTime() > 0) {
+    applied.how = "forced test";
+    return applied;
+  } else if (record->made_by_mbid()) {
+    // mbid's own records start at the excitation by construction.
+    applied.how = "record start";
+    return applied;
+  } else {
+    const identification::ReleaseDetection detection = identification::DetectRelease(*record);
+    applied.how = detection.detected ? "detected" : "record start";
+    applied.release_time_s = detection.release_time_s;
+    if (!detection.detected) return applied;
+    if (detection.from_rest) {
+      // The identified decay places a release from rest to a fraction of a sample: the test's
+      // simulation starts there, and a sample's error is a phase error of every mode.
+      identification::IdentificationOptions options;
+      options.compute_spectrum = false;
+      options.compute_stabilization = false;
+      try {
+        applied.release_time_s = identification::Identify(*record, options, origin).release_time_s;
+      } catch (const NumericalError&) {
+        // No modes to refine with: the onset fit's instant stands (identification will say why).
+      }
+    }
+  }
+  *record = identification::CutAtRelease(*record, applied.release_time_s, origin);
+  return applied;
+}
+
+}  // namespace mbid::validation

@@ -1,0 +1,131 @@
+#include "mbid/validation/scenario.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "mbid/common/error.h"
+#include "mbid/model/model_factory.h"
+#include "mbid/simulation/scenario_sections.h"
+#include "mbid/validation/identification_settings.h"
+
+namespace mbid::validation {
+
+std::unique_ptr<model::MechanicalModel> Scenario::MakeModel() const {
+  return model::MakeModel(root.Child("model"));
+}
+
+std::unique_ptr<model::MechanicalModel> Scenario::MakeAlternativeModel(size_t index) const {
+  const std::string& file = structure_alternatives.at(index);
+  if (!std::filesystem::is_regular_file(file)) {
+    throw InputError(path, "structure.alternatives[" + std::to_string(index) + "]",
+                     "cannot open '" + file + "'", "a readable YAML file with a model: section");
+  }
+  const YamlReader alternative = YamlReader::FromFile(file);
+  if (!alternative.IsMap() || !alternative.Has("model")) {
+    alternative.Fail("no model: section", "a YAML file with a model: section");
+  }
+  return model::MakeModel(alternative.Child("model"));
+}
+
+identification::IdentificationOptions Scenario::ReadIdentification() const {
+  return root.Has("identification") ? ReadIdentificationSettings(root.Child("identification"))
+                                    : identification::IdentificationOptions();
+}
+
+updating::UpdatingSettings Scenario::ReadUpdating(const model::MechanicalModel& model) const {
+  return root.Has("updating")
+             ? updating::ReadUpdatingSettings(root.Child("updating"), model, simulation.integrator)
+             : updating::MakeDefaultUpdatingSettings(model, simulation.integrator);
+}
+
+const simulation::Excitation& Scenario::RequireExcitation() const {
+  if (!has_excitation) root.Fail("no excitation section", "excitation: {type: ...}");
+  return excitation;
+}
+
+Scenario LoadScenario(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "", "cannot open the scenario file", "a readable YAML file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return LoadScenarioFromText(text.str(), path);
+}
+
+namespace {
+constexpr double kMaxSamples = 1e8;
+}  // namespace
+
+Scenario LoadScenarioFromText(const std::string& text, const std::string& source) {
+  Scenario scenario{source, "",   text, YamlReader::FromString(text, source), false, {}, {}, {},
+                    {},     0.95, {}};
+  if (!scenario.root.IsMap()) scenario.root.Fail("not a mapping", "a YAML mapping of sections");
+  scenario.root.ExpectMap({"name", "model", "excitation", "simulation", "sensors", "record",
+                           "identification", "updating", "validation", "structure"});
+  scenario.name = scenario.root.String("name");
+  // Any other name is made a safe folder name where it names the results folder.
+  if (scenario.name.empty()) scenario.root.FailAt("name", "''", "a non-empty name");
+  // Build the model once so that every error surfaces at load time.
+  const auto model = scenario.MakeModel();
+  if (scenario.root.Has("excitation")) {
+    scenario.has_excitation = true;
+    scenario.excitation = simulation::ReadExcitation(scenario.root.Child("excitation"), *model);
+  }
+  if (scenario.root.Has("simulation")) {
+    scenario.simulation = simulation::ReadSimulationOptions(scenario.root.Child("simulation"));
+  }
+  if (scenario.root.Has("validation")) {
+    const YamlReader validation = scenario.root.Child("validation");
+    validation.ExpectMap({"min_correlation"});
+    scenario.validation_min_correlation = validation.Double("min_correlation", 0.95);
+    if (!(scenario.validation_min_correlation > -1 && scenario.validation_min_correlation <= 1)) {
+      validation.FailAt("min_correlation", "out of range", "a correlation in (-1, 1]");
+    }
+  }
+  if (scenario.root.Has("sensors")) {
+    scenario.sensors = simulation::ReadSensorOptions(scenario.root.Child("sensors"), *model);
+  }
+  // The record's size before anything allocates it: 1e8 samples per channel (0.8 GB of doubles)
+  // is beyond any test this tool is for.
+  const double samples =
+      std::floor(scenario.simulation.duration_s * scenario.sensors.sample_rate_hz + 1e-9) + 1;
+  if (!(samples <= kMaxSamples && samples >= 2)) {
+    // Either key may be the wrong one; the message gives both values.
+    throw InputError(
+        scenario.root.source(), "simulation.duration_s, sensors.sample_rate_hz",
+        fmt::format("{:g} s at {:g} Hz is {:.3g} samples per channel",
+                    scenario.simulation.duration_s, scenario.sensors.sample_rate_hz, samples),
+        fmt::format("2 to {:g} samples (duration_s x sample_rate_hz + 1)", kMaxSamples));
+  }
+  if (scenario.root.Has("structure")) {
+    const YamlReader structure = scenario.root.Child("structure");
+    structure.ExpectMap({"alternatives"});
+    const std::filesystem::path folder = std::filesystem::path(source).parent_path();
+    for (const std::string& file : structure.StringList("alternatives")) {
+      const std::filesystem::path given(file);
+      scenario.structure_alternatives.push_back(
+          given.is_absolute() || folder.empty() ? file : (folder / given).string());
+    }
+    // Every alternative's model is built now, so that its errors surface at load time.
+    for (size_t i = 0; i < scenario.structure_alternatives.size(); ++i) {
+      scenario.MakeAlternativeModel(i);
+    }
+  }
+  if (scenario.root.Has("record")) {
+    const std::filesystem::path folder = std::filesystem::path(source).parent_path();
+    scenario.records = ReadRecordSources(scenario.root.Child("record"),
+                                         folder.empty() ? "." : folder.string(), *model);
+  }
+  return scenario;
+}
+
+std::string DefaultScenarioPath() {
+  const std::filesystem::path in_tree =
+      std::filesystem::path(MBID_SOURCE_DIR) / "scenarios" / "reference-crane.yaml";
+  return in_tree.string();
+}
+
+}  // namespace mbid::validation

@@ -1,0 +1,114 @@
+#include "mbid/validation/two_route_update.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <numeric>
+#include <vector>
+
+namespace mbid::validation {
+
+std::vector<size_t> SelectMainModes(const identification::ModalResult& identified, size_t count) {
+  // Energy of mode k over the analysed record, sum over channels of
+  // A^2 (1 - e^{-2 decay T}) / (4 decay), each channel in units of its residual noise variance so
+  // that no channel dominates by its unit; noiseless channels count unweighted.
+  const double record_s = (identified.samples - 1) * identified.sample_interval_s;
+  std::vector<double> energy(identified.modes.size(), 0.0);
+  for (size_t k = 0; k < identified.modes.size(); ++k) {
+    const auto& mode = identified.modes[k];
+    const double decay = mode.decay_rate_per_s;
+    const double duration = std::abs(decay) * record_s < 1e-12
+                                ? record_s / 2
+                                : -std::expm1(-2 * decay * record_s) / (4 * decay);
+    for (Eigen::Index c = 0; c < mode.amplitude.size(); ++c) {
+      const double noise = c < identified.noise_std.size() && identified.noise_std[c] > 0
+                               ? identified.noise_std[c]
+                               : 1.0;
+      energy[k] += mode.amplitude[c] * mode.amplitude[c] * duration / (noise * noise);
+    }
+  }
+  std::vector<size_t> order(identified.modes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&energy](size_t a, size_t b) { return energy[a] > energy[b]; });
+  order.resize(std::min(count, order.size()));
+  std::sort(order.begin(), order.end());  // ascending frequency, as identified
+  return order;
+}
+
+std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
+    const model::MechanicalModel& model, const identification::ModalResult& identified,
+    const Measurement& record, const simulation::Excitation& excitation,
+    const updating::UpdatingSettings& settings, std::string* note) {
+  if (!settings.algebraic_start) {
+    *note = "algebraic_start is off";
+    return nullptr;
+  }
+  const size_t n = static_cast<size_t>(model.coordinate_count());
+  const std::string free = updating::FindFreeCoordinate(model);
+  if (!free.empty()) {
+    *note =
+        fmt::format("coordinate '{}' has no spring (eq. 7 needs one on every coordinate)", free);
+    return nullptr;
+  }
+  if (identified.modes.size() < n) {
+    *note = fmt::format("{} identified modes for {} coordinates", identified.modes.size(), n);
+    return nullptr;
+  }
+  std::vector<size_t> main = SelectMainModes(identified, n);
+  if (identified.modes.size() > n) {
+    std::vector<std::string> left_out;
+    for (size_t k = 0; k < identified.modes.size(); ++k) {
+      if (std::find(main.begin(), main.end(), k) == main.end()) {
+        left_out.push_back(fmt::format("{:.3f} Hz", identified.modes[k].frequency_hz));
+      }
+    }
+    *note = fmt::format("eq. 7 on the {} main modes (largest energy in the record); left out: {}",
+                        n, fmt::join(left_out, ", "));
+  }
+  std::vector<std::complex<double>> lambda;
+  for (size_t k : main) lambda.push_back(identified.modes[k].lambda);
+  return std::make_shared<const updating::CharacteristicResult>(
+      updating::SolveCharacteristicEquation(
+          updating::MakeCharacteristicProblem(model, lambda, record, excitation),
+          settings.algebraic));
+}
+
+updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
+                                       const std::vector<updating::TestRecord>& records,
+                                       updating::UpdatingSettings settings,
+                                       const updating::CharacteristicResult* algebraic,
+                                       std::string* start, std::string* note,
+                                       const std::function<void(const std::string&)>& say) {
+  *start = "scenario";
+  bool from_route1 = false;
+  if (algebraic != nullptr) {
+    std::string why;
+    from_route1 = updating::ApplyAlgebraicStart(*algebraic, settings.options, &why);
+    if (from_route1) *start = "route1";
+    if (!why.empty()) *note = note->empty() ? why : *note + "; " + why;
+  }
+  std::vector<updating::SearchStart> starts;
+  if (algebraic != nullptr) starts = updating::MakeAlgebraicStarts(*algebraic, from_route1);
+  // Route 1 ran on as many poles as coordinates (SolveAlgebraicRoute) and solved: its sets are
+  // every joint set with these poles.
+  settings.global_search.complete_starts =
+      algebraic != nullptr && algebraic->status == updating::CharacteristicResult::Status::kSolved;
+  updating::GlobalSearchResult search = updating::SearchGlobally(
+      model, records, settings.options, *start, starts, settings.global_search, say);
+  if (algebraic != nullptr) updating::MarkAlgebraicAmbiguity(*algebraic, search.best);
+  return search;
+}
+
+void WeighByIdentifiedNoise(const identification::ModalResult& identified,
+                            updating::TestRecord& record) {
+  for (size_t c = 0; c < identified.channels.size(); ++c) {
+    const double noise = identified.noise_std[static_cast<Eigen::Index>(c)];
+    if (noise > 0) record.noise_std.emplace(identified.channels[c], noise);
+  }
+}
+
+}  // namespace mbid::validation
