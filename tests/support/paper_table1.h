@@ -1,6 +1,6 @@
 #pragma once
 
-// The paper's Table 1 (shared/docs/method.md) and the record scenarios/paper-ks5579.yaml makes
+// The paper's Table 1 (docs/method.md) and the record scenarios/paper-ks5579.yaml makes
 // of it, for the tests that check Route 1 and the identifier against it.
 #include <cmath>
 #include <cstdint>
