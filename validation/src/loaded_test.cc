@@ -30,20 +30,36 @@ LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
   test.path = path;
   test.record =
       records::ImportMeasurement(path, MergeImportOptions({}, overrides, &model), &test.import);
-  // Checked here rather than left to the fit: identification would run first on any channels.
+  // Checked before anything else is read from the file.
   RequireModelOutputs(test.record, path, model);
   // A simulated test carries its own scenario: its excitation is the one of this record (a load
   // drop and an initial deflection can then be fitted together).
   std::optional<simulation::Excitation> own =
       IsHdf5(path) ? ReadStoredExcitation(path) : std::nullopt;
-  test.excitation = own ? *own : scenario.RequireExcitation();
-  test.excitation_source = own ? path : "scenario";
-  // The simulation of the test starts at the release: the record is cut there.
-  test.release =
-      CutRecordAtRelease(&test.record, path, OverrideRelease({}, overrides), test.excitation);
+  LoadedTest prepared =
+      PrepareTest(std::move(test.record), path, own ? *own : scenario.RequireExcitation(), model,
+                  identification_options, OverrideRelease({}, overrides));
+  prepared.import = std::move(test.import);
+  prepared.excitation_source = own ? path : "scenario";
+  return prepared;
+}
 
+LoadedTest PrepareTest(Measurement record, const std::string& origin,
+                       const simulation::Excitation& excitation,
+                       const model::MechanicalModel& model,
+                       const identification::IdentificationOptions& identification_options,
+                       const ReleaseChoice& release) {
+  LoadedTest test;
+  test.path = origin;
+  test.record = std::move(record);
+  // Checked here rather than left to the fit: identification would run first on any channels.
+  RequireModelOutputs(test.record, origin, model);
+  test.excitation = excitation;
+  test.excitation_source = "scenario";
+  // The simulation of the test starts at the release: the record is cut there.
+  test.release = CutRecordAtRelease(&test.record, origin, release, test.excitation);
   test.identified = identification::Identify(
-      test.record, FreeDecayOptions(identification_options, test.excitation), path);
+      test.record, FreeDecayOptions(identification_options, test.excitation), origin);
   return test;
 }
 

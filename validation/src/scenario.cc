@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -122,10 +123,27 @@ Scenario LoadScenarioFromText(const std::string& text, const std::string& source
   return scenario;
 }
 
-std::string DefaultScenarioPath() {
-  const std::filesystem::path in_tree =
-      std::filesystem::path(MBID_SOURCE_DIR) / "scenarios" / "reference-crane.yaml";
-  return in_tree.string();
+std::string DefaultScenarioPath(const std::string& data_dir_hint) {
+  namespace fs = std::filesystem;
+  const fs::path relative = fs::path("scenarios") / "reference-crane.yaml";
+  std::vector<fs::path> candidates;
+  // An explicit choice first, then the installation the caller knows (its CMake package or
+  // Python module), the installation beside the running program (bin/../share/mbid), the
+  // source tree of a build, and the configured installation prefix.
+  if (const char* env = std::getenv("MBID_DATA_DIR"); env != nullptr && *env != '\0') {
+    candidates.emplace_back(env);
+  }
+  if (!data_dir_hint.empty()) candidates.emplace_back(data_dir_hint);
+  std::error_code error;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
+  if (!error) candidates.push_back(exe.parent_path().parent_path() / "share" / "mbid");
+  candidates.emplace_back(MBID_SOURCE_DIR);
+  candidates.emplace_back(MBID_INSTALL_DATA_DIR);
+  for (const fs::path& dir : candidates) {
+    if (fs::is_regular_file(dir / relative, error)) return (dir / relative).string();
+  }
+  // None found: the source tree's path, which the error of reading it will name.
+  return (fs::path(MBID_SOURCE_DIR) / relative).string();
 }
 
 }  // namespace mbid::validation

@@ -35,6 +35,14 @@ LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
                     const identification::IdentificationOptions& identification_options,
                     const ImportOverrides& overrides);
 
+// A record already in memory as one test: checked against `model`, cut at the release (found in
+// the record unless `release` says otherwise) and identified; `origin` names it in messages.
+LoadedTest PrepareTest(Measurement record, const std::string& origin,
+                       const simulation::Excitation& excitation,
+                       const model::MechanicalModel& model,
+                       const identification::IdentificationOptions& identification_options,
+                       const ReleaseChoice& release = {});
+
 // One line per step on standard error: the import, the release, the record and its modes.
 void DescribeLoadedTest(const LoadedTest& test);
 

@@ -55,8 +55,9 @@ Scenario LoadScenario(const std::string& path);
 // and becomes Scenario::path.
 Scenario LoadScenarioFromText(const std::string& text, const std::string& source);
 
-// The built-in reference scenario: scenarios/reference-crane.yaml of the source tree, or of the
-// installed share directory.
-std::string DefaultScenarioPath();
+// The built-in reference scenario, scenarios/reference-crane.yaml, from the first data folder
+// that has it: $MBID_DATA_DIR, `data_dir_hint`, <program>/../share/mbid, the source tree, the
+// configured installation's share/mbid.
+std::string DefaultScenarioPath(const std::string& data_dir_hint = "");
 
 }  // namespace mbid::validation

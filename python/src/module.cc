@@ -1,0 +1,238 @@
+// The Python module `mbid` (its compiled part, mbid._mbid): the facade of <mbid/mbid.h> with
+// records as numpy arrays and mbid's errors as Python exceptions with the same one-line text.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mbid/mbid.h"
+
+namespace py = pybind11;
+
+namespace {
+
+py::array_t<double> ToArray(const Eigen::VectorXd& v) {
+  py::array_t<double> array(v.size());
+  std::copy(v.data(), v.data() + v.size(), array.mutable_data());
+  return array;
+}
+
+// A record as Python sees it: time and channels as numpy arrays (copies), SI units.
+py::dict Channels(const mbid::Measurement& m) {
+  py::dict channels;
+  for (int c = 0; c < m.channel_count(); ++c) {
+    channels[py::str(m.channels[static_cast<size_t>(c)])] = ToArray(m.values.col(c));
+  }
+  return channels;
+}
+
+py::dict Units(const mbid::Measurement& m) {
+  py::dict units;
+  for (size_t c = 0; c < m.channels.size(); ++c) units[py::str(m.channels[c])] = m.units[c];
+  return units;
+}
+
+// identify_arrays: a uniformly sampled record from a time array and named channel arrays.
+mbid::Measurement MakeRecord(
+    py::array_t<double, py::array::c_style | py::array::forcecast> time,
+    const std::map<std::string, py::array_t<double, py::array::c_style | py::array::forcecast>>&
+        channels,
+    const std::map<std::string, std::string>& units) {
+  if (time.ndim() != 1) {
+    throw mbid::InputError("identify_arrays", "time",
+                           "an array of dimension " + std::to_string(time.ndim()),
+                           "a one-dimensional array of times in s");
+  }
+  const Eigen::Index n = time.shape(0);
+  const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(time.data(), n);
+  mbid::Measurement m;
+  double start = 0;
+  m.sample_interval_s = mbid::CheckUniformTime(
+      t, "identify_arrays", [](Eigen::Index j) { return "time[" + std::to_string(j) + "]"; }, 0.0,
+      &start);
+  m.start_time_s = t.size() > 0 ? t[0] : 0.0;
+  if (channels.empty()) {
+    throw mbid::InputError("identify_arrays", "channels", "no channel",
+                           "a dict {name: array} with at least one channel");
+  }
+  m.values.resize(n, static_cast<Eigen::Index>(channels.size()));
+  Eigen::Index column = 0;
+  for (const auto& [name, values] : channels) {
+    if (values.ndim() != 1 || values.shape(0) != n) {
+      throw mbid::InputError("identify_arrays", "channels/" + name,
+                             "an array of shape different from time's",
+                             "a one-dimensional array of " + std::to_string(n) + " samples");
+    }
+    m.values.col(column++) = Eigen::Map<const Eigen::VectorXd>(values.data(), n);
+    m.channels.push_back(name);
+    const auto unit = units.find(name);
+    m.units.push_back(unit == units.end() ? "1" : unit->second);
+  }
+  for (const auto& [name, unit] : units) {
+    if (channels.count(name) == 0) {
+      throw mbid::InputError("identify_arrays", "units/" + name, "a unit for no channel",
+                             "units only for the given channels");
+    }
+  }
+  m.source = "import";
+  m.Validate("identify_arrays");
+  return m;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_mbid, m) {
+  m.doc() = "mbid: multibody identification (simulate, identify, update, validate)";
+
+  // The same one-line messages as the command line; InputError is a ValueError (bad input),
+  // NumericalError a RuntimeError (a fit or integration that failed).
+  static py::exception<mbid::InputError> input_error(m, "InputError", PyExc_ValueError);
+  static py::exception<mbid::NumericalError> numerical_error(m, "NumericalError",
+                                                             PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const mbid::InputError& e) {
+      input_error(e.what());
+    } catch (const mbid::NumericalError& e) {
+      numerical_error(e.what());
+    }
+  });
+
+  py::class_<mbid::Scenario>(m, "Scenario", "A scenario file, read strictly.")
+      .def_readonly("name", &mbid::Scenario::name)
+      .def_readonly("path", &mbid::Scenario::path)
+      .def_readonly("yaml", &mbid::Scenario::yaml_text)
+      .def("__repr__", [](const mbid::Scenario& s) { return "<mbid.Scenario '" + s.name + "'>"; });
+
+  py::class_<mbid::Measurement>(m, "Record",
+                                "A uniformly sampled record: .time (s) and .channels (SI units) "
+                                "as numpy arrays.")
+      .def_property_readonly("time",
+                             [](const mbid::Measurement& r) { return ToArray(r.CalcTime()); })
+      .def_property_readonly("channels", &Channels)
+      .def_property_readonly("units", &Units)
+      .def_readonly("sample_interval_s", &mbid::Measurement::sample_interval_s)
+      .def_readonly("start_time_s", &mbid::Measurement::start_time_s)
+      .def_property_readonly("samples", &mbid::Measurement::samples)
+      .def("__repr__", [](const mbid::Measurement& r) {
+        return "<mbid.Record " + std::to_string(r.samples()) + " samples x " +
+               std::to_string(r.channel_count()) + " channels>";
+      });
+
+  py::class_<mbid::identification::IdentifiedMode>(m, "Mode")
+      .def_readonly("frequency_hz", &mbid::identification::IdentifiedMode::frequency_hz)
+      .def_readonly("decay_rate_per_s", &mbid::identification::IdentifiedMode::decay_rate_per_s)
+      .def_readonly("damping_ratio", &mbid::identification::IdentifiedMode::damping_ratio)
+      .def_readonly("undamped_frequency_hz",
+                    &mbid::identification::IdentifiedMode::undamped_frequency_hz)
+      .def_readonly("std_frequency_hz", &mbid::identification::IdentifiedMode::std_frequency_hz)
+      .def_readonly("std_decay_rate_per_s",
+                    &mbid::identification::IdentifiedMode::std_decay_rate_per_s)
+      .def_readonly("significant", &mbid::identification::IdentifiedMode::significant)
+      .def_property_readonly(
+          "amplitude",
+          [](const mbid::identification::IdentifiedMode& mode) { return ToArray(mode.amplitude); })
+      .def_property_readonly(
+          "phase_rad",
+          [](const mbid::identification::IdentifiedMode& mode) { return ToArray(mode.phase_rad); })
+      .def("__repr__", [](const mbid::identification::IdentifiedMode& mode) {
+        return "<mbid.Mode " + std::to_string(mode.frequency_hz) + " Hz, damping ratio " +
+               std::to_string(mode.damping_ratio) + ">";
+      });
+
+  py::class_<mbid::ModalResult>(m, "ModalResult")
+      .def_readonly("modes", &mbid::ModalResult::modes)
+      .def_readonly("reliable", &mbid::ModalResult::reliable)
+      .def_readonly("reasons", &mbid::ModalResult::reasons)
+      .def_readonly("warnings", &mbid::ModalResult::warnings)
+      .def_readonly("method", &mbid::ModalResult::method)
+      .def_readonly("channels", &mbid::ModalResult::channels)
+      .def_readonly("release_time_s", &mbid::ModalResult::release_time_s)
+      .def_readonly("model_order", &mbid::ModalResult::model_order)
+      .def_property_readonly("correlation",
+                             [](const mbid::ModalResult& r) { return ToArray(r.correlation); });
+
+  py::class_<mbid::ParameterValue>(m, "Parameter")
+      .def_readonly("value", &mbid::ParameterValue::value)
+      .def_readonly("std", &mbid::ParameterValue::std)
+      .def_readonly("relative_std", &mbid::ParameterValue::relative_std)
+      .def_readonly("interval_lower", &mbid::ParameterValue::interval_lower)
+      .def_readonly("interval_upper", &mbid::ParameterValue::interval_upper)
+      .def_readonly("determined", &mbid::ParameterValue::determined)
+      .def_readonly("why_undetermined", &mbid::ParameterValue::why_undetermined)
+      .def_readonly("units", &mbid::ParameterValue::units)
+      .def_readonly("test", &mbid::ParameterValue::test)
+      .def("__repr__", [](const mbid::ParameterValue& p) {
+        return "<mbid.Parameter " + std::to_string(p.value) + " +- " + std::to_string(p.std) + " " +
+               p.units + ">";
+      });
+
+  py::class_<mbid::UpdateResult>(m, "UpdateResult")
+      .def_readonly("parameters", &mbid::UpdateResult::parameters)
+      .def_readonly("converged", &mbid::UpdateResult::converged)
+      .def_readonly("credible", &mbid::UpdateResult::credible)
+      .def_readonly("credibility", &mbid::UpdateResult::credibility)
+      .def_readonly("non_unique", &mbid::UpdateResult::non_unique)
+      .def_readonly("undetermined", &mbid::UpdateResult::undetermined)
+      .def_readonly("start", &mbid::UpdateResult::start)
+      .def_readonly("chi_square_per_dof", &mbid::UpdateResult::chi_square_per_dof);
+
+  py::class_<mbid::ValidationResult>(m, "ValidationResult")
+      .def_property_readonly(
+          "verdict", [](const mbid::ValidationResult& r) { return mbid::ToString(r.verdict); })
+      .def_readonly("reasons", &mbid::ValidationResult::reasons)
+      .def_readonly("min_correlation", &mbid::ValidationResult::min_correlation)
+      .def_readonly("correlation", &mbid::ValidationResult::correlation)
+      .def_readonly("identified", &mbid::ValidationResult::identified)
+      .def_readonly("updated", &mbid::ValidationResult::updated);
+
+  m.def("load_scenario", &mbid::LoadScenario, py::arg("path"), "Reads a scenario file.");
+  m.def("load_scenario_text", &mbid::LoadScenarioFromText, py::arg("yaml"),
+        py::arg("source") = "scenario", "A scenario from YAML text.");
+  m.def(
+      "default_scenario_path",
+      [](const std::string& hint) { return mbid::DefaultScenarioPath(hint); },
+      py::arg("data_dir_hint") = "", "The built-in reference scenario's file.");
+  m.def("simulate", &mbid::Simulate, py::arg("scenario"), py::call_guard<py::gil_scoped_release>(),
+        "Simulates the scenario's test: a Record.");
+  m.def(
+      "read_record", [](const std::string& path) { return mbid::ReadRecord(path); },
+      py::arg("path"), "Reads a record file (CSV, HDF5, MAT, UFF58, LVM), SI units.");
+  m.def(
+      "identify", [](const mbid::Measurement& r) { return mbid::Identify(r); }, py::arg("record"),
+      py::call_guard<py::gil_scoped_release>(), "Identifies the modes of a free-decay record.");
+  m.def(
+      "identify_arrays",
+      [](py::array_t<double, py::array::c_style | py::array::forcecast> time,
+         const std::map<std::string,
+                        py::array_t<double, py::array::c_style | py::array::forcecast>>& channels,
+         const std::map<std::string, std::string>& units) {
+        const mbid::Measurement record = MakeRecord(time, channels, units);
+        py::gil_scoped_release release;
+        return mbid::Identify(record);
+      },
+      py::arg("time"), py::arg("channels"), py::arg("units") = std::map<std::string, std::string>{},
+      "Identifies the modes of a free decay given as arrays: time (s, uniform) and {name: "
+      "values}.");
+  m.def("update", &mbid::Update, py::arg("scenario"), py::arg("records"),
+        py::call_guard<py::gil_scoped_release>(),
+        "Tunes the scenario's model to the records: .parameters['c_alpha'].value, .std.");
+  m.def(
+      "run",
+      [](const mbid::Scenario& scenario, const std::string& output_folder, bool overwrite,
+         bool quiet) {
+        mbid::ValidationOptions options;
+        options.output_folder = output_folder;
+        options.overwrite = overwrite;
+        options.quiet = quiet;
+        return mbid::RunValidationCycle(scenario, options);
+      },
+      py::arg("scenario"), py::arg("output_folder") = "", py::arg("overwrite") = false,
+      py::arg("quiet") = true, py::call_guard<py::gil_scoped_release>(),
+      "The validation cycle in memory: .verdict is 'passed', 'failed' or 'inconclusive'.");
+}

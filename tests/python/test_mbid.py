@@ -1,0 +1,137 @@
+"""The Python module against independent truth: closed-form signals, unit conversion, the C++
+command line's own numbers, and errors with the command line's messages.
+
+Run by ctest with PYTHONPATH=<build>/python; argv[1:]: the mbid binary and the source tree."""
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+import mbid
+
+MBID_BINARY = os.environ["MBID_BINARY"]
+SOURCE_DIR = os.environ["MBID_SOURCE_DIR"]
+REFERENCE = os.path.join(SOURCE_DIR, "scenarios", "reference-crane.yaml")
+
+
+class RecordTest(unittest.TestCase):
+    def test_simulate_gives_numpy_time_and_channels(self):
+        scenario = mbid.load_scenario(REFERENCE)
+        record = mbid.simulate(scenario)
+        self.assertIsInstance(record.time, np.ndarray)
+        self.assertEqual(record.time.shape, (record.samples,))
+        # Uniform sampling: t_j = t_0 + j tau (tau from the scenario's sensors, 0.01 s).
+        np.testing.assert_allclose(np.diff(record.time), record.sample_interval_s, rtol=1e-12)
+        self.assertAlmostEqual(record.sample_interval_s, 0.01, places=15)
+        self.assertEqual(sorted(record.channels), ["phi", "psi"])
+        for values in record.channels.values():
+            self.assertIsInstance(values, np.ndarray)
+            self.assertEqual(values.shape, record.time.shape)
+        self.assertEqual(record.units["psi"], "rad")
+
+    def test_read_record_converts_degrees_to_radians(self):
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "logger.csv")
+            with open(path, "w") as f:
+                f.write("time [s],psi [deg]\n")
+                for j in range(50):
+                    f.write(f"{0.02 * j:.2f},{30.0 + j}\n")
+            record = mbid.read_record(path)
+        self.assertEqual(record.units["psi"], "rad")
+        # deg -> rad by udunits2: exactly pi / 180 per degree.
+        np.testing.assert_allclose(record.channels["psi"],
+                                   np.radians(30.0 + np.arange(50)), rtol=1e-12)
+        self.assertAlmostEqual(record.sample_interval_s, 0.02, places=12)
+
+
+class IdentifyTest(unittest.TestCase):
+    def test_identify_arrays_recovers_a_closed_form_decay(self):
+        # y = exp(-0.3 t) cos(2 pi 2 t) + 0.5 exp(-0.8 t) sin(2 pi 5.5 t): two modes whose
+        # frequencies and decay rates are exact; noise-free, they come back to 1e-6 relative.
+        t = np.arange(2000) * 0.005
+        y = (np.exp(-0.3 * t) * np.cos(2 * np.pi * 2.0 * t)
+             + 0.5 * np.exp(-0.8 * t) * np.sin(2 * np.pi * 5.5 * t))
+        result = mbid.identify_arrays(t, {"x": y}, {"x": "m"})
+        self.assertEqual(len(result.modes), 2)
+        self.assertAlmostEqual(result.modes[0].frequency_hz, 2.0, delta=2e-6)
+        self.assertAlmostEqual(result.modes[0].decay_rate_per_s, 0.3, delta=3e-7)
+        self.assertAlmostEqual(result.modes[1].frequency_hz, 5.5, delta=5.5e-6)
+        self.assertAlmostEqual(result.modes[1].decay_rate_per_s, 0.8, delta=8e-7)
+        # damping ratio = decay / |lambda| by definition.
+        mode = result.modes[0]
+        self.assertAlmostEqual(mode.damping_ratio,
+                               0.3 / math.hypot(0.3, 2 * math.pi * 2.0), delta=1e-7)
+
+    def test_identify_of_a_record_equals_identify_of_its_arrays(self):
+        record = mbid.simulate(mbid.load_scenario(REFERENCE))
+        a = mbid.identify(record)
+        b = mbid.identify_arrays(record.time, record.channels, record.units)
+        # Same modes; the time grid re-fitted from the array may differ in its last bits.
+        self.assertEqual(len(a.modes), len(b.modes))
+        for x, y in zip(a.modes, b.modes):
+            self.assertAlmostEqual(x.frequency_hz, y.frequency_hz, delta=1e-9 * x.frequency_hz)
+            self.assertAlmostEqual(x.decay_rate_per_s, y.decay_rate_per_s,
+                                   delta=1e-9 * x.decay_rate_per_s)
+
+
+class UpdateAndRunTest(unittest.TestCase):
+    def test_update_equals_the_command_line(self):
+        # The module and `mbid update` run the same code on the same record: same bits.
+        scenario = mbid.load_scenario(REFERENCE)
+        with tempfile.TemporaryDirectory() as folder:
+            h5 = os.path.join(folder, "test.h5")
+            subprocess.run([MBID_BINARY, "simulate", REFERENCE, "-o", h5, "--quiet"], check=True)
+            record = mbid.read_record(h5)
+            out = os.path.join(folder, "update.json")
+            subprocess.run([MBID_BINARY, "update", REFERENCE, h5, "--json", out, "--quiet"],
+                           check=True, stdout=subprocess.DEVNULL)
+            with open(out) as f:
+                cli = json.load(f)
+        tuned = mbid.update(scenario, [record])
+        self.assertTrue(tuned.converged)
+        for name, entry in cli["parameters"].items():
+            self.assertIn(name, tuned.parameters)
+            self.assertEqual(tuned.parameters[name].value, entry["value"], name)
+            self.assertEqual(tuned.parameters[name].std, entry["std"], name)
+        self.assertGreater(tuned.parameters["c_alpha"].std, 0.0)
+
+    def test_run_gives_the_verdict_as_text(self):
+        result = mbid.run(mbid.load_scenario(REFERENCE))
+        # The reference crane's own simulated test validates (docs/validation.md).
+        self.assertEqual(result.verdict, "passed")
+        self.assertEqual(result.reasons, [])
+        self.assertGreaterEqual(min(result.correlation.values()), result.min_correlation)
+
+
+class ErrorTest(unittest.TestCase):
+    def test_a_missing_scenario_is_an_input_error_with_the_commands_message(self):
+        with self.assertRaises(mbid.InputError) as raised:
+            mbid.load_scenario("no-such-scenario.yaml")
+        message = str(raised.exception)
+        self.assertTrue(message.startswith("no-such-scenario.yaml:"), message)
+        self.assertEqual(message.count("\n"), 0)
+        self.assertIsInstance(raised.exception, ValueError)
+        cli = subprocess.run([MBID_BINARY, "run", "no-such-scenario.yaml"],
+                             capture_output=True, text=True)
+        self.assertEqual(cli.returncode, 2)
+        self.assertIn(message, cli.stderr)
+
+    def test_non_uniform_time_names_the_sample(self):
+        t = np.array([0.0, 0.1, 0.2, 0.35, 0.4])
+        with self.assertRaises(mbid.InputError) as raised:
+            mbid.identify_arrays(t, {"x": np.ones(5)})
+        self.assertIn("time[", str(raised.exception))
+
+    def test_a_channel_of_the_wrong_length_is_refused(self):
+        with self.assertRaises(mbid.InputError) as raised:
+            mbid.identify_arrays(np.arange(10) * 0.1, {"x": np.ones(9)})
+        self.assertIn("channels/x", str(raised.exception))
+
+
+if __name__ == "__main__":
+    unittest.main()
