@@ -1,0 +1,101 @@
+// <mbid/mbid.h> as a library user calls it: closed-form records, the verdict, errors, and the
+// folder rules of `mbid run -o` when the cycle is asked to write its results.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "mbid/mbid.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kReference = std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
+
+// y = exp(-0.3 t) cos(2 pi 2 t) + 0.5 exp(-0.8 t) sin(2 pi 5.5 t), 2000 samples at 5 ms.
+mbid::Measurement TwoModes() {
+  mbid::Measurement m;
+  m.channels = {"x"};
+  m.units = {"m"};
+  m.sample_interval_s = 0.005;
+  m.values.resize(2000, 1);
+  for (int j = 0; j < 2000; ++j) {
+    const double t = j * m.sample_interval_s;
+    m.values(j, 0) = std::exp(-0.3 * t) * std::cos(2 * M_PI * 2.0 * t) +
+                     0.5 * std::exp(-0.8 * t) * std::sin(2 * M_PI * 5.5 * t);
+  }
+  return m;
+}
+
+TEST(FacadeTest, IdentifyRecoversClosedFormModes) {
+  const mbid::ModalResult result = mbid::Identify(TwoModes());
+  ASSERT_EQ(result.modes.size(), 2u);
+  // Noise-free: the poles come back to 1e-6 relative.
+  EXPECT_NEAR(result.modes[0].frequency_hz, 2.0, 2e-6);
+  EXPECT_NEAR(result.modes[0].decay_rate_per_s, 0.3, 3e-7);
+  EXPECT_NEAR(result.modes[1].frequency_hz, 5.5, 5.5e-6);
+  EXPECT_NEAR(result.modes[1].decay_rate_per_s, 0.8, 8e-7);
+  // damping ratio = decay / |lambda| by definition.
+  EXPECT_NEAR(result.modes[0].damping_ratio, 0.3 / std::hypot(0.3, 2 * M_PI * 2.0), 1e-7);
+}
+
+TEST(FacadeTest, VerdictsReadAsTheContractWritesThem) {
+  EXPECT_EQ(mbid::ToString(mbid::Verdict::kPassed), "passed");
+  EXPECT_EQ(mbid::ToString(mbid::Verdict::kFailed), "failed");
+  EXPECT_EQ(mbid::ToString(mbid::Verdict::kInconclusive), "inconclusive");
+}
+
+TEST(FacadeTest, BadInputIsAnInputErrorWithOneLine) {
+  try {
+    mbid::LoadScenario("no-such-scenario.yaml");
+    FAIL() << "no error";
+  } catch (const mbid::InputError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(message.rfind("no-such-scenario.yaml:", 0), 0u) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos);
+  }
+  const mbid::Scenario scenario = mbid::LoadScenario(kReference);
+  EXPECT_THROW(mbid::Update(scenario, {}), mbid::InputError);
+  mbid::Measurement bad = TwoModes();
+  bad.values(10, 0) = std::nan("");
+  EXPECT_THROW(mbid::Identify(bad), mbid::InputError);
+}
+
+TEST(FacadeTest, TheCycleInMemoryPassesTheReferenceAndWritesNothing) {
+  const fs::path cwd = fs::temp_directory_path() / "mbid_facade_cycle";
+  fs::remove_all(cwd);
+  fs::create_directories(cwd);
+  const fs::path before = fs::current_path();
+  fs::current_path(cwd);
+  const mbid::ValidationResult result = mbid::RunValidationCycle(mbid::LoadScenario(kReference));
+  fs::current_path(before);
+  // The reference crane's own simulated test validates (docs/validation.md).
+  EXPECT_EQ(result.verdict, mbid::Verdict::kPassed);
+  EXPECT_TRUE(result.reasons.empty());
+  ASSERT_EQ(result.correlation.size(), 2u);  // psi and phi
+  for (const auto& [channel, k] : result.correlation) EXPECT_GE(k, result.min_correlation);
+  EXPECT_EQ(result.updated.parameters.count("c_alpha"), 1u);
+  EXPECT_GT(result.updated.parameters.at("c_alpha").std, 0.0);
+  EXPECT_TRUE(fs::is_empty(cwd));  // no results/ folder, no figures
+  fs::remove_all(cwd);
+}
+
+TEST(FacadeTest, AFolderOfTheUsersIsNeverReplaced) {
+  const fs::path dir = fs::temp_directory_path() / "mbid_facade_folder";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "thesis.tex") << "years of work";
+  mbid::ValidationOptions options;
+  options.output_folder = dir.string();
+  options.overwrite = true;
+  EXPECT_THROW(mbid::RunValidationCycle(mbid::LoadScenario(kReference), options), mbid::InputError);
+  std::ifstream in(dir / "thesis.tex");
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "years of work");
+  fs::remove_all(dir);
+}
+
+}  // namespace
