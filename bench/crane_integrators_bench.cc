@@ -34,8 +34,7 @@ const mbid::model::MultibodyModel& Crane() {
 }
 
 Excitation LoadDrop() {
-  Excitation drop;
-  drop.type = Excitation::Type::kLoadDrop;
+  mbid::simulation::LoadDrop drop;
   drop.payload_mass_kg = 650.0;
   return drop;
 }

@@ -1,58 +1,61 @@
 #include "mbid/simulation/excitation.h"
 
-#include <cmath>
+#include "mbid/common/yaml_reader.h"
 
 namespace mbid::simulation {
+namespace {
+
+template <typename T>
+Excitation ReadAs(const YamlReader& node, const model::MechanicalModel& model) {
+  return T::Read(node, model);
+}
+
+// The registry follows the variant, so that listing a type there is its one registration line.
+template <typename... Types>
+std::vector<ExcitationReader> MakeReaders(const std::variant<Types...>* /*list*/) {
+  return {ExcitationReader{Types::kTypeName, &ReadAs<Types>}...};
+}
+
+}  // namespace
 
 std::string Excitation::type_name() const {
-  switch (type) {
-    case Type::kLoadDrop:
-      return "load_drop";
-    case Type::kInitialDeflection:
-      return "initial_deflection";
-    case Type::kImpulse:
-      return "impulse";
-    case Type::kBurst:
-      return "burst";
-  }
-  return "unknown";
+  return std::visit([](const auto& e) -> std::string { return e.kTypeName; }, value);
 }
 
 double Excitation::CalcForcingEndTime() const {
-  switch (type) {
-    case Type::kImpulse:
-      return duration_s;
-    case Type::kBurst:
-      return cycles / frequency_hz;
-    default:
-      return 0.0;
-  }
+  return std::visit([](const auto& e) { return e.CalcForcingEndTime(); }, value);
 }
 
 double Excitation::CalcForcingFactor(double t) const {
   const double end = CalcForcingEndTime();
   if (t < 0 || t >= end) return 0.0;
-  if (type == Type::kImpulse) {
-    return pulse_shape == PulseShape::kRectangular ? 1.0 : std::sin(M_PI * t / duration_s);
-  }
-  return std::sin(2 * M_PI * frequency_hz * t);  // burst
+  return std::visit([t](const auto& e) { return e.CalcForcingFactor(t); }, value);
+}
+
+const ForceTarget* Excitation::force_target() const {
+  return std::visit([](const auto& e) { return e.force_target(); }, value);
+}
+
+bool Excitation::start_depends_on_model() const {
+  return std::visit([](const auto& e) { return e.kStartDependsOnModel; }, value);
 }
 
 Eigen::VectorXd CalcInitialCoordinates(const model::MechanicalModel& model,
                                        const Excitation& excitation) {
-  const int n = model.coordinate_count();
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
-  if (excitation.type == Excitation::Type::kLoadDrop) {
-    // At rest only the payload's weight matters; after release the machine is unloaded.
-    return model.SolveStaticEquilibrium(model.CalcPayloadLoads(excitation.payload_mass_kg));
-  }
-  if (excitation.type == Excitation::Type::kInitialDeflection) {
-    for (int i = 0; i < n; ++i) {
-      const auto found = excitation.deflection_rad.find(model.coordinate_names()[i]);
-      if (found != excitation.deflection_rad.end()) q[i] = found->second;
-    }
-  }
-  return q;
+  return std::visit([&model](const auto& e) { return e.CalcInitialCoordinates(model); },
+                    excitation.value);
+}
+
+const std::vector<ExcitationReader>& ExcitationReaders() {
+  static const std::vector<ExcitationReader> readers =
+      MakeReaders(static_cast<const ExcitationVariant*>(nullptr));
+  return readers;
+}
+
+std::vector<std::string> ExcitationTypeNames() {
+  std::vector<std::string> names;
+  for (const ExcitationReader& reader : ExcitationReaders()) names.push_back(reader.type_name);
+  return names;
 }
 
 }  // namespace mbid::simulation

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "mbid/common/error.h"
 
@@ -11,27 +12,6 @@ namespace {
 
 bool Contains(const std::vector<std::string>& names, const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
-}
-
-// The target of an impulse or burst: `point` + `force_N` or `coordinate` + `torque_Nm`.
-void ReadForceTarget(const YamlReader& node, const model::MechanicalModel& model,
-                     Excitation& excitation) {
-  const bool has_point = node.Has("point") || node.Has("force_N");
-  const bool has_torque = node.Has("coordinate") || node.Has("torque_Nm");
-  if (has_point == has_torque) {
-    node.Fail("needs exactly one target",
-              "either point + force_N (a force in N, ground frame) or coordinate + torque_Nm");
-  }
-  if (has_point) {
-    excitation.point = node.Choice("point", model.load_points(), model.load_points().front());
-    const std::array<double, 3> f = node.Vector3("force_N");
-    excitation.force_N = Eigen::Vector3d(f[0], f[1], f[2]);
-    if (excitation.force_N.isZero(0.0)) node.FailAt("force_N", "zero force", "a non-zero force");
-  } else {
-    excitation.coordinate = node.Choice("coordinate", model.coordinate_names(), "");
-    excitation.torque_Nm = node.Double("torque_Nm");
-    if (excitation.torque_Nm == 0) node.FailAt("torque_Nm", "zero torque", "a non-zero torque");
-  }
 }
 
 }  // namespace
@@ -122,55 +102,11 @@ std::map<std::string, double> ReadPerUnitChannelValues(const YamlReader& node,
 }
 
 Excitation ReadExcitation(const YamlReader& node, const model::MechanicalModel& model) {
-  Excitation excitation;
-  const std::string type =
-      node.Choice("type", {"load_drop", "initial_deflection", "impulse", "burst"}, "");
-  if (type == "load_drop") {
-    node.ExpectMap({"type", "payload_mass_kg"});
-    excitation.type = Excitation::Type::kLoadDrop;
-    excitation.payload_mass_kg = node.PositiveDouble("payload_mass_kg");
-  } else if (type == "initial_deflection") {
-    node.ExpectMap({"type", "deflection_rad", "deflection_m"});
-    excitation.type = Excitation::Type::kInitialDeflection;
-    // Angles of rotational coordinates under deflection_rad, slides of prismatic ones under
-    // deflection_m; both are kept in SI in one map.
-    const std::vector<std::string> units = model.coordinate_units();
-    for (const auto& [key, unit] : {std::pair<const char*, const char*>{"deflection_rad", "rad"},
-                                    std::pair<const char*, const char*>{"deflection_m", "m"}}) {
-      if (!node.Has(key)) continue;
-      std::vector<std::string> coordinates;
-      for (size_t i = 0; i < units.size(); ++i) {
-        if (units[i] == unit) coordinates.push_back(model.coordinate_names()[i]);
-      }
-      const YamlReader deflection = node.Child(key);
-      deflection.ExpectMap(coordinates);
-      for (const std::string& coordinate : deflection.Keys()) {
-        excitation.deflection_rad[coordinate] = deflection.Double(coordinate);
-      }
-    }
-    if (excitation.deflection_rad.empty()) {
-      node.FailAt("deflection_rad", "no coordinate given",
-                  "at least one coordinate's deflection (deflection_rad or deflection_m)");
-    }
-  } else if (type == "impulse") {
-    node.ExpectMap({"type", "point", "force_N", "coordinate", "torque_Nm", "duration_s", "shape"});
-    excitation.type = Excitation::Type::kImpulse;
-    ReadForceTarget(node, model, excitation);
-    excitation.duration_s = node.PositiveDouble("duration_s");
-    excitation.pulse_shape =
-        node.Choice("shape", {"half_sine", "rectangular"}, "half_sine") == "rectangular"
-            ? Excitation::PulseShape::kRectangular
-            : Excitation::PulseShape::kHalfSine;
-  } else {
-    node.ExpectMap(
-        {"type", "point", "force_N", "coordinate", "torque_Nm", "frequency_hz", "cycles"});
-    excitation.type = Excitation::Type::kBurst;
-    ReadForceTarget(node, model, excitation);
-    excitation.frequency_hz = node.PositiveDouble("frequency_hz");
-    excitation.cycles = node.Int("cycles");
-    if (excitation.cycles < 1) node.FailAt("cycles", "fewer than one cycle", "an integer >= 1");
+  const std::string type = node.Choice("type", ExcitationTypeNames(), "");
+  for (const ExcitationReader& reader : ExcitationReaders()) {
+    if (type == reader.type_name) return reader.read(node, model);
   }
-  return excitation;
+  throw std::logic_error("ReadExcitation: no reader for '" + type + "'");
 }
 
 IntegratorOptions ReadIntegratorOptions(const YamlReader& node, IntegratorOptions o) {

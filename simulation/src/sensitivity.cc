@@ -32,7 +32,7 @@ Eigen::MatrixXd CalcInitialStateSensitivity(const model::MechanicalModel& model,
                                             const std::vector<std::string>& names) {
   const int n = model.coordinate_count();
   Eigen::MatrixXd dq0(n, static_cast<Eigen::Index>(names.size()));
-  if (excitation.type != Excitation::Type::kLoadDrop) {
+  if (!excitation.start_depends_on_model()) {
     // The other tests start from given coordinates that no model parameter moves.
     dq0.setZero();
     return dq0;

@@ -57,23 +57,25 @@ std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
 std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalModel& model,
                                                         const Excitation& excitation) {
   if (!(excitation.CalcForcingEndTime() > 0)) return nullptr;
+  const ForceTarget* target = excitation.force_target();
+  if (target == nullptr) return nullptr;
   std::unique_ptr<model::MechanicalModel> forced = model.Clone();
   const int n = model.coordinate_count();
   int torque_index = -1;
   for (int i = 0; i < n; ++i) {
-    if (model.coordinate_names()[i] == excitation.coordinate) torque_index = i;
+    if (model.coordinate_names()[i] == target->coordinate) torque_index = i;
   }
-  forced->SetExternalLoad([excitation, n, torque_index](double t,
-                                                        std::vector<model::PointLoad>& loads,
-                                                        Eigen::VectorXd& generalized_forces) {
-    const double factor = excitation.CalcForcingFactor(t);
-    if (factor == 0.0) return;
-    if (!excitation.point.empty()) loads.push_back({excitation.point, factor * excitation.force_N});
-    if (torque_index >= 0) {
-      generalized_forces = Eigen::VectorXd::Zero(n);
-      generalized_forces[torque_index] = factor * excitation.torque_Nm;
-    }
-  });
+  forced->SetExternalLoad(
+      [excitation, on = *target, n, torque_index](double t, std::vector<model::PointLoad>& loads,
+                                                  Eigen::VectorXd& generalized_forces) {
+        const double factor = excitation.CalcForcingFactor(t);
+        if (factor == 0.0) return;
+        if (!on.point.empty()) loads.push_back({on.point, factor * on.force_N});
+        if (torque_index >= 0) {
+          generalized_forces = Eigen::VectorXd::Zero(n);
+          generalized_forces[torque_index] = factor * on.torque_Nm;
+        }
+      });
   return forced;
 }
 

@@ -31,8 +31,10 @@ void ExpectIdentifiedModesMatchExact(const Case& test_case, double noise_std_rad
       YamlReader::FromFile(std::string(MBID_SOURCE_DIR) + "/scenarios/" + test_case.scenario);
   const auto model = model::MakeModel(root.Child("model"));
   simulation::Excitation excitation = simulation::ReadExcitation(root.Child("excitation"), *model);
-  excitation.payload_mass_kg *= kScale;
-  for (auto& [coordinate, angle] : excitation.deflection_rad) angle *= kScale;
+  if (auto* drop = excitation.get_if<simulation::LoadDrop>()) drop->payload_mass_kg *= kScale;
+  if (auto* deflection = excitation.get_if<simulation::InitialDeflection>()) {
+    for (auto& [coordinate, angle] : deflection->deflection_rad) angle *= kScale;
+  }
   simulation::SimulationOptions options =
       simulation::ReadSimulationOptions(root.Child("simulation"));
   options.integrator.relative_tolerance = 1e-10;  // integration error far below the noise

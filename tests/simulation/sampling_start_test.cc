@@ -49,11 +49,10 @@ SensorOptions Sensors(double rate_hz, double start_s = 0.0) {
 
 // A lateral burst at the boom tip for 2 s (3 cycles at 1.5 Hz): the forced stretch stops at
 // every sample, so a whole-sample start must still visit the skipped ones.
-Excitation Burst() {
-  Excitation burst;
-  burst.type = Excitation::Type::kBurst;
-  burst.point = "boom_tip";
-  burst.force_N = Eigen::Vector3d(0, 2000, 0);
+Excitation BoomTipBurst() {
+  Burst burst;
+  burst.target.point = "boom_tip";
+  burst.target.force_N = Eigen::Vector3d(0, 2000, 0);
   burst.frequency_hz = 1.5;
   burst.cycles = 3;
   return burst;
@@ -67,8 +66,9 @@ TEST(SamplingStartTest, WholeSampleStartKeepsTheBitsOfTheRecordFromThatSample) {
   Crane crane = LoadCrane();
   crane.simulation.duration_s = 3.0;
   const double tau = 1.0 / 50;
-  for (const auto& [excitation, k] :
-       {std::pair<Excitation, int>{crane.excitation, 7}, {Burst(), 60}, {Burst(), 120}}) {
+  for (const auto& [excitation, k] : {std::pair<Excitation, int>{crane.excitation, 7},
+                                      {BoomTipBurst(), 60},
+                                      {BoomTipBurst(), 120}}) {
     const SimulationResult from_zero =
         Simulate(*crane.model, excitation, crane.simulation, Sensors(50.0));
     for (const double start : {k * tau, k * tau * (1 + 1e-9)}) {

@@ -32,8 +32,7 @@ SensorOptions NoiselessSensors(double rate_hz, std::vector<std::string> channels
 }
 
 Excitation Deflection(double alpha, double gamma, double eta, double theta) {
-  Excitation excitation;
-  excitation.type = Excitation::Type::kInitialDeflection;
+  InitialDeflection excitation;
   excitation.deflection_rad = {{"alpha", alpha}, {"gamma", gamma}, {"eta", eta}, {"theta", theta}};
   return excitation;
 }
@@ -98,9 +97,9 @@ TEST(SimulateTest, SmallLoadDropFollowsLinearModel) {
   // A 10 kg drop deflects ~1e-4 rad: the nonlinear terms are O(q) ~ 1e-4 of the response, so the
   // nonlinear and linear responses agree to 1e-3 of the amplitude (the bound).
   const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
-  Excitation drop;
-  drop.type = Excitation::Type::kLoadDrop;
-  drop.payload_mass_kg = 10.0;
+  LoadDrop load_drop;
+  load_drop.payload_mass_kg = 10.0;
+  const Excitation drop = load_drop;
   SimulationOptions options;
   options.duration_s = 5.0;
   options.integrator.relative_tolerance = 1e-10;
@@ -186,14 +185,14 @@ TEST(SimulateTest, ImpulseDeliversItsMomentum) {
   model::TruckCraneParameters parameters = ReferenceParameters();
   for (auto& joint : parameters.joints) joint.damping_Nms_per_rad = 0.0;
   model::MultibodyModel crane = model::MakeTruckCrane(parameters);
-  Excitation impulse;
-  impulse.type = Excitation::Type::kImpulse;
-  impulse.coordinate = "gamma";
-  impulse.torque_Nm = 1e5;
+  Impulse impulse;
+  impulse.target.coordinate = "gamma";
+  impulse.target.torque_Nm = 1e5;
   impulse.duration_s = 0.001;
+  const Excitation excitation = impulse;
   crane.SetExternalLoad([&](double t, std::vector<model::PointLoad>&, Eigen::VectorXd& tau) {
     tau = Eigen::VectorXd::Zero(4);
-    tau[1] = impulse.torque_Nm * impulse.CalcForcingFactor(t);
+    tau[1] = impulse.target.torque_Nm * excitation.CalcForcingFactor(t);
   });
   IntegratorOptions options;
   options.relative_tolerance = 1e-10;
@@ -204,7 +203,7 @@ TEST(SimulateTest, ImpulseDeliversItsMomentum) {
   Eigen::VectorXd u(4);
   for (int i = 0; i < 4; ++i) u[i] = end.getU()[i];
   const Eigen::VectorXd momentum = crane.Linearize().M * u;
-  const double J = impulse.torque_Nm * 2 * impulse.duration_s / M_PI;
+  const double J = impulse.target.torque_Nm * 2 * impulse.duration_s / M_PI;
   EXPECT_NEAR(momentum[1], J, 0.002 * J);
   EXPECT_LT(std::abs(momentum[3]), 0.002 * J);  // no direct push on theta
 }
@@ -213,10 +212,9 @@ TEST(SimulateTest, BurstAndImpulseRunThroughSimulate) {
   const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   SimulationOptions options;
   options.duration_s = 3.0;
-  Excitation burst;
-  burst.type = Excitation::Type::kBurst;
-  burst.point = "boom_tip";
-  burst.force_N = Eigen::Vector3d(0, 2000, 0);
+  Burst burst;
+  burst.target.point = "boom_tip";
+  burst.target.force_N = Eigen::Vector3d(0, 2000, 0);
   burst.frequency_hz = 1.5;
   burst.cycles = 3;
   const SimulationResult result =
@@ -232,9 +230,9 @@ TEST(SimulateTest, TorsionalOscillatorFollowsItsClosedForm) {
   // theta = theta0 e^{-s t} (cos w t + s/w sin w t), s = d/2J, w = sqrt(c/J - s^2).
   const double J = 2.0, c = 800.0, d = 8.0, theta0 = 0.01;
   const model::MultibodyModel oscillator = model::MakeTorsionalOscillator({J, c, d});
-  Excitation excitation;
-  excitation.type = Excitation::Type::kInitialDeflection;
-  excitation.deflection_rad = {{"angle", theta0}};
+  InitialDeflection deflection;
+  deflection.deflection_rad = {{"angle", theta0}};
+  const Excitation excitation = deflection;
   SimulationOptions options;
   options.duration_s = 3.0;
   options.integrator.relative_tolerance = 1e-11;
@@ -314,8 +312,8 @@ TEST(SimulateTest, ReadsScenarioSections) {
   const YamlReader root = YamlReader::FromFile(kReference);
   const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   const Excitation excitation = ReadExcitation(root.Child("excitation"), crane);
-  EXPECT_EQ(excitation.type, Excitation::Type::kInitialDeflection);
-  EXPECT_EQ(excitation.deflection_rad.at("theta"), -0.006);
+  ASSERT_NE(excitation.get_if<InitialDeflection>(), nullptr);
+  EXPECT_EQ(excitation.get<InitialDeflection>().deflection_rad.at("theta"), -0.006);
   const SimulationOptions options = ReadSimulationOptions(root.Child("simulation"));
   EXPECT_EQ(options.duration_s, 8.0);
   EXPECT_EQ(options.integrator.relative_tolerance, 1e-8);

@@ -25,8 +25,9 @@ inline TestDesign OscillatorRelease(const std::string& name, double deflection_r
                                     double noise_rad) {
   TestDesign design;
   design.name = name;
-  design.excitation.type = simulation::Excitation::Type::kInitialDeflection;
-  design.excitation.deflection_rad["angle"] = deflection_rad;
+  simulation::InitialDeflection deflection;
+  deflection.deflection_rad["angle"] = deflection_rad;
+  design.excitation = deflection;
   design.simulation.duration_s = 2.0;
   design.simulation.integrator.method = simulation::IntegratorOptions::Method::kBdf;
   design.sensors.sample_rate_hz = 100.0;

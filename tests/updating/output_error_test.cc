@@ -237,7 +237,8 @@ TEST(OutputErrorTest, PayloadMassAsANuisanceParameter) {
   const Crane crane = LoadCrane(testing::kLoadDropScenario);
   const Measurement record = testing::SimulateExact(crane, 3.0, 50.0);
   TestRecord test{"drop", record, crane.excitation, {}};
-  test.excitation.payload_mass_kg *= 1.2;  // the start; the truth is the scenario's 650 kg
+  test.excitation.get<simulation::LoadDrop>().payload_mass_kg *=
+      1.2;  // the start; the truth is the scenario's 650 kg
   test.fit_payload_mass = true;
   UpdateOptions options = StartOff(*crane.model, 1.2, 0.8, {"c_theta", "d_theta"});
   options.integrator = crane.simulation.integrator;
@@ -247,8 +248,8 @@ TEST(OutputErrorTest, PayloadMassAsANuisanceParameter) {
   const ParameterEstimate& mass = result.Find("drop:payload_mass_kg");
   EXPECT_EQ(mass.test, "drop");
   EXPECT_EQ(mass.units, "kg");
-  EXPECT_NEAR(mass.value, crane.excitation.payload_mass_kg,
-              1e-5 * crane.excitation.payload_mass_kg);
+  const double truth = crane.excitation.get<simulation::LoadDrop>().payload_mass_kg;
+  EXPECT_NEAR(mass.value, truth, 1e-5 * truth);
   EXPECT_LT(std::abs(RelativeError(result, *crane.model, "c_theta")), 1e-5);
   EXPECT_LT(std::abs(RelativeError(result, *crane.model, "d_theta")), 1e-5);
 }

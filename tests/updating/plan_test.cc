@@ -121,14 +121,12 @@ TEST(PlanCraneTest, AfterThePapersLoadDropAnEtaDeflectionDeterminesDEta) {
     return PlanCandidate{name, nullptr, design};
   };
   simulation::Excitation heavier = drop.excitation;
-  heavier.payload_mass_kg = 1300.0;
-  simulation::Excitation eta;
-  eta.type = simulation::Excitation::Type::kInitialDeflection;
+  heavier.get<simulation::LoadDrop>().payload_mass_kg = 1300.0;
+  simulation::InitialDeflection eta;
   eta.deflection_rad["eta"] = 0.004;  // the reference scenario's eta deflection, eta alone
-  simulation::Excitation pulse;
-  pulse.type = simulation::Excitation::Type::kImpulse;
-  pulse.coordinate = "gamma";
-  pulse.torque_Nm = 2e4;  // 50 ms half sine: gamma's response ~1e-3 rad, the drop's order
+  simulation::Impulse pulse;
+  pulse.target.coordinate = "gamma";
+  pulse.target.torque_Nm = 2e4;  // 50 ms half sine: gamma's response ~1e-3 rad, the drop's order
   pulse.duration_s = 0.05;
   PlanOptions plan_options;
   plan_options.threads = 2;

@@ -155,11 +155,11 @@ TEST(SensitivityTest, ForcedTestCarriesSensitivitiesAcrossTheRestart) {
   // An impulse: Simulate restarts CVODES where the pulse ends; the sensitivities must carry
   // over. A torque pulse on theta, 0.2 s, then 1.8 s of free decay.
   Crane crane = LoadCrane(updating::testing::kReferenceScenario);
-  crane.excitation = Excitation();
-  crane.excitation.type = Excitation::Type::kImpulse;
-  crane.excitation.coordinate = "theta";
-  crane.excitation.torque_Nm = 5e4;
-  crane.excitation.duration_s = 0.2;
+  simulation::Impulse impulse;
+  impulse.target.coordinate = "theta";
+  impulse.target.torque_Nm = 5e4;
+  impulse.duration_s = 0.2;
+  crane.excitation = impulse;
   CheckAgainstDifferences(crane, 2.0, {"c_theta", "d_theta", "c_alpha"});
 }
 
@@ -172,10 +172,10 @@ TEST(SensitivityTest, PayloadMassDirectionMatchesCentralDifferences) {
   options.integrator.interpolate_outputs = true;
   SensorOptions sensors;
   sensors.sample_rate_hz = 50.0;
-  const double mass = crane.excitation.payload_mass_kg;
+  const double mass = crane.excitation.get<simulation::LoadDrop>().payload_mass_kg;
   auto initial_q = [&](double m) {
     Excitation changed = crane.excitation;
-    changed.payload_mass_kg = m;
+    changed.get<simulation::LoadDrop>().payload_mass_kg = m;
     return CalcInitialCoordinates(*crane.model, changed);
   };
   InitialStateDirection direction;
@@ -187,7 +187,7 @@ TEST(SensitivityTest, PayloadMassDirectionMatchesCentralDifferences) {
   const SimulationOptions tight = Tight(options);
   auto simulate_at = [&](double m) {
     Excitation changed = crane.excitation;
-    changed.payload_mass_kg = m;
+    changed.get<simulation::LoadDrop>().payload_mass_kg = m;
     return Simulate(*crane.model, changed, tight, sensors).exact;
   };
   const Eigen::MatrixXd expected = ReferenceSensitivity(simulate_at, mass);

@@ -179,10 +179,11 @@ class TestEvaluator {
           model.SetParameter(unknown.name, value);
           break;
         case Unknown::Kind::kPayloadMass:
-          excitation.payload_mass_kg = value;
+          excitation.get<simulation::LoadDrop>().payload_mass_kg = value;
           break;
         case Unknown::Kind::kDeflection:
-          excitation.deflection_rad[unknown.coordinate] = value;
+          excitation.get<simulation::InitialDeflection>().deflection_rad[unknown.coordinate] =
+              value;
           break;
       }
     }
@@ -353,9 +354,10 @@ class TestEvaluator {
     } else {
       const double h = 1e-4 * value;
       Excitation changed = excitation;
-      changed.payload_mass_kg = value + h;
+      double& mass = changed.get<simulation::LoadDrop>().payload_mass_kg;
+      mass = value + h;
       const Eigen::VectorXd plus = simulation::CalcInitialCoordinates(model, changed);
-      changed.payload_mass_kg = value - h;
+      mass = value - h;
       const Eigen::VectorXd minus = simulation::CalcInitialCoordinates(model, changed);
       direction.dq0_dp = (plus - minus) / (2 * h);
       direction.scale = value;
@@ -470,7 +472,8 @@ std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,
   for (size_t t = 0; t < tests.size(); ++t) {
     const TestRecord& test = tests[t];
     if (test.fit_payload_mass) {
-      if (test.excitation.type != Excitation::Type::kLoadDrop) {
+      const auto* drop = test.excitation.get_if<simulation::LoadDrop>();
+      if (drop == nullptr) {
         throw InputError(test.name, "fit_payload_mass", "the test is not a load drop",
                          "payload mass as a nuisance parameter of load-drop tests only");
       }
@@ -479,19 +482,20 @@ std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,
       unknown.name = test.name + ":payload_mass_kg";
       unknown.units = "kg";
       unknown.test = static_cast<int>(t);
-      unknown.initial = test.excitation.payload_mass_kg;
+      unknown.initial = drop->payload_mass_kg;
       unknown.lower = unknown.initial / 100;
       unknown.upper = unknown.initial * 100;
       unknowns.push_back(unknown);
     }
     if (test.fit_initial_deflection) {
-      if (test.excitation.type != Excitation::Type::kInitialDeflection) {
+      const auto* deflection = test.excitation.get_if<simulation::InitialDeflection>();
+      if (deflection == nullptr) {
         throw InputError(test.name, "fit_initial_deflection",
                          "the test is not an initial deflection",
                          "initial deflections as nuisance parameters of initial_deflection "
                          "tests only");
       }
-      for (const auto& [coordinate, value] : test.excitation.deflection_rad) {
+      for (const auto& [coordinate, value] : deflection->deflection_rad) {
         Unknown unknown;
         unknown.kind = Unknown::Kind::kDeflection;
         unknown.name = test.name + ":deflection_" + coordinate;
@@ -1047,9 +1051,10 @@ UpdateResult FitStages(const model::MechanicalModel& model, const std::vector<Te
         if (test.name != estimate.test) continue;
         const std::string prefix = test.name + ":deflection_";
         if (estimate.name == test.name + ":payload_mass_kg") {
-          test.excitation.payload_mass_kg = estimate.value;
+          test.excitation.get<simulation::LoadDrop>().payload_mass_kg = estimate.value;
         } else if (estimate.name.compare(0, prefix.size(), prefix) == 0) {
-          test.excitation.deflection_rad[estimate.name.substr(prefix.size())] = estimate.value;
+          test.excitation.get<simulation::InitialDeflection>()
+              .deflection_rad[estimate.name.substr(prefix.size())] = estimate.value;
         }
       }
     }

@@ -386,9 +386,9 @@ TestRecord MakeTestRecord(const std::string& name, const Measurement& record,
     if (found != settings.noise_std.end()) test.noise_std[channel] = found->second;
   }
   test.fit_payload_mass =
-      settings.fit_payload_mass && excitation.type == simulation::Excitation::Type::kLoadDrop;
+      settings.fit_payload_mass && excitation.get_if<simulation::LoadDrop>() != nullptr;
   test.fit_initial_deflection = settings.fit_initial_deflection &&
-                                excitation.type == simulation::Excitation::Type::kInitialDeflection;
+                                excitation.get_if<simulation::InitialDeflection>() != nullptr;
   switch (settings.fit_offsets) {
     case UpdatingSettings::Offsets::kAuto:
       // mbid's own records (simulated, or synthetic modes) have no zero error unless a sensor

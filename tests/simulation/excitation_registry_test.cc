@@ -1,0 +1,80 @@
+#include <gtest/gtest.h>
+
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "mbid/common/error.h"
+#include "mbid/common/yaml_reader.h"
+#include "mbid/model/model_factory.h"
+#include "mbid/model/truck_crane_description.h"
+#include "mbid/simulation/excitation.h"
+#include "mbid/simulation/scenario_sections.h"
+
+namespace mbid::simulation {
+namespace {
+
+const std::string kReference = std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
+
+const model::MultibodyModel& Crane() {
+  static const model::MultibodyModel crane = model::MakeTruckCrane(
+      model::ReadTruckCraneParameters(YamlReader::FromFile(kReference).Child("model")));
+  return crane;
+}
+
+Excitation Read(const std::string& yaml) {
+  const YamlReader root = YamlReader::FromString("excitation: " + yaml + "\n", "inline.yaml");
+  return ReadExcitation(root.Child("excitation"), Crane());
+}
+
+TEST(ExcitationRegistryTest, ListsTheTypesInTheVariantsOrder) {
+  // The order is the unknown-type error's: a new type joins at the end of ExcitationVariant.
+  EXPECT_EQ(ExcitationTypeNames(),
+            (std::vector<std::string>{"load_drop", "initial_deflection", "impulse", "burst"}));
+  EXPECT_EQ(ExcitationReaders().size(), std::variant_size_v<ExcitationVariant>);
+}
+
+TEST(ExcitationRegistryTest, EachReaderGivesItsOwnType) {
+  const Excitation drop = Read("{type: load_drop, payload_mass_kg: 650}");
+  ASSERT_NE(drop.get_if<LoadDrop>(), nullptr);
+  EXPECT_EQ(drop.get<LoadDrop>().payload_mass_kg, 650.0);
+  EXPECT_TRUE(drop.start_depends_on_model());
+  EXPECT_EQ(drop.force_target(), nullptr);
+
+  const Excitation deflection = Read("{type: initial_deflection, deflection_rad: {theta: 0.01}}");
+  ASSERT_NE(deflection.get_if<InitialDeflection>(), nullptr);
+  EXPECT_EQ(deflection.get<InitialDeflection>().deflection_rad.at("theta"), 0.01);
+  EXPECT_FALSE(deflection.start_depends_on_model());
+
+  const Excitation impulse = Read(
+      "{type: impulse, coordinate: gamma, torque_Nm: 1000, duration_s: 0.1, "
+      "shape: rectangular}");
+  ASSERT_NE(impulse.get_if<Impulse>(), nullptr);
+  EXPECT_EQ(impulse.get<Impulse>().pulse_shape, Impulse::PulseShape::kRectangular);
+  ASSERT_NE(impulse.force_target(), nullptr);
+  EXPECT_EQ(impulse.force_target()->coordinate, "gamma");
+  EXPECT_EQ(impulse.CalcForcingEndTime(), 0.1);
+  EXPECT_EQ(impulse.CalcForcingFactor(0.05), 1.0);
+  EXPECT_EQ(impulse.CalcForcingFactor(0.1), 0.0);  // the forcing has ended
+
+  const Excitation burst =
+      Read("{type: burst, point: boom_tip, force_N: [0, 100, 0], frequency_hz: 2, cycles: 3}");
+  ASSERT_NE(burst.get_if<Burst>(), nullptr);
+  EXPECT_EQ(burst.force_target()->point, "boom_tip");
+  EXPECT_EQ(burst.CalcForcingEndTime(), 1.5);
+}
+
+TEST(ExcitationRegistryTest, UnknownTypeListsTheRegisteredOnes) {
+  try {
+    Read("{type: initial_deflexion}");
+    FAIL() << "read an unknown type";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "inline.yaml:excitation.type: unknown choice 'initial_deflexion'; expected one of "
+              "load_drop, initial_deflection, impulse, burst; did you mean "
+              "'initial_deflection'?");
+  }
+}
+
+}  // namespace
+}  // namespace mbid::simulation
