@@ -133,7 +133,7 @@ int Main(int argc, char** argv) {
   identify->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
   identify
       ->add_option("--method", identify_method, "hankel-nls (default) or prony-svd (the paper's)")
-      ->check(CLI::IsMember({"hankel-nls", "prony-svd"}));
+      ->check(CLI::IsMember(mbid::identification::MethodNames()));
   identify->add_option("--order", identify_options.prony.order, "prony-svd: order p of eq. 3")
       ->capture_default_str();
   identify->add_option("--channels", identify_options.channels, "Channels to analyse (default all)")

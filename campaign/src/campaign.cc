@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "mbid/common/error.h"
@@ -176,8 +177,11 @@ Campaign LoadCampaign(const std::string& path) {
   campaign.text = ReadText(path, path, "", "a readable campaign file (YAML)");
   const YamlReader root = YamlReader::FromString(campaign.text, path);
   if (!root.IsMap()) root.Fail("is not a map", "a campaign: name, base, steps, sweep, ...");
-  root.ExpectMap({"name", "description", "base", "scenario", "seed", "steps", "set", "sweep",
-                  "study", "damper_sizing", "laws"});
+  std::vector<std::string> keys{"name",  "description", "base",  "scenario", "seed",
+                                "steps", "set",         "sweep", "study"};
+  const std::vector<std::string> studies = StudyNames();
+  keys.insert(keys.end(), studies.begin(), studies.end());  // each study's section
+  root.ExpectMap(keys);
   campaign.name = root.String("name");
   if (campaign.name.empty() || campaign.name.find('/') != std::string::npos) {
     root.FailAt("name", "'" + campaign.name + "'", "a non-empty name without '/'");
@@ -188,16 +192,15 @@ Campaign LoadCampaign(const std::string& path) {
   campaign.seed = static_cast<std::uint64_t>(seed);
   ReadBase(root, campaign);
 
-  const std::string study = root.Choice("study", {"none", "damper_sizing", "laws"}, "none");
-  campaign.study = study == "damper_sizing" ? CampaignStudy::kDamperSizing
-                   : study == "laws"        ? CampaignStudy::kLaws
-                                            : CampaignStudy::kNone;
-  if (root.Has("damper_sizing") && campaign.study != CampaignStudy::kDamperSizing) {
-    root.FailAt("damper_sizing", "section without study: damper_sizing",
-                "study: damper_sizing, or no damper_sizing section");
-  }
-  if (root.Has("laws") && campaign.study != CampaignStudy::kLaws) {
-    root.FailAt("laws", "section without study: laws", "study: laws, or no laws section");
+  std::vector<std::string> study_choices{"none"};
+  study_choices.insert(study_choices.end(), studies.begin(), studies.end());
+  const std::string study = root.Choice("study", study_choices, "none");
+  campaign.study = MakeStudy(study);
+  for (const std::string& name : studies) {
+    if (root.Has(name) && study != name) {
+      root.FailAt(name, "section without study: " + name,
+                  "study: " + name + ", or no " + name + " section");
+    }
   }
   ReadSteps(root, campaign);
 
@@ -208,19 +211,12 @@ Campaign LoadCampaign(const std::string& path) {
     }
   }
 
+  // A study may make the cases itself (damper sizing sweeps its dampers); else the sweep does.
+  std::optional<std::vector<std::vector<Assignment>>> study_cases;
+  if (campaign.study) study_cases = campaign.study->ReadCases(root, &campaign);
   std::vector<std::vector<Assignment>> inputs;
-  if (campaign.study == CampaignStudy::kDamperSizing) {
-    if (root.Has("sweep")) {
-      root.FailAt("sweep", "a sweep in a damper-sizing study",
-                  "no sweep: the study sweeps the dampers of damper_sizing.joints itself");
-    }
-    campaign.damper_sizing = ReadDamperSizing(root.Child("damper_sizing"), campaign.base);
-    inputs = DamperSizingCases(campaign.damper_sizing, "damper_sizing");
-    if (!root.Has("steps")) campaign.steps.simulate = campaign.damper_sizing.has_settling_target();
-    if (campaign.damper_sizing.has_settling_target()) campaign.steps.simulate = true;
-    for (const std::string& joint : campaign.damper_sizing.joints) {
-      campaign.swept_keys.push_back(DamperSizingSpec::DampingKey(joint));
-    }
+  if (study_cases) {
+    inputs = std::move(*study_cases);
   } else {
     SweepPlan plan = ReadSweep(root, campaign.seed);
     inputs = std::move(plan.assignments);
@@ -233,10 +229,7 @@ Campaign LoadCampaign(const std::string& path) {
                        "each key either in set or in the sweep");
     }
   }
-  if (campaign.study == CampaignStudy::kLaws) {
-    campaign.laws = ReadLaws(root.Child("laws"), campaign.swept_keys, campaign.steps.identify,
-                             campaign.steps.update);
-  }
+  if (campaign.study) campaign.study->ReadSection(root, campaign);
 
   const int count = static_cast<int>(inputs.size());
   campaign.cases.reserve(inputs.size());

@@ -102,12 +102,7 @@ CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case) 
         WriteTruth(file, *model, *test);
         WriteSimulationInfo(file, excitation, options, *test);
       });
-      if (campaign.study == CampaignStudy::kDamperSizing) {
-        const DamperSizingSpec& spec = campaign.damper_sizing;
-        outcome.settling_time_s = CalcSettlingTime(
-            test->exact, test->forcing_end_s, spec.settling_band_fraction, spec.settling_band_rad);
-        row["settling_time_s"] = Number(outcome.settling_time_s);
-      }
+      if (campaign.study) campaign.study->AddCaseMetrics(*test, &outcome);
 
       internal::StepInput input{&scenario, model, test, nullptr};
       if (campaign.steps.identify) {

@@ -4,24 +4,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <limits>
-#include <sstream>
+#include <map>
+#include <utility>
 
 #include "mbid/campaign/campaign.h"
 #include "mbid/campaign/campaign_case.h"
 #include "mbid/common/error.h"
-#include "mbid/report/gnuplot.h"
 
 namespace mbid::campaign {
-using report::DrawFigure;
-using report::Figure;
-using report::GnuplotAvailable;
-using report::PlotSeries;
-
 namespace {
-
-namespace fs = std::filesystem;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -56,11 +48,12 @@ bool Meets(const DamperSizingSpec& spec, const std::string& target, const Point&
 // Evaluates the model with d_joint = damping: an ad-hoc case of the campaign.
 class Evaluator {
  public:
-  Evaluator(const Campaign& campaign, const std::string& joint) : campaign_(campaign) {
+  Evaluator(const Campaign& campaign, const DamperSizingSpec& spec, const std::string& joint)
+      : campaign_(campaign) {
     campaign_.cases.clear();
     key_ = DamperSizingSpec::DampingKey(joint);
     // The damping ratio alone needs no simulation.
-    if (!campaign.damper_sizing.has_settling_target()) campaign_.steps = {false, false, false};
+    if (!spec.has_settling_target()) campaign_.steps = {false, false, false};
   }
   // Targets bisect over the same brackets ("all" repeats another target's): each damping is
   // evaluated once.
@@ -91,6 +84,85 @@ class Evaluator {
 
 Eigen::VectorXd ToVector(const std::vector<double>& values) {
   return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+// A joint's curves from the cases' summary rows (the cases that swept its damper, in campaign
+// order); `damping` and `points` receive the sweep for the bisection.
+JointSizing ReadCurves(const std::string& joint, const std::vector<nlohmann::ordered_json>& rows,
+                       std::vector<double>* damping_out, std::vector<Point>* points_out) {
+  const std::string key = DamperSizingSpec::DampingKey(joint);
+  JointSizing sizing;
+  sizing.joint = joint;
+  std::vector<double>& damping = *damping_out;
+  std::vector<Point>& points = *points_out;
+  std::vector<std::vector<double>> ratios;
+  size_t modes = 0;
+  for (const auto& row : rows) {
+    if (!row.contains(key)) continue;
+    damping.push_back(RowNumber(row, key));
+    Point point;
+    std::vector<double> mode_ratios;
+    if (row["status"] == "ok") {
+      point.min_damping_ratio = RowNumber(row, "exact.min_damping_ratio");
+      point.settling_time_s = RowNumber(row, "settling_time_s");
+      if (row.contains("settling_time_s") && row["settling_time_s"].is_null()) {
+        point.settling_time_s = kInf;  // not settled within the record
+      }
+      for (int k = 1; row.contains(fmt::format("exact.mode{}.damping_ratio", k)); ++k) {
+        mode_ratios.push_back(RowNumber(row, fmt::format("exact.mode{}.damping_ratio", k)));
+      }
+    }
+    modes = std::max(modes, mode_ratios.size());
+    points.push_back(point);
+    ratios.push_back(mode_ratios);
+  }
+  const Eigen::Index n = static_cast<Eigen::Index>(damping.size());
+  sizing.damping_Nms_per_rad = ToVector(damping);
+  sizing.damping_ratio = Eigen::MatrixXd::Constant(n, static_cast<Eigen::Index>(modes), kNaN);
+  sizing.min_damping_ratio.resize(n);
+  sizing.settling_time_s.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& mode_ratios = ratios[static_cast<size_t>(i)];
+    for (size_t k = 0; k < mode_ratios.size(); ++k) {
+      sizing.damping_ratio(i, static_cast<Eigen::Index>(k)) = mode_ratios[k];
+    }
+    sizing.min_damping_ratio[i] = points[static_cast<size_t>(i)].min_damping_ratio;
+    sizing.settling_time_s[i] = points[static_cast<size_t>(i)].settling_time_s;
+  }
+  return sizing;
+}
+
+// The smallest damping that meets `target` (NaN if no sweep point does) and how it was found;
+// `evaluations` counts the bisection's evaluations of the model.
+std::pair<double, std::string> FindSmallest(const DamperSizingSpec& spec, const std::string& target,
+                                            const std::vector<double>& damping,
+                                            const std::vector<Point>& points,
+                                            const Evaluator& evaluate, int* evaluations_total) {
+  size_t first = 0;
+  while (first < points.size() && !Meets(spec, target, points[first])) ++first;
+  if (first == points.size()) {
+    return {kNaN, fmt::format("not met by any damping up to {:.6g} N*m*s/rad",
+                              damping.empty() ? kNaN : damping.back())};
+  }
+  if (first == 0) {
+    return {damping[0], "met at the smallest damping of the range; smaller not tried"};
+  }
+  // Bisection between the last failing and the first admissible sweep point: it finds the
+  // smallest admissible damping when the target holds on one side of a single crossing,
+  // and a crossing inside the bracket otherwise.
+  double low = damping[first - 1];
+  double high = damping[first];
+  int evaluations = 0;
+  std::string failure;
+  for (int i = 0; i < kMaxBisections && (high - low) > spec.relative_tolerance * high; ++i) {
+    const double middle = spec.log_spacing && low > 0 ? std::sqrt(low * high) : 0.5 * (low + high);
+    (Meets(spec, target, evaluate(middle, &evaluations, &failure)) ? high : low) = middle;
+  }
+  *evaluations_total += evaluations;
+  std::string note = fmt::format("bisection between {:.6g} and {:.6g} N*m*s/rad ({} steps)",
+                                 damping[first - 1], damping[first], evaluations);
+  if (!failure.empty()) note += "; some evaluations failed: " + failure;
+  return {high, note};
 }
 
 }  // namespace
@@ -214,9 +286,8 @@ double CalcSettlingTime(const Measurement& exact, double after_s, double band_fr
   return t[last_outside + 1] - after_s;
 }
 
-DamperSizingResult SizeDampers(const Campaign& campaign,
+DamperSizingResult SizeDampers(const Campaign& campaign, const DamperSizingSpec& spec,
                                const std::vector<nlohmann::ordered_json>& rows) {
-  const DamperSizingSpec& spec = campaign.damper_sizing;
   DamperSizingResult result;
   std::vector<std::string> targets;
   if (spec.min_damping_ratio > 0) targets.push_back("min_damping_ratio");
@@ -224,79 +295,15 @@ DamperSizingResult SizeDampers(const Campaign& campaign,
   if (targets.size() == 2) targets.push_back("all");
 
   for (const std::string& joint : spec.joints) {
-    const std::string key = DamperSizingSpec::DampingKey(joint);
-    JointSizing sizing;
-    sizing.joint = joint;
     std::vector<double> damping;
     std::vector<Point> points;
-    std::vector<std::vector<double>> ratios;
-    size_t modes = 0;
-    for (const auto& row : rows) {
-      if (!row.contains(key)) continue;
-      damping.push_back(RowNumber(row, key));
-      Point point;
-      std::vector<double> mode_ratios;
-      if (row["status"] == "ok") {
-        point.min_damping_ratio = RowNumber(row, "exact.min_damping_ratio");
-        point.settling_time_s = RowNumber(row, "settling_time_s");
-        if (row.contains("settling_time_s") && row["settling_time_s"].is_null()) {
-          point.settling_time_s = kInf;  // not settled within the record
-        }
-        for (int k = 1; row.contains(fmt::format("exact.mode{}.damping_ratio", k)); ++k) {
-          mode_ratios.push_back(RowNumber(row, fmt::format("exact.mode{}.damping_ratio", k)));
-        }
-      }
-      modes = std::max(modes, mode_ratios.size());
-      points.push_back(point);
-      ratios.push_back(mode_ratios);
-    }
-    const Eigen::Index n = static_cast<Eigen::Index>(damping.size());
-    sizing.damping_Nms_per_rad = ToVector(damping);
-    sizing.damping_ratio = Eigen::MatrixXd::Constant(n, static_cast<Eigen::Index>(modes), kNaN);
-    sizing.min_damping_ratio.resize(n);
-    sizing.settling_time_s.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const auto& mode_ratios = ratios[static_cast<size_t>(i)];
-      for (size_t k = 0; k < mode_ratios.size(); ++k) {
-        sizing.damping_ratio(i, static_cast<Eigen::Index>(k)) = mode_ratios[k];
-      }
-      sizing.min_damping_ratio[i] = points[static_cast<size_t>(i)].min_damping_ratio;
-      sizing.settling_time_s[i] = points[static_cast<size_t>(i)].settling_time_s;
-    }
-
-    const Evaluator evaluate(campaign, joint);
+    JointSizing sizing = ReadCurves(joint, rows, &damping, &points);
+    const Evaluator evaluate(campaign, spec, joint);
     for (const std::string& target : targets) {
       sizing.targets.push_back(target);
-      size_t first = 0;
-      while (first < points.size() && !Meets(spec, target, points[first])) ++first;
-      if (first == points.size()) {
-        sizing.smallest_Nms_per_rad.push_back(kNaN);
-        sizing.notes.push_back(fmt::format("not met by any damping up to {:.6g} N*m*s/rad",
-                                           damping.empty() ? kNaN : damping.back()));
-        continue;
-      }
-      if (first == 0) {
-        sizing.smallest_Nms_per_rad.push_back(damping[0]);
-        sizing.notes.push_back("met at the smallest damping of the range; smaller not tried");
-        continue;
-      }
-      // Bisection between the last failing and the first admissible sweep point: it finds the
-      // smallest admissible damping when the target holds on one side of a single crossing,
-      // and a crossing inside the bracket otherwise.
-      double low = damping[first - 1];
-      double high = damping[first];
-      int evaluations = 0;
-      std::string failure;
-      for (int i = 0; i < kMaxBisections && (high - low) > spec.relative_tolerance * high; ++i) {
-        const double middle =
-            spec.log_spacing && low > 0 ? std::sqrt(low * high) : 0.5 * (low + high);
-        (Meets(spec, target, evaluate(middle, &evaluations, &failure)) ? high : low) = middle;
-      }
-      result.refinement_evaluations += evaluations;
-      sizing.smallest_Nms_per_rad.push_back(high);
-      std::string note = fmt::format("bisection between {:.6g} and {:.6g} N*m*s/rad ({} steps)",
-                                     damping[first - 1], damping[first], evaluations);
-      if (!failure.empty()) note += "; some evaluations failed: " + failure;
+      const auto [smallest, note] =
+          FindSmallest(spec, target, damping, points, evaluate, &result.refinement_evaluations);
+      sizing.smallest_Nms_per_rad.push_back(smallest);
       sizing.notes.push_back(note);
     }
     result.joints.push_back(std::move(sizing));
@@ -325,127 +332,6 @@ void WriteDamperSizing(H5Writer& file, const DamperSizingSpec& spec,
                      "N*m*s/rad");
     file.WriteStrings(group, "notes", joint.notes);
   }
-}
-
-std::string DamperSizingReport(const DamperSizingSpec& spec, const DamperSizingResult& result,
-                               const std::string& folder, std::vector<std::string>* figures) {
-  std::ostringstream md;
-  md << "## Damper sizing\n\n";
-  md << "Each joint's damping `d_k` alone is swept over its range (the other joints keep the "
-        "base scenario's values); the smallest admissible `d_k` is refined by bisection between "
-        "the last sweep point that fails a target and the first that meets it.\n\nTargets: ";
-  std::vector<std::string> targets;
-  if (spec.min_damping_ratio > 0) {
-    targets.push_back(fmt::format("smallest modal damping ratio >= {}", spec.min_damping_ratio));
-  }
-  if (spec.has_settling_target()) {
-    targets.push_back(fmt::format(
-        "settling time <= {} s (band: {})", spec.max_settling_time_s,
-        spec.settling_band_rad > 0
-            ? fmt::format("{} rad", spec.settling_band_rad)
-            : fmt::format("{} of each output's peak deviation", spec.settling_band_fraction)));
-  }
-  md << fmt::format("{}.\n\n", fmt::join(targets, "; "));
-  md << "| joint | target | smallest d, N*m*s/rad | how |\n|---|---|---|---|\n";
-  for (const JointSizing& joint : result.joints) {
-    for (size_t t = 0; t < joint.targets.size(); ++t) {
-      const double d = joint.smallest_Nms_per_rad[t];
-      md << fmt::format("| {} | {} | {} | {} |\n", joint.joint, joint.targets[t],
-                        std::isfinite(d) ? fmt::format("{:.6g}", d) : "not met", joint.notes[t]);
-    }
-  }
-  md << "\n";
-  if (!GnuplotAvailable()) {
-    md << "gnuplot with pngcairo was not found: no figures.\n\n";
-    return md.str();
-  }
-  for (const JointSizing& joint : result.joints) {
-    const Eigen::Index n = joint.damping_Nms_per_rad.size();
-    if (n == 0) continue;
-    const double d_low = joint.damping_Nms_per_rad.minCoeff();
-    const double d_high = joint.damping_Nms_per_rad.maxCoeff();
-    const std::string x_range = spec.log_spacing
-                                    ? fmt::format("[{}:{}]", d_low / 1.25, d_high * 1.25)
-                                    : fmt::format("[{}:{}]", d_low, d_high);
-    const auto marker = [&](const std::string& target, double y_low, double y_high,
-                            std::vector<PlotSeries>& series) {
-      for (size_t t = 0; t < joint.targets.size(); ++t) {
-        if (joint.targets[t] != target || !std::isfinite(joint.smallest_Nms_per_rad[t])) continue;
-        const double d = joint.smallest_Nms_per_rad[t];
-        series.push_back({fmt::format("smallest d = {:.4g} N*m*s/rad", d), Eigen::Vector2d(d, d),
-                          Eigen::Vector2d(y_low, y_high), "lines dt 2 lw 2 lc rgb '#2ca02c'"});
-      }
-    };
-    {
-      Figure figure;
-      figure.title = fmt::format("Damping ratio of every mode vs d_{}", joint.joint);
-      figure.x_label = fmt::format("d_{}, N*m*s/rad", joint.joint);
-      figure.y_label = "damping ratio, 1";
-      figure.log_x = spec.log_spacing;
-      figure.x_range = x_range;
-      figure.y_range = "[0:*]";
-      figure.key = "outside right top box";
-      for (Eigen::Index k = 0; k < joint.damping_ratio.cols(); ++k) {
-        std::vector<double> x, y;
-        for (Eigen::Index i = 0; i < n; ++i) {
-          if (!std::isfinite(joint.damping_ratio(i, k))) continue;
-          x.push_back(joint.damping_Nms_per_rad[i]);
-          y.push_back(joint.damping_ratio(i, k));
-        }
-        if (x.empty()) continue;
-        figure.series.push_back(
-            {fmt::format("mode {}", k + 1), ToVector(x), ToVector(y), "linespoints pt 7 ps 0.6"});
-      }
-      if (spec.min_damping_ratio > 0) {
-        figure.series.push_back(
-            {fmt::format("target {}", spec.min_damping_ratio), Eigen::Vector2d(d_low, d_high),
-             Eigen::Vector2d::Constant(spec.min_damping_ratio), "lines dt 3 lw 2 lc rgb 'black'"});
-        double top = spec.min_damping_ratio;
-        for (Eigen::Index i = 0; i < joint.damping_ratio.size(); ++i) {
-          if (std::isfinite(joint.damping_ratio.data()[i])) {
-            top = std::max(top, joint.damping_ratio.data()[i]);
-          }
-        }
-        marker("min_damping_ratio", 0.0, top, figure.series);
-      }
-      const std::string name = fmt::format("damping_ratio_vs_d_{}.png", joint.joint);
-      DrawFigure(figure, (fs::path(folder) / name).string());
-      figures->push_back(name);
-      md << "![Damping ratio vs d_" << joint.joint << "](" << name << ")\n\n";
-    }
-    if (spec.has_settling_target()) {
-      Figure figure;
-      figure.title = fmt::format("Settling time of the outputs vs d_{}", joint.joint);
-      figure.x_label = fmt::format("d_{}, N*m*s/rad", joint.joint);
-      figure.y_label = "settling time, s";
-      figure.log_x = spec.log_spacing;
-      figure.x_range = x_range;
-      figure.y_range = "[0:*]";
-      figure.key = "outside right top box";
-      std::vector<double> x, y;
-      double y_max = spec.max_settling_time_s;
-      for (Eigen::Index i = 0; i < n; ++i) {
-        if (!std::isfinite(joint.settling_time_s[i])) continue;
-        x.push_back(joint.damping_Nms_per_rad[i]);
-        y.push_back(joint.settling_time_s[i]);
-        y_max = std::max(y_max, y.back());
-      }
-      figure.series.push_back({"settling time (cases)", ToVector(x), ToVector(y),
-                               "linespoints pt 7 ps 0.6 lc rgb '#1f77b4'"});
-      figure.series.push_back(
-          {fmt::format("target {} s", spec.max_settling_time_s), Eigen::Vector2d(d_low, d_high),
-           Eigen::Vector2d::Constant(spec.max_settling_time_s), "lines dt 3 lw 2 lc rgb 'black'"});
-      marker("max_settling_time_s", 0.0, y_max, figure.series);
-      const std::string name = fmt::format("settling_time_vs_d_{}.png", joint.joint);
-      DrawFigure(figure, (fs::path(folder) / name).string());
-      figures->push_back(name);
-      md << "![Settling time vs d_" << joint.joint << "](" << name << ")\n\n";
-      if (static_cast<Eigen::Index>(x.size()) < n) {
-        md << "Dampings whose outputs did not settle within the record are not plotted.\n\n";
-      }
-    }
-  }
-  return md.str();
 }
 
 }  // namespace mbid::campaign

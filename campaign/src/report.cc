@@ -132,7 +132,7 @@ std::vector<std::string> WriteCampaignReport(const Campaign& campaign,
   std::vector<std::string> figures = study.figures;
   const bool gnuplot = GnuplotAvailable();
   const std::string x_key = NumericSweptKey(campaign, rows);
-  if (campaign.study != CampaignStudy::kDamperSizing && !x_key.empty()) {
+  if ((!campaign.study || campaign.study->PlotsModesAcrossCases()) && !x_key.empty()) {
     md << "## Modes across the campaign\n\n";
     if (!gnuplot) {
       md << "gnuplot with pngcairo was not found: no figures.\n\n";

@@ -5,14 +5,9 @@
 #include <vector>
 
 #include "mbid/campaign/campaign.h"
+#include "mbid/campaign/study.h"
 
 namespace mbid::campaign::internal {
-
-// A study's part of the report: Markdown and the figures it drew.
-struct StudyReport {
-  std::string markdown;
-  std::vector<std::string> figures;
-};
 
 // report.md in `folder` (atomically): the campaign, its cases by status, the failed cases with
 // their reasons, the modes across the campaign against the first numeric swept key (exact and,

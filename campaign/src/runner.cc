@@ -15,17 +15,12 @@
 #include "mbid/campaign/campaign_runner.h"
 #include "mbid/common/atomic_file.h"
 #include "mbid/common/hdf5_io.h"
-#include "mbid/model/mechanical_model.h"
-#include "mbid/validation/scenario.h"
 #include "progress.h"
 #include "report.h"
 #include "results_folder.h"
 #include "summary_table.h"
-#include "units.h"
 
 namespace mbid::campaign {
-using validation::LoadScenarioFromText;
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -88,32 +83,10 @@ int FinishCampaign(const Campaign& campaign, const internal::ResultsFolder& fold
   const std::string info_path = folder.Path(".campaign-info.h5");
   const std::string study_path = folder.Path(".study.h5");
   WriteCampaignInfo(campaign, rows, info_path);
-  internal::StudyReport study;
-  if (campaign.study == CampaignStudy::kDamperSizing) {
-    progress.Say("sizing dampers (curves and bisection)");
-    const DamperSizingResult result = SizeDampers(campaign, rows);
-    H5Writer file(study_path);
-    WriteDamperSizing(file, campaign.damper_sizing, result);
-    file.Commit();
-    study.markdown =
-        DamperSizingReport(campaign.damper_sizing, result, folder.Path(""), &study.figures);
-  } else if (campaign.study == CampaignStudy::kLaws) {
-    progress.Say("fitting the laws");
-    std::vector<PolynomialLaw> laws = FitLaws(campaign.laws, rows);
-    // Stiffness and damping units from the base model: N*m/rad on pins, N/m on slides.
-    const std::vector<model::Parameter> parameters =
-        LoadScenarioFromText(YAML::Dump(campaign.base), campaign.base_source)
-            .MakeModel()
-            ->parameters();
-    for (PolynomialLaw& law : laws) {
-      for (const model::Parameter& parameter : parameters) {
-        if (internal::ShortName(law.quantity) == parameter.name) law.units = parameter.units;
-      }
-    }
-    H5Writer file(study_path);
-    WriteLaws(file, laws);
-    file.Commit();
-    study.markdown = LawsReport(campaign.laws, laws, rows, folder.Path(""), &study.figures);
+  StudyReport study;
+  if (campaign.study) {
+    study = campaign.study->Run({campaign, rows, folder.Path(""), study_path,
+                                 [&progress](const std::string& line) { progress.Say(line); }});
   }
   const std::vector<std::string> figures =
       internal::WriteCampaignReport(campaign, rows, folder.Path(""), study);

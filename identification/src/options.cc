@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "internal.h"
+#include "methods/method.h"
 
 namespace mbid::identification {
 namespace {
@@ -24,26 +25,6 @@ class Checker {
 };
 
 }  // namespace
-
-std::string MethodName(Method method) {
-  switch (method) {
-    case Method::kHankelNls:
-      return "hankel-nls";
-    case Method::kPronySvd:
-      return "prony-svd";
-  }
-  return "unknown";
-}
-
-bool ParseMethod(const std::string& name, Method* method) {
-  for (Method candidate : {Method::kHankelNls, Method::kPronySvd}) {
-    if (name == MethodName(candidate)) {
-      *method = candidate;
-      return true;
-    }
-  }
-  return false;
-}
 
 std::optional<OptionProblem> FindOptionProblem(const IdentificationOptions& o) {
   Checker c;
@@ -109,6 +90,11 @@ std::optional<OptionProblem> FindOptionProblem(const IdentificationOptions& o) {
             o.refinement.parameter_tolerance, "a positive number");
   c.Require(o.refinement.gradient_tolerance > 0, "refinement.gradient_tolerance",
             o.refinement.gradient_tolerance, "a positive number");
+  if (!c.problem() && FindMethod(o.method.name()) == nullptr) {
+    std::string names;
+    for (const std::string& name : MethodNames()) names += (names.empty() ? "" : ", ") + name;
+    return OptionProblem{"method", "unknown method '" + o.method.name() + "'", "one of " + names};
+  }
   return c.problem();
 }
 

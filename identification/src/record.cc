@@ -8,6 +8,7 @@
 #include "internal.h"
 #include "mbid/common/error.h"
 #include "mbid/identification/spectrum.h"
+#include "methods/method.h"
 
 namespace mbid::identification {
 namespace {
@@ -100,12 +101,7 @@ int ChooseDecimation(const Eigen::MatrixXd& centered, double sample_interval_s,
 }
 
 int RequiredSamples(const IdentificationOptions& options, int channels) {
-  if (options.method == Method::kPronySvd) {
-    // Rows j = 0..s-p of eq. 3 must at least match the m p + 1 unknowns per channel.
-    return (channels + 1) * options.prony.order + 1;
-  }
-  // The Hankel matrix needs 8 columns (4 poles plus room for the noise floor) and as many rows.
-  return 24;
+  return FindMethod(options.method.name())->required_samples(options, channels);
 }
 
 AnalysisRecord PrepareRecord(const Measurement& measurement, const IdentificationOptions& options,
@@ -177,9 +173,7 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
   const int available = q == 1 ? count : decimated_count;
   if (available < required) {
     const std::string order =
-        options.method == Method::kPronySvd
-            ? fmt::format("order p = {} with {} channels", options.prony.order, columns.size())
-            : std::string("the Hankel matrix");
+        FindMethod(options.method.name())->requirement(options, static_cast<int>(columns.size()));
     throw InputError(
         origin, "samples",
         fmt::format("{} samples in the window [{}, {}] s{}", count, options.window_start_s,

@@ -31,7 +31,8 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
                      "extra_orders",
                      "min_correlation",
                      "prony"});
-  const std::string method = section.Choice("method", {"hankel-nls", "prony-svd"}, "hankel-nls");
+  const std::string method = section.Choice("method", identification::MethodNames(),
+                                            identification::Method::kHankelNls.name());
   identification::ParseMethod(method, &options.method);
   options.window_start_s = section.Double("window_start_s", options.window_start_s);
   options.window_end_s = section.Double("window_end_s", options.window_end_s);

@@ -3,12 +3,12 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "mbid/campaign/campaign_sweep.h"
-#include "mbid/campaign/damper_sizing.h"
-#include "mbid/campaign/laws.h"
+#include "mbid/campaign/study.h"
 #include "mbid/common/yaml_reader.h"
 
 namespace mbid::campaign {
@@ -20,8 +20,6 @@ struct CampaignSteps {
   bool identify = false;
   bool update = false;
 };
-
-enum class CampaignStudy { kNone, kDamperSizing, kLaws };
 
 // One case: the base scenario with the campaign's fixed values and this case's swept values.
 struct CampaignCase {
@@ -49,9 +47,8 @@ struct Campaign {
   std::vector<Assignment> fixed;        // `set:`, applied to every case before its inputs
   std::vector<std::string> swept_keys;  // the inputs' keys, columns of summary.csv
   std::vector<CampaignCase> cases;
-  CampaignStudy study = CampaignStudy::kNone;
-  DamperSizingSpec damper_sizing;
-  LawsSpec laws;
+  // The design study run after the cases (`study:`, study.h), with its section; null for none.
+  std::shared_ptr<CampaignStudy> study;
 
   // The case's resolved scenario, as YAML text that LoadScenarioFromText reads: the base with
   // name "<campaign>-<case id>", sensors.seed = the case's seed (unless set or swept), the fixed

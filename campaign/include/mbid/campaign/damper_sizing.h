@@ -75,7 +75,7 @@ struct DamperSizingResult {
 
 // The curves from the cases' summary rows (in campaign order) and the refined smallest
 // dampers; the refinement evaluates ad-hoc cases of `campaign` (serially).
-DamperSizingResult SizeDampers(const Campaign& campaign,
+DamperSizingResult SizeDampers(const Campaign& campaign, const DamperSizingSpec& spec,
                                const std::vector<nlohmann::ordered_json>& rows);
 
 // /damper_sizing/<joint>/...: damping_Nms_per_rad, damping_ratio (points x modes),

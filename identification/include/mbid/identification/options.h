@@ -2,23 +2,41 @@
 
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mbid::identification {
 
-// The estimator of the poles.
-enum class Method {
+// The estimator of the poles, by the name it is registered under (src/methods/, one file per
+// method; adding one: docs/extending.md). The built-in ones have constants.
+class Method {
+ public:
   // Default: block-Hankel SVD (matrix pencil) initialization with the order from the noise
   // floor and stability across orders, then a Ceres refinement of all poles and amplitudes.
-  kHankelNls,
+  static const Method kHankelNls;
   // The paper's method, steps 2-5 of method.md (vector AR with constant term, eq. 3-4).
-  kPronySvd,
+  static const Method kPronySvd;
+
+  // Any name; Identify rejects one that no method is registered under (ParseMethod checks).
+  explicit Method(std::string name) : name_(std::move(name)) {}
+
+  const std::string& name() const { return name_; }
+  friend bool operator==(const Method& a, const Method& b) { return a.name_ == b.name_; }
+  friend bool operator!=(const Method& a, const Method& b) { return !(a == b); }
+
+ private:
+  std::string name_;
 };
 
+inline const Method Method::kHankelNls{"hankel-nls"};
+inline const Method Method::kPronySvd{"prony-svd"};
+
 // "hankel-nls" or "prony-svd", as in the JSON field `method` and the `--method` flag.
-std::string MethodName(Method method);
-// Parses a method name; false (and `method` unchanged) for an unknown name.
+std::string MethodName(const Method& method);
+// Parses a method name; false (and `method` unchanged) for a name no method is registered under.
 bool ParseMethod(const std::string& name, Method* method);
+// The registered methods' names, in the order the choices are listed.
+std::vector<std::string> MethodNames();
 
 enum class SpectrumWindow { kNone, kHann };
 

@@ -1,0 +1,264 @@
+// H5Writer: mbid's HDF5 files, built in memory and written atomically (docs/file-formats.md).
+#include <H5Cpp.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "hdf5_internal.h"
+#include "internal.h"
+#include "mbid/common/atomic_file.h"
+#include "mbid/common/error.h"
+#include "mbid/common/hdf5_io.h"
+
+namespace mbid {
+using internal::AttributeField;
+using internal::Describe;
+using internal::H5Lock;
+using internal::H5Mutex;
+using internal::JoinPath;
+using internal::kH5FormatVersion;
+using internal::ObjectExists;
+using internal::OpenedObject;
+using internal::PathPrefixes;
+using internal::VariableUtf8;
+
+namespace {
+
+// Long vectors (recorded channels) are chunked and compressed; short results stay contiguous.
+constexpr hsize_t kChunkThreshold = 4096;
+constexpr hsize_t kChunkSize = 65536;  // 512 KiB of doubles: inside HDF5's default chunk cache.
+constexpr int kDeflateLevel = 4;       // Most of level 9's gain on smooth signals, much faster.
+constexpr size_t kCoreIncrement = 1 << 20;  // in-memory file growth: 1 MiB, few reallocations
+
+H5::Group EnsureGroup(H5::H5File& file, const std::string& path) {
+  for (const std::string& prefix : PathPrefixes(path)) {
+    if (!file.nameExists(prefix)) {
+      file.createGroup(prefix);
+    } else if (file.childObjType(prefix) != H5O_TYPE_GROUP) {
+      throw H5::Exception("EnsureGroup", prefix + " exists and is not a group");
+    }
+  }
+  return file.openGroup(PathPrefixes(path).empty() ? "/" : path);
+}
+
+void RemoveIfExists(H5::H5File& file, const std::string& path) {
+  if (!PathPrefixes(path).empty() && ObjectExists(file, path)) file.unlink(path);
+}
+
+void PrepareAttribute(const H5::H5Object& object, const std::string& name) {
+  if (object.attrExists(name)) object.removeAttr(name);
+}
+
+void WriteStringAttr(const H5::H5Object& object, const std::string& name,
+                     const std::string& value) {
+  PrepareAttribute(object, name);
+  const H5::StrType type = VariableUtf8();
+  object.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, value);
+}
+
+void WriteStringArrayAttr(const H5::H5Object& object, const std::string& name,
+                          const std::vector<std::string>& values) {
+  PrepareAttribute(object, name);
+  const H5::StrType type = VariableUtf8();
+  const hsize_t n = values.size();
+  std::vector<const char*> pointers;
+  for (const auto& v : values) pointers.push_back(v.c_str());
+  object.createAttribute(name, type, H5::DataSpace(1, &n)).write(type, pointers.data());
+}
+
+void WriteDoubleAttr(const H5::H5Object& object, const std::string& name, double value) {
+  PrepareAttribute(object, name);
+  object.createAttribute(name, H5::PredType::IEEE_F64LE, H5::DataSpace(H5S_SCALAR))
+      .write(H5::PredType::NATIVE_DOUBLE, &value);
+}
+
+void WriteIntAttr(const H5::H5Object& object, const std::string& name, int value) {
+  PrepareAttribute(object, name);
+  object.createAttribute(name, H5::PredType::STD_I32LE, H5::DataSpace(H5S_SCALAR))
+      .write(H5::PredType::NATIVE_INT, &value);
+}
+
+void WriteDoubleDataset(H5::H5File& file, const std::string& group, const std::string& name,
+                        const std::vector<hsize_t>& dims, const double* data,
+                        const std::string& units) {
+  EnsureGroup(file, group);
+  const std::string path = JoinPath(group, name);
+  RemoveIfExists(file, path);
+  hsize_t count = 1;
+  for (hsize_t d : dims) count *= d;
+  H5::DSetCreatPropList properties;
+  if (dims.size() == 1 && count >= kChunkThreshold) {
+    const hsize_t chunk = std::min(count, kChunkSize);
+    properties.setChunk(1, &chunk);
+    if (H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
+      properties.setShuffle();
+      properties.setDeflate(kDeflateLevel);
+    }
+  }
+  const H5::DataSpace space = dims.empty()
+                                  ? H5::DataSpace(H5S_SCALAR)
+                                  : H5::DataSpace(static_cast<int>(dims.size()), dims.data());
+  H5::DataSet dataset = file.createDataSet(path, H5::PredType::IEEE_F64LE, space, properties);
+  if (count > 0) dataset.write(data, H5::PredType::NATIVE_DOUBLE);
+  if (!units.empty()) WriteStringAttr(dataset, "units", units);
+}
+
+}  // namespace
+
+struct H5Writer::Impl {
+  Impl(const std::string& path, bool sync) : atomic(path, sync) {}
+
+  // Runs HDF5 calls for `object`, turning HDF5's exceptions into std::runtime_error.
+  template <typename Body>
+  void Run(const std::string& object, Body&& body) {
+    H5Lock lock(H5Mutex());
+    if (committed || !file) {
+      throw std::logic_error("H5Writer: " + atomic.path() + " is already committed or failed");
+    }
+    try {
+      body(*file);
+    } catch (const H5::Exception& e) {
+      throw std::runtime_error(
+          fmt::format("cannot write {} to HDF5 file {}: {}", object, atomic.path(), Describe(e)));
+    }
+  }
+
+  AtomicFile atomic;  // declared first: removes the temporary after closing it
+  std::unique_ptr<H5::H5File> file;
+  bool committed = false;
+};
+
+H5Writer::H5Writer(const std::string& path, bool sync) {
+  H5Lock lock(H5Mutex());
+  H5::Exception::dontPrint();
+  impl_ = std::make_unique<Impl>(path, sync);
+  try {
+    try {
+      // In memory (the core driver without a backing store): HDF5 never meets a disk error.
+      // HDF5 1.10.8 cannot recover from a failed write or close on disk (a full file system):
+      // the file's identifier stays half closed and closing it again, at the latest in
+      // H5close at exit, is a segmentation fault. Commit() writes the image itself.
+      H5::FileAccPropList access;
+      access.setCore(kCoreIncrement, false);
+      impl_->file = std::make_unique<H5::H5File>(impl_->atomic.temp_path(), H5F_ACC_TRUNC,
+                                                 H5::FileCreatPropList::DEFAULT, access);
+    } catch (const H5::Exception& e) {
+      throw std::runtime_error(
+          fmt::format("cannot create HDF5 file {}: {}", impl_->atomic.temp_path(), Describe(e)));
+    }
+    impl_->Run("/", [](H5::H5File& file) {
+      const H5::Group root = file.openGroup("/");
+      WriteStringAttr(root, "format", "mbid");
+      WriteIntAttr(root, "format_version", kH5FormatVersion);
+    });
+  } catch (...) {
+    impl_.reset();  // close and remove the temporary while still holding the HDF5 lock
+    throw;
+  }
+}
+
+H5Writer::~H5Writer() {
+  H5Lock lock(H5Mutex());
+  impl_.reset();
+}
+
+void H5Writer::WriteMeasurement(const Measurement& measurement, const std::string& path) {
+  measurement.Validate(impl_->atomic.path());
+  impl_->Run(path, [&measurement, &path](H5::H5File& file) {
+    RemoveIfExists(file, path);
+    const H5::Group group = EnsureGroup(file, path);
+    WriteStringArrayAttr(group, "channels", measurement.channels);
+    WriteDoubleAttr(group, "sample_interval_s", measurement.sample_interval_s);
+    WriteStringAttr(group, "source", measurement.source);
+    const std::vector<hsize_t> dims = {static_cast<hsize_t>(measurement.samples())};
+    const Eigen::VectorXd time = measurement.CalcTime();
+    WriteDoubleDataset(file, path, "time", dims, time.data(), "s");
+    for (int c = 0; c < measurement.channel_count(); ++c) {
+      WriteDoubleDataset(file, path, measurement.channels[c], dims,
+                         measurement.values.col(c).data(), measurement.units[c]);
+    }
+  });
+}
+
+void H5Writer::WriteScenarioYaml(const std::string& yaml_text) {
+  WriteStringAttribute("/scenario", "yaml", yaml_text);
+}
+
+void H5Writer::WriteVector(const std::string& group, const std::string& name,
+                           const Eigen::VectorXd& v, const std::string& units) {
+  impl_->Run(JoinPath(group, name), [&](H5::H5File& file) {
+    WriteDoubleDataset(file, group, name, {static_cast<hsize_t>(v.size())}, v.data(), units);
+  });
+}
+
+void H5Writer::WriteMatrix(const std::string& group, const std::string& name,
+                           const Eigen::MatrixXd& m, const std::string& units) {
+  // HDF5 and numpy are row-major; Eigen's default is column-major.
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> row_major = m;
+  impl_->Run(JoinPath(group, name), [&](H5::H5File& file) {
+    WriteDoubleDataset(file, group, name,
+                       {static_cast<hsize_t>(m.rows()), static_cast<hsize_t>(m.cols())},
+                       row_major.data(), units);
+  });
+}
+
+void H5Writer::WriteScalar(const std::string& group, const std::string& name, double value,
+                           const std::string& units) {
+  impl_->Run(JoinPath(group, name),
+             [&](H5::H5File& file) { WriteDoubleDataset(file, group, name, {}, &value, units); });
+}
+
+void H5Writer::WriteStrings(const std::string& group, const std::string& name,
+                            const std::vector<std::string>& values) {
+  const std::string path = JoinPath(group, name);
+  impl_->Run(path, [&](H5::H5File& file) {
+    EnsureGroup(file, group);
+    RemoveIfExists(file, path);
+    const H5::StrType type = VariableUtf8();
+    const hsize_t n = values.size();
+    std::vector<const char*> pointers;
+    for (const auto& v : values) pointers.push_back(v.c_str());
+    H5::DataSet dataset = file.createDataSet(path, type, H5::DataSpace(1, &n));
+    if (n > 0) dataset.write(pointers.data(), type);
+  });
+}
+
+void H5Writer::WriteStringAttribute(const std::string& group, const std::string& name,
+                                    const std::string& value) {
+  impl_->Run(AttributeField(group, name), [&](H5::H5File& file) {
+    if (!ObjectExists(file, group)) EnsureGroup(file, group);
+    WriteStringAttr(OpenedObject(file, group).get(), name, value);
+  });
+}
+
+void H5Writer::WriteDoubleAttribute(const std::string& group, const std::string& name,
+                                    double value) {
+  impl_->Run(AttributeField(group, name), [&](H5::H5File& file) {
+    if (!ObjectExists(file, group)) EnsureGroup(file, group);
+    WriteDoubleAttr(OpenedObject(file, group).get(), name, value);
+  });
+}
+
+void H5Writer::Commit() {
+  std::vector<char> image;
+  {
+    H5Lock lock(H5Mutex());
+    impl_->Run("the file", [&image](H5::H5File& file) {
+      file.flush(H5F_SCOPE_GLOBAL);
+      const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
+      if (size < 0) throw H5::FileIException("H5Fget_file_image", "failed");
+      image.resize(static_cast<size_t>(size));
+      if (H5Fget_file_image(file.getId(), image.data(), image.size()) != size) {
+        throw H5::FileIException("H5Fget_file_image", "failed");
+      }
+      file.close();
+    });
+    impl_->file.reset();
+  }
+  internal::WriteWholeFile(impl_->atomic.temp_path(), image);
+  impl_->atomic.Commit();
+  impl_->committed = true;
+}
+
+}  // namespace mbid

@@ -1,0 +1,46 @@
+#include "free_decay.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "mbid/identification/release.h"
+
+namespace mbid::identification {
+
+// Where the free decay starts, and the options with the analysis window starting there.
+IdentificationOptions ApplyRelease(const Measurement& measurement,
+                                   const IdentificationOptions& options, ModalResult* result,
+                                   bool* from_rest) {
+  *from_rest = false;
+  IdentificationOptions applied = options;
+  result->release_time_s = measurement.start_time_s;
+  switch (options.release) {
+    case ReleaseMode::kNone:
+      result->release = "none";
+      return applied;
+    case ReleaseMode::kGiven:
+      result->release = "given";
+      result->release_time_s = options.release_time_s;
+      break;
+    case ReleaseMode::kDetect: {
+      const ReleaseDetection detection = DetectRelease(measurement);
+      result->release = detection.detected ? "detected" : "record start";
+      result->release_time_s = detection.release_time_s;
+      *from_rest = detection.from_rest;
+      if (detection.detected) {
+        result->warnings.push_back(fmt::format(
+            "{}; the analysis starts there (--release none to analyse the whole record)",
+            detection.description));
+      }
+      break;
+    }
+  }
+  // Samples at or after the release: PrepareRecord keeps t >= window_start_s - tau / 2.
+  applied.window_start_s =
+      std::max(options.window_start_s,
+               result->release_time_s + 0.5 * measurement.sample_interval_s * (1 - 1e-9));
+  return applied;
+}
+
+}  // namespace mbid::identification

@@ -1,0 +1,88 @@
+#include "reliability.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace mbid::identification {
+
+// Reasons the data do not support the result (ModalResult::reliable).
+void AssessReliability(const AnalysisRecord& record, const IdentificationOptions& options,
+                       const Estimate& estimate, ModalResult* result) {
+  std::vector<std::string>& reasons = result->reasons;
+  // The fit's residual against the record's own noise level: a record the modes explain leaves
+  // noise (ratio about 1; coloured noise a little more). 3 x the noise, or a residual above a
+  // millionth of the signal when the record is noiseless, means something in the record is not
+  // in the modes (a start before the free decay, a nonlinearity, a missed mode).
+  const Eigen::VectorXd& residual = estimate.fit.residual_variance;
+  for (Eigen::Index c = 0; c < residual.size() && c < estimate.noise_std.size(); ++c) {
+    const double rms = std::sqrt(record.decimated.col(c).squaredNorm() / record.decimated.rows());
+    const double level = std::max(estimate.noise_std(c), 1e-6 * rms);
+    const double ratio = std::sqrt(residual(c)) / level;
+    if (ratio > 3) {
+      reasons.push_back(fmt::format(
+          "the residual in channel {} is {:.3g} times the record's noise level: the modes do not "
+          "explain the record",
+          result->channels[static_cast<size_t>(c)], ratio));
+    }
+  }
+  for (Eigen::Index c = 0; c < result->correlation.size(); ++c) {
+    if (!(result->correlation(c) >= options.min_correlation)) {
+      reasons.push_back(fmt::format(
+          "K = {:.3f} in channel {} is below min_correlation {}: the modes do not explain the "
+          "record in the analysed band",
+          result->correlation(c), result->channels[static_cast<size_t>(c)],
+          options.min_correlation));
+    }
+  }
+  const double top_hz = std::min(record.max_frequency_hz, record.flat_frequency_hz);
+  for (const IdentifiedMode& mode : result->modes) {
+    if (mode.frequency_hz > 0.95 * top_hz) {
+      reasons.push_back(fmt::format(
+          "the mode at {:.4g} Hz is at the top of the analysed band ({:.4g} Hz{}): it may be "
+          "cut by the band or the decimation filter",
+          mode.frequency_hz, top_hz,
+          record.decimation > 1 ? fmt::format(", decimation {}", record.decimation) : ""));
+    }
+    if (options.min_frequency_hz > 0 && mode.frequency_hz < 1.05 * options.min_frequency_hz) {
+      reasons.push_back(fmt::format("the mode at {:.4g} Hz is at the bottom of the band ({} Hz)",
+                                    mode.frequency_hz, options.min_frequency_hz));
+    }
+    if (mode.std_frequency_hz > 0.1 * mode.frequency_hz ||
+        (mode.decay_rate_per_s > 0 && mode.std_decay_rate_per_s > mode.decay_rate_per_s)) {
+      reasons.push_back(fmt::format(
+          "the mode at {:.4g} Hz is undetermined (std of frequency {:.3g} Hz, of decay {:.3g} "
+          "1/s)",
+          mode.frequency_hz, mode.std_frequency_hz, mode.std_decay_rate_per_s));
+    }
+  }
+  for (const IdentifiedMode& mode : result->modes) {
+    if (mode.backbone && mode.backbone->amplitude_dependent) {
+      const auto [low, high] = std::minmax_element(mode.backbone->frequency_hz.begin(),
+                                                   mode.backbone->frequency_hz.end());
+      reasons.push_back(fmt::format(
+          "the mode at {:.4g} Hz is amplitude dependent ({:.4g} to {:.4g} Hz): its constant "
+          "frequency and damping hold at no amplitude; use its backbone",
+          mode.frequency_hz, *low, *high));
+    }
+  }
+  // Modes within 3 % of each other: one mode whose frequency drifts with amplitude, or two the
+  // record cannot tell apart; either way not two modes to size dampers on.
+  for (size_t k = 1; k < result->modes.size(); ++k) {
+    const double low = result->modes[k - 1].frequency_hz;
+    const double high = result->modes[k].frequency_hz;
+    if (high - low < 0.03 * high) {
+      reasons.push_back(fmt::format(
+          "modes at {:.4g} and {:.4g} Hz are {:.2g} % apart: one mode drifting with amplitude "
+          "or two the record cannot separate",
+          low, high, 100 * (high - low) / high));
+    }
+  }
+  if (result->termination != "converged") {
+    reasons.push_back("the refinement did not converge (" + result->termination + ")");
+  }
+  result->reliable = reasons.empty();
+}
+
+}  // namespace mbid::identification

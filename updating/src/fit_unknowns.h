@@ -1,0 +1,40 @@
+#pragma once
+
+// The unknowns of the output-error fit (output_error.h): shared model parameters and nuisance
+// parameters of single tests. Not part of the public API.
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mbid/model/mechanical_model.h"
+#include "mbid/updating/output_error.h"
+
+namespace mbid::updating::internal {
+
+// A number in messages: 4 significant digits.
+std::string FormatValue(double value);
+
+// One unknown of the fit: a shared model parameter or a nuisance parameter of one test.
+struct Unknown {
+  enum class Kind { kModel, kPayloadMass, kDeflection };
+  Kind kind = Kind::kModel;
+  std::string name;  // model parameter name, or "<test>:payload_mass_kg" ...
+  std::string units;
+  int test = -1;           // owning test of a nuisance parameter
+  std::string coordinate;  // kDeflection
+  bool log_scale = true;
+  double initial = 0, lower = 0, upper = 0;
+
+  // Ceres' coordinate x and back.
+  double ToInternal(double value) const { return log_scale ? std::log(value) : value; }
+  double ToValue(double x) const { return log_scale ? std::exp(x) : x; }
+};
+
+// The unknowns of `options.parameters` (all of the model's if empty) and the tests' nuisance
+// parameters (payload mass of a load drop, initial deflections), starts and bounds checked.
+std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,
+                                     const std::vector<TestRecord>& tests,
+                                     const UpdateOptions& options);
+
+}  // namespace mbid::updating::internal

@@ -1,0 +1,20 @@
+#pragma once
+
+// One fit of the output-error problem (UpdateModel's stages). Not part of the public API.
+
+#include <string>
+#include <vector>
+
+#include "mbid/model/mechanical_model.h"
+#include "mbid/updating/output_error.h"
+
+namespace mbid::updating::internal {
+
+// One fit of the whole problem (one continuation stage; with estimated noise two passes). The
+// initial cost is reported at `report_start` (values of the unknowns) if given, else at the
+// options' starts.
+UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
+                 const UpdateOptions& options, int first_stage, const std::string& stage_label,
+                 const std::vector<double>* report_start);
+
+}  // namespace mbid::updating::internal
