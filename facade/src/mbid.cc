@@ -78,10 +78,7 @@ Measurement ReadRecord(const std::string& path, const records::ImportOptions& op
 }
 
 ModalResult Identify(const Measurement& record, const IdentificationOptions& options) {
-  std::string why;
-  if (!options.IsValid(&why)) {
-    throw InputError("identification options", "", why, "valid identification options");
-  }
+  // Identify checks the options itself; a record made in memory has not been checked yet.
   record.Validate("record");
   return identification::Identify(record, options, "record");
 }
@@ -133,16 +130,7 @@ ValidationResult RunValidationCycle(const Scenario& scenario, const ValidationOp
   result.verdict = ParseVerdict(result.cycle.verdict);
   result.reasons = result.cycle.reasons;
   result.min_correlation = result.cycle.min_correlation;
-  for (const validation::RunTest& test : result.cycle.tests) {
-    const updating::TestFit& fit = test.tuned.tests.front();
-    for (size_t c = 0; c < fit.channels.size(); ++c) {
-      const double k = fit.correlation[static_cast<Eigen::Index>(c)];
-      const auto found = result.correlation.find(fit.channels[c]);
-      if (found == result.correlation.end() || k < found->second) {
-        result.correlation[fit.channels[c]] = k;
-      }
-    }
-  }
+  result.correlation = validation::CalcWorstCorrelation(result.cycle.tests);
   const validation::RunTest& first = result.cycle.tests.front();
   result.identified = first.identified;
   result.updated = Summarise(first.search, first.start_note);

@@ -50,11 +50,9 @@ mbid::Measurement MakeRecord(
   const Eigen::Index n = time.shape(0);
   const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(time.data(), n);
   mbid::Measurement m;
-  double start = 0;
   m.sample_interval_s = mbid::CheckUniformTime(
       t, "identify_arrays", [](Eigen::Index j) { return "time[" + std::to_string(j) + "]"; }, 0.0,
-      &start);
-  m.start_time_s = t.size() > 0 ? t[0] : 0.0;
+      &m.start_time_s);
   if (channels.empty()) {
     throw mbid::InputError("identify_arrays", "channels", "no channel",
                            "a dict {name: array} with at least one channel");

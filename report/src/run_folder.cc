@@ -185,14 +185,11 @@ int WriteRunFolder(const validation::CycleResult& cycle, const validation::Scena
                       {"validation", TestValidationJson(test, threshold)}});
       if (test.import) list.back()["import"] = validation::ImportReportToJson(*test.import);
       if (test.release) list.back()["release"] = test.release->ToJson();
-      const updating::TestFit& fit = test.tuned.tests.front();
-      for (size_t c = 0; c < fit.channels.size(); ++c) {
-        const double k = fit.correlation[static_cast<Eigen::Index>(c)];
-        auto& worst = validation["correlation"][fit.channels[c]];
-        if (k < worst.get<double>()) worst = k;
-      }
     }
     summary["tests"] = list;
+    for (const auto& [channel, k] : validation::CalcWorstCorrelation(tests)) {
+      validation["correlation"][channel] = k;
+    }
   }
   if (several) {
     std::vector<const updating::UpdateResult*> results;

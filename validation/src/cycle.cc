@@ -87,6 +87,19 @@ std::string VerdictLine(const std::vector<RunTest>& tests, double threshold,
 
 }  // namespace
 
+std::map<std::string, double> CalcWorstCorrelation(const std::vector<RunTest>& tests) {
+  std::map<std::string, double> worst;
+  for (const RunTest& test : tests) {
+    const updating::TestFit& fit = test.tuned.tests.front();
+    for (size_t c = 0; c < fit.channels.size(); ++c) {
+      const double k = fit.correlation[static_cast<Eigen::Index>(c)];
+      const auto found = worst.find(fit.channels[c]);
+      if (found == worst.end() || k < found->second) worst[fit.channels[c]] = k;
+    }
+  }
+  return worst;
+}
+
 CycleResult RunCycle(const Scenario& scenario, const CycleOptions& options) {
   const Say say = options.say ? options.say : [](const std::string&) {};
   CycleResult result;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,6 +38,10 @@ struct CycleResult {
   std::string verdict_line;          // "re-simulation vs record: K(x) = ...; threshold ... -> ..."
   double min_correlation = 0.95;     // the threshold the verdict used
 };
+
+// Per channel, the smallest re-simulation correlation K over the tests: what the verdict of
+// several tests is judged on.
+std::map<std::string, double> CalcWorstCorrelation(const std::vector<RunTest>& tests);
 
 // Runs the cycle on `scenario`. Throws InputError on bad input (records, settings) and
 // NumericalError when a fit does not converge.
