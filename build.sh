@@ -7,7 +7,7 @@ cd "$(dirname "$0")"
 
 # Debian 12 packages only (docs/install.md says what each is for).
 packages=(build-essential cmake ccache pkg-config
-  libsimbody-dev libeigen3-dev libsundials-dev libceres-dev libhdf5-dev hdf5-tools
+  libsimbody-dev libeigen3-dev libsundials-dev libceres-dev libhdf5-dev hdf5-tools zlib1g-dev
   libyaml-cpp-dev libcli11-dev libfmt-dev nlohmann-json3-dev libmuparser-dev libudunits2-dev libmatio-dev libboost-dev
   libgtest-dev libbenchmark-dev gnuplot-nox python3-h5py pybind11-dev python3-dev python3-numpy
   openmpi-bin libopenmpi-dev)

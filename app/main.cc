@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mbid/app/commands.h"
+#include "mbid/app/exit_code.h"
 #include "mbid/app/run_cycle.h"
 #include "mbid/app/version.h"
 #include "mbid/common/error.h"
@@ -210,7 +211,7 @@ int Main(int argc, char** argv) {
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version
     std::cerr << "mbid: error: command line: " << error.what() << "; expected see mbid --help\n";
-    return static_cast<int>(mbid::ExitCode::kInvalidInput);
+    return static_cast<int>(mbid::app::ExitCode::kInvalidInput);
   }
   common.import = MakeOverrides(import_flags);
   if (run->parsed()) {
@@ -249,7 +250,7 @@ int Main(int argc, char** argv) {
   if (simulate->parsed()) {
     return mbid::app::RunSimulateCommand(scenario_path, output_path, common, export_paths);
   }
-  return static_cast<int>(mbid::ExitCode::kOther);
+  return static_cast<int>(mbid::app::ExitCode::kOther);
 }
 
 }  // namespace
@@ -261,12 +262,12 @@ int main(int argc, char** argv) {
     return Main(argc, argv);
   } catch (const mbid::InputError& error) {
     std::cerr << "mbid: error: " << error.what() << "\n";
-    return static_cast<int>(mbid::ExitCode::kInvalidInput);
+    return static_cast<int>(mbid::app::ExitCode::kInvalidInput);
   } catch (const mbid::NumericalError& error) {
     std::cerr << "mbid: numerical failure: " << error.what() << "\n";
-    return static_cast<int>(mbid::ExitCode::kNumericalFailure);
+    return static_cast<int>(mbid::app::ExitCode::kNumericalFailure);
   } catch (const std::exception& error) {
     std::cerr << "mbid: failure: " << error.what() << "\n";
-    return static_cast<int>(mbid::ExitCode::kOther);
+    return static_cast<int>(mbid::app::ExitCode::kOther);
   }
 }

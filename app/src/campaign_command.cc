@@ -1,10 +1,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <iostream>
 #include <memory>
 #include <thread>
 
 #include "mbid/app/commands.h"
+#include "mbid/app/exit_code.h"
 #include "mbid/campaign/campaign.h"
 #include "mbid/campaign/campaign_runner.h"
 #include "mbid/common/error.h"
@@ -47,7 +49,15 @@ int RunCampaignCommand(const std::string& campaign_path, const std::string& outp
   options.workers = workers;
   options.resume = resume;
   options.quiet = common.quiet;
-  return RunCampaign(campaign, output_dir, options, cluster.get()).exit_code;
+  const campaign::CampaignRunSummary summary =
+      RunCampaign(campaign, output_dir, options, cluster.get());
+  // Said even with --quiet: results the user had were lost and recomputed.
+  for (const std::string& damaged : summary.damaged_cases) {
+    std::cerr << "mbid: warning: " << output_dir << ": case " << damaged << "; computed again\n";
+  }
+  // Rank 0 throws the folder's error itself; the other ranks learn only that it stopped.
+  return static_cast<int>(summary.stopped_before_running ? ExitCode::kInvalidInput
+                                                         : ExitCode::kSuccess);
 }
 
 }  // namespace mbid::app

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mbid/app/commands.h"
+#include "mbid/app/exit_code.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
@@ -153,7 +154,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     std::cerr << fmt::format("mbid: numerical failure: updating: {}: {}\n",
                              result.termination_name(), result.message);
   }
-  return static_cast<int>(result.exit_code());
+  return static_cast<int>(converged ? ExitCode::kSuccess : ExitCode::kNumericalFailure);
 }
 
 }  // namespace mbid::app

@@ -1,6 +1,13 @@
 #include "results_folder.h"
 
+#include <fmt/format.h>
+#include <zlib.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "mbid/campaign/campaign_case.h"
@@ -16,12 +23,55 @@ constexpr char kManifest[] = "campaign.json";
 constexpr char kMerged[] = "campaign.h5";
 constexpr char kFormat[] = "mbid-campaign";
 constexpr int kFormatVersion = 1;
+// A case file written completely but not yet renamed to its checksummed name.
+constexpr char kUnsealed[] = ".unsealed.h5";
+
+// CRC-32 (zlib) of a file's bytes: catches the zeroed or lost blocks a power cut leaves in a
+// file that was renamed but never synced.
+uint32_t FileCrc32(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot be read: " + std::strerror(errno));
+  uLong crc = crc32(0L, Z_NULL, 0);
+  std::vector<char> buffer(1 << 16);
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const std::streamsize got = in.gcount();
+    if (got > 0)
+      crc = crc32(crc, reinterpret_cast<const Bytef*>(buffer.data()), static_cast<uInt>(got));
+  }
+  if (in.bad()) throw std::runtime_error(path + ": read failed");
+  return static_cast<uint32_t>(crc);
+}
+
+// "<id>.<8 hex digits>.h5" -> id and checksum; false for any other name.
+bool ParseCommittedName(const std::string& name, std::string* id, uint32_t* crc) {
+  constexpr size_t kHex = 8;
+  if (name.size() < kHex + 5 || name.compare(name.size() - 3, 3, ".h5") != 0) return false;
+  const size_t dot = name.size() - 3 - kHex - 1;
+  if (name[dot] != '.') return false;
+  const std::string hex = name.substr(dot + 1, kHex);
+  if (hex.find_first_not_of("0123456789abcdef") != std::string::npos) return false;
+  *id = name.substr(0, dot);
+  *crc = static_cast<uint32_t>(std::stoul(hex, nullptr, 16));
+  return !id->empty();
+}
+
+// What a kill between creating the folder and committing the manifest leaves: nothing, an
+// empty cases/ or a temporary of the manifest. Such a folder starts afresh.
+bool IsHalfCreated(const fs::path& dir) {
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(dir, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name == "cases" && fs::is_directory(entry.path()) && fs::is_empty(entry.path())) continue;
+    if (name.rfind(kManifest, 0) == 0 && name.find(".tmp-") != std::string::npos) continue;
+    if (name.rfind(std::string(".") + kManifest, 0) == 0 && name.find(".tmp-") != std::string::npos)
+      continue;
+    return false;
+  }
+  return !error;
+}
 
 }  // namespace
-
-std::string ResultsFolder::CasePath(const std::string& case_id) const {
-  return (fs::path(dir_) / "cases" / (case_id + ".h5")).string();
-}
 
 std::string ResultsFolder::Path(const std::string& name) const {
   return (fs::path(dir_) / name).string();
@@ -48,12 +98,13 @@ ResultsFolder::State ResultsFolder::Prepare(const Campaign& campaign, bool resum
     fs::create_directories(dir / "cases", error);
     return State::kResumed;
   }
-  if (fs::exists(dir) && !(fs::is_directory(dir) && fs::is_empty(dir))) {
+  if (fs::exists(dir) && !(fs::is_directory(dir) && IsHalfCreated(dir))) {
     throw InputError(dir_, "", "exists and is not a campaign folder",
                      "a new or empty output folder");
   }
-  fs::create_directories(dir / "cases", error);
-  if (error || !fs::is_directory(dir / "cases")) {
+  // The manifest first: from then on the folder is this campaign's, whatever happens next.
+  fs::create_directories(dir, error);
+  if (error || !fs::is_directory(dir)) {
     throw InputError(dir_, "", "cannot create the folder (" + error.message() + ")",
                      "a writable location for the results");
   }
@@ -63,15 +114,24 @@ ResultsFolder::State ResultsFolder::Prepare(const Campaign& campaign, bool resum
              {"fingerprint", campaign.Fingerprint()},
              {"cases", campaign.cases.size()}},
             manifest_path.string());
+  fs::create_directories(dir / "cases", error);
+  if (error || !fs::is_directory(dir / "cases")) {
+    throw InputError(dir_, "", "cannot create cases/ (" + error.message() + ")",
+                     "a writable location for the results");
+  }
   return State::kNew;
 }
 
-std::vector<bool> ResultsFolder::ScanCommitted(const Campaign& campaign) const {
+ResultsFolder::Scan ResultsFolder::ScanCommitted(const Campaign& campaign) const {
   const fs::path cases = fs::path(dir_) / "cases";
   std::error_code error;
-  // Temporaries of a process that was killed: AtomicFile names them "<file>.tmp-<pid>-<n>".
+  // Temporaries of a process that was killed: AtomicFile names them "<file>.tmp-<pid>-<n>";
+  // unsealed case files lost their process before the checksummed rename.
   for (const auto& entry : fs::directory_iterator(cases, error)) {
-    if (entry.path().filename().string().find(".tmp-") != std::string::npos) {
+    const std::string name = entry.path().filename().string();
+    std::string id;
+    uint32_t crc = 0;
+    if (name.find(".tmp-") != std::string::npos || !ParseCommittedName(name, &id, &crc)) {
       fs::remove(entry.path(), error);
     }
   }
@@ -80,18 +140,62 @@ std::vector<bool> ResultsFolder::ScanCommitted(const Campaign& campaign) const {
       fs::remove_all(entry.path(), error);
     }
   }
-  std::vector<bool> committed(campaign.cases.size(), false);
-  for (size_t i = 0; i < campaign.cases.size(); ++i) {
-    const std::string path = CasePath(campaign.cases[i].id);
-    if (!fs::exists(path)) continue;
-    try {
-      ReadCaseRow(path);
-      committed[i] = true;
-    } catch (const std::exception&) {
-      fs::remove(path, error);  // not a complete case file: run the case again
+  std::map<std::string, size_t> index;
+  for (size_t i = 0; i < campaign.cases.size(); ++i) index[campaign.cases[i].id] = i;
+  Scan scan;
+  scan.committed.assign(campaign.cases.size(), false);
+  for (const auto& [id, path] : FindCommittedCases()) {
+    const auto it = index.find(id);
+    std::string why;
+    if (it == index.end()) {
+      why = "not a case of this campaign";
+    } else {
+      std::string name;
+      uint32_t expected = 0;
+      ParseCommittedName(fs::path(path).filename().string(), &name, &expected);
+      try {
+        const uint32_t actual = FileCrc32(path);
+        if (actual != expected) {
+          why = fmt::format("damaged file (CRC-32 {:08x}, committed as {:08x})", actual, expected);
+        } else {
+          ReadCaseRow(path);
+          scan.committed[it->second] = true;
+          continue;
+        }
+      } catch (const std::exception& failure) {
+        why = failure.what();
+      }
+    }
+    fs::remove(path, error);
+    if (it != index.end()) scan.damaged.push_back(id + ": " + why);
+  }
+  return scan;
+}
+
+void ResultsFolder::CommitCase(const std::string& case_id,
+                               const std::function<void(const std::string& path)>& write) const {
+  const fs::path cases = fs::path(dir_) / "cases";
+  const std::string unsealed = (cases / (case_id + kUnsealed)).string();
+  write(unsealed);
+  const std::string sealed =
+      (cases / fmt::format("{}.{:08x}.h5", case_id, FileCrc32(unsealed))).string();
+  if (std::rename(unsealed.c_str(), sealed.c_str()) != 0) {
+    throw std::runtime_error(
+        fmt::format("cannot commit case file {}: {}", sealed, std::strerror(errno)));
+  }
+}
+
+std::map<std::string, std::string> ResultsFolder::FindCommittedCases() const {
+  std::map<std::string, std::string> found;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(fs::path(dir_) / "cases", error)) {
+    std::string id;
+    uint32_t crc = 0;
+    if (ParseCommittedName(entry.path().filename().string(), &id, &crc)) {
+      found[id] = entry.path().string();
     }
   }
-  return committed;
+  return found;
 }
 
 void ResultsFolder::RemoveCases() const {

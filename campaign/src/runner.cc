@@ -74,8 +74,17 @@ int FinishCampaign(const Campaign& campaign, const internal::ResultsFolder& fold
   std::vector<nlohmann::ordered_json> rows;
   rows.reserve(campaign.cases.size());
   int failed = 0;
+  const std::map<std::string, std::string> case_files = folder.FindCommittedCases();
+  const auto case_file = [&](const std::string& id) {
+    const auto it = case_files.find(id);
+    if (it == case_files.end()) {
+      throw std::runtime_error("campaign " + campaign.name + ": the file of case " + id +
+                               " disappeared from " + folder.Path("cases"));
+    }
+    return it->second;
+  };
   for (const CampaignCase& one_case : campaign.cases) {
-    rows.push_back(ReadCaseRow(folder.CasePath(one_case.id)));
+    rows.push_back(ReadCaseRow(case_file(one_case.id)));
     if (rows.back()["status"] != "ok") ++failed;
   }
   internal::WriteSummaryCsv(rows, folder.Path("summary.csv"));
@@ -97,7 +106,7 @@ int FinishCampaign(const Campaign& campaign, const internal::ResultsFolder& fold
     file.CopyTree(info_path, "/", {});
     file.CreateGroup("/cases");
     for (const CampaignCase& one_case : campaign.cases) {
-      file.CopyTree(folder.CasePath(one_case.id), "/cases/" + one_case.id,
+      file.CopyTree(case_file(one_case.id), "/cases/" + one_case.id,
                     {"format", "format_version", "row"});
     }
     if (fs::exists(study_path)) file.CopyTree(study_path, "/", {"format", "format_version"});
@@ -135,6 +144,7 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
 
   const internal::ResultsFolder folder(output_dir);
   std::vector<int> pending;
+  std::vector<std::string> damaged;
   std::exception_ptr folder_error;
   int decision = kRun;
   if (cluster.is_root()) {
@@ -147,10 +157,11 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
         fs::remove(folder.Path(".campaign-info.h5"), ignored);
         fs::remove(folder.Path(".study.h5"), ignored);
       } else {
-        const std::vector<bool> committed = folder.ScanCommitted(campaign);
-        for (size_t i = 0; i < committed.size(); ++i) {
-          if (!committed[i]) pending.push_back(static_cast<int>(i));
+        const internal::ResultsFolder::Scan scan = folder.ScanCommitted(campaign);
+        for (size_t i = 0; i < scan.committed.size(); ++i) {
+          if (!scan.committed[i]) pending.push_back(static_cast<int>(i));
         }
+        damaged = scan.damaged;
       }
     } catch (...) {
       folder_error = std::current_exception();
@@ -160,10 +171,11 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
   decision = cluster.Broadcast(decision);
   if (decision == kStop) {
     if (folder_error) std::rethrow_exception(folder_error);
-    summary.exit_code = 2;
+    summary.stopped_before_running = true;
     return summary;
   }
   summary.already_committed = summary.cases - static_cast<int>(pending.size());
+  summary.damaged_cases = damaged;
   internal::CampaignProgress progress(campaign.name, summary.cases, summary.already_committed,
                                       options.quiet || !cluster.is_root());
   if (decision == kAlreadyComplete) {
@@ -198,7 +210,8 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
       while (const std::optional<int> index = queue.Pop()) {
         const CaseOutcome outcome =
             ComputeCase(campaign, campaign.cases[static_cast<size_t>(*index)]);
-        WriteCaseFile(outcome, folder.CasePath(outcome.id));
+        folder.CommitCase(outcome.id,
+                          [&outcome](const std::string& path) { WriteCaseFile(outcome, path); });
         if (!outcome.ok()) ++tally.failed;
         ++tally.done;
         notify_main();

@@ -29,10 +29,4 @@ NumericalError::NumericalError(std::string stage, std::string reason)
       stage_(std::move(stage)),
       reason_(std::move(reason)) {}
 
-ExitCode ExitCodeFor(const std::exception& error) {
-  if (dynamic_cast<const InputError*>(&error) != nullptr) return ExitCode::kInvalidInput;
-  if (dynamic_cast<const NumericalError*>(&error) != nullptr) return ExitCode::kNumericalFailure;
-  return ExitCode::kOther;
-}
-
 }  // namespace mbid

@@ -47,7 +47,6 @@ TEST(CharacteristicTest, ExactPolesGiveTheModelsJointValues) {
       MakeCharacteristicProblem(*reference, ExactPoles(*crane.model), record, crane.excitation);
   const CharacteristicResult result = SolveCharacteristicEquation(problem, {});
   ASSERT_EQ(result.status, CharacteristicResult::Status::kSolved) << result.message;
-  EXPECT_EQ(result.exit_code(), ExitCode::kSuccess);
   const CharacteristicSolution& chosen = result.solutions[static_cast<size_t>(result.chosen)];
   const Eigen::VectorXd c = TrueJointValues(*crane.model, "c_");
   const Eigen::VectorXd d = TrueJointValues(*crane.model, "d_");
@@ -149,7 +148,6 @@ TEST(CharacteristicTest, GrowingPolesHaveNoAdmissibleSet) {
       MakeCharacteristicProblem(*crane.model, mirrored, std::nullopt, std::nullopt);
   const CharacteristicResult result = SolveCharacteristicEquation(problem, {});
   EXPECT_EQ(result.status, CharacteristicResult::Status::kNoAdmissibleSet) << result.message;
-  EXPECT_EQ(result.exit_code(), ExitCode::kNumericalFailure);
   EXPECT_EQ(result.status_name(), "no_admissible_set");
   ASSERT_FALSE(result.solutions.empty());
   for (const CharacteristicSolution& set : result.solutions) {

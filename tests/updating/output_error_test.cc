@@ -96,7 +96,6 @@ TEST(OutputErrorTest, NoiselessLoadDropFromFiftyPercentOffRecoversAllEight) {
   const UpdateResult result =
       UpdateModel(*crane.model, {{"load drop", record, crane.excitation, {}}}, options);
   ASSERT_EQ(result.termination, UpdateResult::Termination::kConverged) << result.message;
-  EXPECT_EQ(result.exit_code(), ExitCode::kSuccess);
   Record(result, *crane.model);
   for (const std::string& name : kAllParameters) {
     EXPECT_LT(std::abs(RelativeError(result, *crane.model, name)), 1e-5) << name;
@@ -289,7 +288,6 @@ TEST(OutputErrorTest, IterationLimitIsNoConvergenceNotSuccess) {
       UpdateModel(*crane.model, {{"deflection", record, crane.excitation, {}}}, options);
   EXPECT_EQ(result.termination, UpdateResult::Termination::kNoConvergence) << result.message;
   EXPECT_EQ(result.termination_name(), "no_convergence");
-  EXPECT_EQ(result.exit_code(), ExitCode::kNumericalFailure);
   EXPECT_FALSE(result.message.empty());
 }
 
@@ -304,7 +302,6 @@ TEST(OutputErrorTest, FailingSimulationIsAFailureResult) {
   const UpdateResult result =
       UpdateModel(*crane.model, {{"deflection", record, crane.excitation, {}}}, options);
   EXPECT_EQ(result.termination, UpdateResult::Termination::kFailure);
-  EXPECT_EQ(result.exit_code(), ExitCode::kNumericalFailure);
   EXPECT_NE(result.message.find("CV_TOO_MUCH_WORK"), std::string::npos) << result.message;
 }
 

@@ -310,10 +310,6 @@ std::string CharacteristicResult::status_name() const {
   return "unknown";
 }
 
-ExitCode CharacteristicResult::exit_code() const {
-  return status == Status::kSolved ? ExitCode::kSuccess : ExitCode::kNumericalFailure;
-}
-
 Eigen::VectorXd CalcCharacteristicResiduals(const CharacteristicProblem& problem,
                                             const Eigen::VectorXd& c, const Eigen::VectorXd& d) {
   Validate(problem);

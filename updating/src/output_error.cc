@@ -80,10 +80,6 @@ std::string UpdateResult::termination_name() const {
   return "failure";
 }
 
-ExitCode UpdateResult::exit_code() const {
-  return termination == Termination::kConverged ? ExitCode::kSuccess : ExitCode::kNumericalFailure;
-}
-
 const ParameterEstimate& UpdateResult::Find(const std::string& name) const {
   for (const ParameterEstimate& estimate : parameters) {
     if (estimate.name == name) return estimate;

@@ -2,6 +2,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "mbid/campaign/campaign.h"
 
@@ -22,6 +23,8 @@ struct CampaignRunOptions {
 struct CampaignRunSummary {
   int cases = 0;              // in the campaign
   int already_committed = 0;  // found committed by --resume
+  // Case files --resume found damaged (checksum or contents) and computed again: "<id>: <why>".
+  std::vector<std::string> damaged_cases;
   int ran = 0;                // cases this run computed (all ranks)
   int failed = 0;             // cases of the campaign with a status other than ok
   bool was_complete = false;  // --resume of a finished campaign: nothing to do
@@ -29,9 +32,9 @@ struct CampaignRunSummary {
   int workers = 1;          // per rank
   double wall_s = 0;        // the whole run on rank 0, merge and report included
   double cases_wall_s = 0;  // from the first case handed out to the last one committed
-  // Non-zero on ranks other than 0 when rank 0 stopped the campaign before it ran (rank 0
-  // throws the error itself).
-  int exit_code = 0;
+  // On ranks other than 0: rank 0 refused the results folder and stopped the campaign before
+  // it ran (rank 0 throws the error itself).
+  bool stopped_before_running = false;
 };
 
 // Runs `campaign` into `output_dir` (layout and resume rules: docs/campaigns.md): the pending

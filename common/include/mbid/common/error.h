@@ -5,11 +5,8 @@
 
 namespace mbid {
 
-// Exit codes of the `mbid` command (docs/interfaces: contracts).
-enum class ExitCode : int { kSuccess = 0, kOther = 1, kInvalidInput = 2, kNumericalFailure = 3 };
-
 // Input that breaks a contract: a file, field, flag or sample. The message has the form
-// "<source>[:<field>]: <problem>; expected <expected>" and maps to exit code 2.
+// "<source>[:<field>]: <problem>; expected <expected>" and is exit code 2 of the command line.
 class InputError : public std::runtime_error {
  public:
   InputError(std::string source, std::string field, std::string problem, std::string expected);
@@ -25,7 +22,7 @@ class InputError : public std::runtime_error {
 
 // A numerical method that failed on valid input (integrator, optimizer, no modes found).
 // `stage` names the method ("CVODES", "Ceres", "identification"), `reason` says why, in the
-// method's own words where it has them. Maps to exit code 3.
+// method's own words where it has them. Exit code 3 of the command line.
 class NumericalError : public std::runtime_error {
  public:
   NumericalError(std::string stage, std::string reason);
@@ -36,8 +33,5 @@ class NumericalError : public std::runtime_error {
  private:
   std::string stage_, reason_;
 };
-
-// The exit code of the contract for an exception that reached the command line.
-ExitCode ExitCodeFor(const std::exception& error);
 
 }  // namespace mbid

@@ -133,8 +133,6 @@ struct CharacteristicResult {
   std::string message;
 
   std::string status_name() const;  // "solved" | "no_admissible_set" | "no_solution"
-  // kSolved: 0; otherwise 3 (a numerical failure of the contract).
-  ExitCode exit_code() const;
 };
 
 // Solves eq. 7 for the diagonal c, d from every start, deduplicates, drops sets with negative

@@ -222,8 +222,6 @@ struct UpdateResult {
   std::string jacobian;  // "sensitivities" | "numeric"
 
   std::string termination_name() const;  // "converged" | "no_convergence" | "failure"
-  // converged: 0; otherwise 3 (the contract's numerical failure).
-  ExitCode exit_code() const;
   // The estimate named `name`; throws std::out_of_range if absent.
   const ParameterEstimate& Find(const std::string& name) const;
 };
