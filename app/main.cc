@@ -210,7 +210,8 @@ int Main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version
-    std::cerr << "mbid: error: command line: " << error.what() << "; expected see mbid --help\n";
+    std::cerr << "mbid: error: command line: " << mbid::OneLine(error.what())
+              << "; expected see mbid --help\n";
     return static_cast<int>(mbid::app::ExitCode::kInvalidInput);
   }
   common.import = MakeOverrides(import_flags);
@@ -267,7 +268,7 @@ int main(int argc, char** argv) {
     std::cerr << "mbid: numerical failure: " << error.what() << "\n";
     return static_cast<int>(mbid::app::ExitCode::kNumericalFailure);
   } catch (const std::exception& error) {
-    std::cerr << "mbid: failure: " << error.what() << "\n";
+    std::cerr << "mbid: failure: " << mbid::OneLine(error.what()) << "\n";
     return static_cast<int>(mbid::app::ExitCode::kOther);
   }
 }

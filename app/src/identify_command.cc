@@ -17,10 +17,7 @@ using validation::MergeImportOptions;
 int RunIdentifyCommand(const std::string& data_path,
                        const identification::IdentificationOptions& options,
                        const std::string& output_path, const CommonOptions& common) {
-  std::string why;
-  if (!options.IsValid(&why)) {
-    throw InputError("command line", "identification options", why, "see mbid identify --help");
-  }
+  options.Validate("command line");  // before reading a possibly large file
   records::ImportReport import;
   const Measurement measurement = records::ImportMeasurement(
       data_path, MergeImportOptions({}, common.import, nullptr), &import);

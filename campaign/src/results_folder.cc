@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mbid/campaign/campaign_case.h"
+#include "mbid/common/crash_point.h"
 #include "mbid/common/error.h"
 #include "mbid/common/json_io.h"
 
@@ -114,6 +115,7 @@ ResultsFolder::State ResultsFolder::Prepare(const Campaign& campaign, bool resum
              {"fingerprint", campaign.Fingerprint()},
              {"cases", campaign.cases.size()}},
             manifest_path.string());
+  CrashPoint("campaign-manifest");
   fs::create_directories(dir / "cases", error);
   if (error || !fs::is_directory(dir / "cases")) {
     throw InputError(dir_, "", "cannot create cases/ (" + error.message() + ")",
@@ -177,6 +179,7 @@ void ResultsFolder::CommitCase(const std::string& case_id,
   const fs::path cases = fs::path(dir_) / "cases";
   const std::string unsealed = (cases / (case_id + kUnsealed)).string();
   write(unsealed);
+  CrashPoint("case-unsealed");
   const std::string sealed =
       (cases / fmt::format("{}.{:08x}.h5", case_id, FileCrc32(unsealed))).string();
   if (std::rename(unsealed.c_str(), sealed.c_str()) != 0) {

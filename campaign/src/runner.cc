@@ -14,6 +14,7 @@
 #include "mbid/campaign/campaign_case.h"
 #include "mbid/campaign/campaign_runner.h"
 #include "mbid/common/atomic_file.h"
+#include "mbid/common/crash_point.h"
 #include "mbid/common/hdf5_io.h"
 #include "progress.h"
 #include "report.h"
@@ -112,7 +113,9 @@ int FinishCampaign(const Campaign& campaign, const internal::ResultsFolder& fold
     if (fs::exists(study_path)) file.CopyTree(study_path, "/", {"format", "format_version"});
     file.Close();
   }
+  CrashPoint("campaign-merge");
   merged.Commit();
+  CrashPoint("campaign-merged");
   std::error_code ignored;
   fs::remove(info_path, ignored);
   fs::remove(study_path, ignored);

@@ -1,6 +1,7 @@
 #include "mbid/common/atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -10,6 +11,7 @@
 #include <system_error>
 
 #include "internal.h"
+#include "mbid/common/crash_point.h"
 #include "mbid/common/error.h"
 
 namespace mbid {
@@ -21,6 +23,32 @@ namespace fs = std::filesystem;
 std::string MakeTempPath(const std::string& path) {
   static std::atomic<unsigned> counter{0};
   return path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+// Temporaries "<path>.tmp-<pid>-<n>" of this very output left by processes that no longer exist
+// (kill -9, a crash, a power cut): nobody else names files so, and nobody will commit them.
+void RemoveStaleTemporaries(const std::string& path) {
+  const fs::path target(path);
+  const std::string prefix = target.filename().string() + ".tmp-";
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = name.substr(prefix.size());  // "<pid>-<n>"
+    const size_t dash = rest.find('-');
+    if (dash == 0 || dash == std::string::npos || dash > 9 ||
+        rest.find_first_not_of("0123456789-") != std::string::npos ||
+        rest.find('-', dash + 1) != std::string::npos || dash + 1 == rest.size()) {
+      continue;
+    }
+    const pid_t pid = static_cast<pid_t>(std::stol(rest.substr(0, dash)));
+    std::error_code ignored;
+    if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH &&
+        entry.is_regular_file(ignored)) {
+      fs::remove(entry.path(), ignored);
+    }
+  }
 }
 
 }  // namespace
@@ -83,6 +111,7 @@ AtomicFile::AtomicFile(std::string path, bool sync) : path_(std::move(path)), sy
   if (fs::exists(status) && !fs::is_regular_file(status)) {
     throw InputError(path_, "", "exists and is not a regular file", "an output file name");
   }
+  RemoveStaleTemporaries(path_);
   temp_path_ = MakeTempPath(path_);
   interrupt_cleanup_ = std::make_unique<RemoveOnInterrupt>(temp_path_);
 }
@@ -101,6 +130,7 @@ void AtomicFile::Commit() {
     throw std::runtime_error("cannot commit " + path_ + ": nothing was written to " + temp_path_);
   }
   if (sync_) internal::SyncFile(temp_path_);
+  CrashPoint("file-commit");
   interrupt_cleanup_->Commit([this] {
     std::error_code error;
     fs::rename(temp_path_, path_, error);
@@ -110,6 +140,7 @@ void AtomicFile::Commit() {
     }
   });
   committed_ = true;
+  CrashPoint("file-committed");
   if (sync_) internal::SyncFolder(fs::path(path_).parent_path().string());
 }
 

@@ -14,6 +14,7 @@
 #include <system_error>
 
 #include "internal.h"
+#include "mbid/common/crash_point.h"
 #include "mbid/common/error.h"
 
 namespace mbid {
@@ -155,6 +156,7 @@ void OutputFolder::Commit() {
   SyncTree(staging_);
   CheckFinal();  // the folder may have appeared or changed while the results were computed
   fs::path old;
+  CrashPoint("folder-commit");
   interrupt_cleanup_->Commit([&] {
     std::error_code error;
     if (!fs::exists(fs::symlink_status(final_, error))) {
@@ -190,6 +192,7 @@ void OutputFolder::Commit() {
     old = aside;
   });
   committed_ = true;
+  CrashPoint("folder-committed");
   internal::SyncFolder(final_.parent_path().string());
   std::error_code ignored;
   if (!old.empty()) fs::remove_all(old, ignored);

@@ -20,9 +20,7 @@ namespace mbid::identification {
 ModalResult Identify(const Measurement& measurement, const IdentificationOptions& options,
                      const std::string& origin) {
   ModalResult result;
-  if (const auto problem = FindOptionProblem(options)) {
-    throw InputError("identification options", problem->field, problem->problem, problem->expected);
-  }
+  options.Validate("identification options");
   bool from_rest = false;
   const IdentificationOptions applied = ApplyRelease(measurement, options, &result, &from_rest);
   const AnalysisRecord record = PrepareRecord(measurement, applied, origin);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "internal.h"
+#include "mbid/common/error.h"
 #include "methods/method.h"
 
 namespace mbid::identification {
@@ -104,6 +105,12 @@ bool IdentificationOptions::IsValid(std::string* error) const {
     *error = problem->field + ": " + problem->problem + "; expected " + problem->expected;
   }
   return !problem;
+}
+
+void IdentificationOptions::Validate(const std::string& source) const {
+  if (const std::optional<OptionProblem> problem = FindOptionProblem(*this)) {
+    throw InputError(source, problem->field, problem->problem, problem->expected);
+  }
 }
 
 }  // namespace mbid::identification

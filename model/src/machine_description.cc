@@ -201,8 +201,9 @@ void MachineDescription::Validate() const {
     if (!joint.in_parent_m.allFinite() || !joint.in_body_m.allFinite()) {
       Fail(field + ".joint", "non-finite joint position", "finite positions in m");
     }
-    if (!(std::isfinite(body.mass_kg) && body.mass_kg >= 0)) {
-      Fail(field + ".mass_kg", "mass " + std::to_string(body.mass_kg), "a finite mass >= 0 in kg");
+    // 1e9 kg is far past any machine and keeps inertias and their products finite.
+    if (!(std::isfinite(body.mass_kg) && body.mass_kg >= 0 && body.mass_kg <= 1e9)) {
+      Fail(field + ".mass_kg", "mass " + std::to_string(body.mass_kg), "a mass from 0 to 1e9 kg");
     }
     if (!body.com_m.allFinite()) Fail(field + ".com_m", "non-finite position", "finite, in m");
     CheckInertia(body, field + ".inertia_kgm2");

@@ -9,6 +9,19 @@
 namespace mbid::model {
 namespace {
 
+// Bounds far past any machine (the largest weigh ~1e7 kg, the longest booms ~250 m) that keep
+// masses, inertias and their products finite: 1e308 kg would overflow to inf in the model.
+constexpr double kMaxMass_kg = 1e9;
+constexpr double kMaxLength_m = 1000.0;
+
+double ReadMass(const YamlReader& reader, const std::string& key) {
+  const double mass_kg = reader.PositiveDouble(key);
+  if (mass_kg > kMaxMass_kg) {
+    reader.FailAt(key, "mass " + std::to_string(mass_kg) + " kg", "a mass up to 1e9 kg");
+  }
+  return mass_kg;
+}
+
 constexpr double kDegToRad = M_PI / 180.0;
 
 Eigen::Vector3d ReadVector3(const YamlReader& node, const std::string& key) {
@@ -55,22 +68,26 @@ TruckCraneParameters ReadTruckCraneParameters(const YamlReader& model) {
   const YamlReader base = model.Child("base");
   base.ExpectMap({"pitch_pivot_m", "mass_kg", "com_m", "inertia_kgm2"});
   p.p_GOa_m = ReadVector3(base, "pitch_pivot_m");
-  p.base_mass_kg = base.PositiveDouble("mass_kg");
+  p.base_mass_kg = ReadMass(base, "mass_kg");
   p.p_GBcm_m = ReadVector3(base, "com_m");
   p.base_inertia_kgm2 = ReadPrincipalInertia(base);
 
   const YamlReader slewing = model.Child("slewing");
   slewing.ExpectMap({"bearing_m", "mass_kg", "com_m", "inertia_kgm2"});
   p.p_GOs_m = ReadVector3(slewing, "bearing_m");
-  p.slewing_mass_kg = slewing.PositiveDouble("mass_kg");
+  p.slewing_mass_kg = ReadMass(slewing, "mass_kg");
   p.p_OsScm_S_m = ReadVector3(slewing, "com_m");
   p.slewing_inertia_kgm2 = ReadPrincipalInertia(slewing);
 
   const YamlReader boom = model.Child("boom");
   boom.ExpectMap({"foot_m", "mass_kg", "length_m", "axial_inertia_kgm2"});
   p.p_OsF_S_m = ReadVector3(boom, "foot_m");
-  p.boom_mass_kg = boom.PositiveDouble("mass_kg");
+  p.boom_mass_kg = ReadMass(boom, "mass_kg");
   p.boom_length_m = boom.PositiveDouble("length_m");
+  if (p.boom_length_m > kMaxLength_m) {
+    boom.FailAt("length_m", "length " + std::to_string(p.boom_length_m) + " m",
+                "a boom length up to 1000 m");
+  }
   p.boom_axial_inertia_kgm2 = boom.PositiveDouble("axial_inertia_kgm2");
 
   const YamlReader joints = model.Child("joints");

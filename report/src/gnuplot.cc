@@ -89,6 +89,15 @@ class ScratchFile {
   RemoveOnInterrupt cleanup_;
 };
 
+// A full disk shows only in the stream's state, after the last write is flushed.
+void CheckWritten(std::ofstream& out, const std::string& path) {
+  out.close();
+  if (out.fail()) {
+    throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno) +
+                             " (a full disk?)");
+  }
+}
+
 }  // namespace
 
 bool GnuplotAvailable() {
@@ -109,6 +118,7 @@ void DrawFigure(const Figure& figure, const std::string& png_path) {
       }
       out << "\n\n";
     }
+    CheckWritten(out, data.path());
   }
   {
     std::ofstream script(script_file.path());
@@ -131,6 +141,7 @@ void DrawFigure(const Figure& figure, const std::string& png_path) {
              << " title " << Quote(figure.series[k].title);
     }
     script << "\n";
+    CheckWritten(script, script_file.path());
   }
   const int status = Spawn({"gnuplot", AsArgument(script_file.path())}, log.path());
   if (status < 0) {
@@ -141,6 +152,15 @@ void DrawFigure(const Figure& figure, const std::string& png_path) {
     std::stringstream text;
     text << in.rdbuf();
     throw std::runtime_error("gnuplot failed on " + png_path + ": " + text.str());
+  }
+  std::error_code ignored;
+  if (std::filesystem::file_size(png.temp_path(), ignored) == 0 || ignored) {
+    // gnuplot reports a failed write of its output on standard error but exits with 0.
+    std::ifstream in(log.path());
+    std::stringstream text;
+    text << in.rdbuf();
+    throw std::runtime_error("cannot write " + png_path + ": gnuplot wrote no figure (" +
+                             (text.str().empty() ? "no message" : text.str()) + ")");
   }
   png.Commit();
 }

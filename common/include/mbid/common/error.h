@@ -34,4 +34,9 @@ class NumericalError : public std::runtime_error {
   std::string stage_, reason_;
 };
 
+// `text` made fit for one line of a message: control characters (line breaks, tabs, NUL) and
+// bytes that are not UTF-8 become "\xNN". Messages quote file contents; a quoted line break
+// or a stray byte must not break the one-line contract or the JSON written from them.
+std::string OneLine(const std::string& text);
+
 }  // namespace mbid

@@ -185,6 +185,9 @@ struct IdentificationOptions {
   // Ceres style: true if every option is in range; otherwise false with `error` (if given)
   // naming the option, its value and what was expected.
   bool IsValid(std::string* error = nullptr) const;
+  // The same as an InputError "<source>:<option>: <problem>; expected <range>", for callers
+  // whose options come from a file or a command line.
+  void Validate(const std::string& source) const;
 };
 
 }  // namespace mbid::identification
