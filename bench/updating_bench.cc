@@ -132,6 +132,9 @@ void BM_AnchorSensitivityRun(benchmark::State& state) {
   const auto& s = result.statistics;
   state.counters["rhs_evaluations"] = static_cast<double>(
       s.rhs_evaluations + s.rhs_evaluations_for_jacobian + s.rhs_evaluations_for_sensitivities);
+  state.counters["rhs_sensitivities"] = static_cast<double>(s.rhs_evaluations_for_sensitivities);
+  state.counters["steps"] = static_cast<double>(s.steps);
+  state.counters["nonlinear_iterations"] = static_cast<double>(s.nonlinear_iterations);
 }
 
 void BM_UpdateSensitivitiesCentered(benchmark::State& state) {
