@@ -96,7 +96,7 @@ class CvodesIntegrator {
 
   // The derivative dF/dp_k of the applied generalized forces (NU entries, mobility forces per
   // unit of p_k) by sensitivity parameter k at `state` (t, Y set, nominal parameters applied,
-  // realized to Velocity): true if known in closed form, false to let the integrator difference
+  // realized to Position): true if known in closed form, false to let the integrator difference
   // f in p_k. Sensitivity right-hand side kStateJacobian turns it into df/dp_k = [0 | M^-1 dF]
   // (forward-dynamics operator systems only).
   using ParameterForceDerivative =
