@@ -52,7 +52,7 @@ const Setup& Reference() {
 
 using Method = mbid::simulation::IntegratorOptions::Method;
 
-// `method`: the scenario's (BDF) unless given.
+// `method`: the scenario's (auto) unless given.
 void RunUpdate(benchmark::State& state, UpdateOptions::Jacobian jacobian,
                mbid::simulation::SensitivityOptions::DifferenceQuotient quotient,
                std::optional<Method> method = std::nullopt) {
@@ -101,7 +101,7 @@ mbid::simulation::SensorOptions FitSensors(const Setup& setup) {
   return sensors;
 }
 
-// Argument 0: the scenario's BDF, 1: Adams.
+// Argument 0: the scenario's method (auto: Adams), 1: Adams.
 void BM_AnchorPlainSimulation(benchmark::State& state) {
   const Setup& setup = Reference();
   mbid::simulation::SimulationOptions options = FitSimulation(setup);
@@ -123,15 +123,23 @@ void BM_AnchorSensitivityRun(benchmark::State& state) {
   sensitivity.difference_quotient =
       state.range(0) == 0 ? mbid::simulation::SensitivityOptions::DifferenceQuotient::kCentered
                           : mbid::simulation::SensitivityOptions::DifferenceQuotient::kForward;
+  if (state.range(0) == 2) {
+    sensitivity.right_hand_side =
+        mbid::simulation::SensitivityOptions::RightHandSide::kStateJacobian;
+  }
+  mbid::simulation::SimulationOptions simulation = FitSimulation(setup);
+  if (state.range(1) == 1) simulation.integrator.method = Method::kBdf;
   mbid::simulation::SensitivityResult result;
   for (auto _ : state) {
-    result = mbid::simulation::SimulateWithSensitivities(*setup.model, setup.test.excitation,
-                                                         FitSimulation(setup), FitSensors(setup),
-                                                         names, {}, sensitivity);
+    result = mbid::simulation::SimulateWithSensitivities(
+        *setup.model, setup.test.excitation, simulation, FitSensors(setup), names, {}, sensitivity);
   }
   const auto& s = result.statistics;
   state.counters["rhs_evaluations"] = static_cast<double>(
       s.rhs_evaluations + s.rhs_evaluations_for_jacobian + s.rhs_evaluations_for_sensitivities);
+  state.counters["rhs_sensitivities"] = static_cast<double>(s.rhs_evaluations_for_sensitivities);
+  state.counters["steps"] = static_cast<double>(s.steps);
+  state.counters["nonlinear_iterations"] = static_cast<double>(s.nonlinear_iterations);
 }
 
 void BM_UpdateSensitivitiesCentered(benchmark::State& state) {
@@ -152,8 +160,9 @@ void BM_UpdateNumeric(benchmark::State& state) {
 }
 
 BENCHMARK(BM_AnchorPlainSimulation)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-// 0: centered quotients, 1: forward.
-BENCHMARK(BM_AnchorSensitivityRun)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+// First argument 0: centered quotients, 1: forward, 2: kStateJacobian; second 0: the
+// scenario's method (auto: Adams), 1: BDF (what the scenario named before session 8).
+BENCHMARK(BM_AnchorSensitivityRun)->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 // One fit takes seconds: one iteration each, wall time (the threads work in parallel).
 BENCHMARK(BM_UpdateSensitivitiesCentered)
     ->Arg(1)

@@ -696,6 +696,20 @@ void MultibodyModel::ApplyParameterToState(SimTK::State& state, const std::strin
   state.invalidateAllCacheAtOrAbove(SimTK::Stage::Position);
 }
 
+MechanicalModel::ForceDerivative MultibodyModel::MakeParameterForceDerivative(
+    const std::string& name) const {
+  const auto [coordinate, stiffness] =
+      ParseSpringParameter(impl_->coordinates, impl_->machine, name, GetParameter(name));
+  const int n = coordinate_count();
+  // Coordinate i is q_i and u_i of the state (tree order, q' = u). The spring's force
+  // -c (q - q_n) with the preload's q_n = -g_0 / c is -c q - g_0.
+  return [coordinate = coordinate, stiffness = stiffness, n](const SimTK::State& state,
+                                                             Eigen::VectorXd& dforce) {
+    dforce.setZero(n);
+    dforce[coordinate] = stiffness ? -state.getQ()[coordinate] : -state.getU()[coordinate];
+  };
+}
+
 const SimTK::MultibodySystem& MultibodyModel::system() const { return impl_->system; }
 
 SimTK::State MultibodyModel::MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const {

@@ -8,6 +8,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -16,6 +17,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "mbid/common/error.h"
 
@@ -28,6 +30,16 @@ namespace {
 // limit every evaluation fails: SUNDIALS 6.4.1's fixed-point solver (Adams) turns an
 // unrecoverable RHS failure into a convergence failure, so only a sticky failure ends it.
 constexpr int kMaxRhsFailuresPerCall = 100;
+
+// Central-difference step of the state Jacobian's columns, relative to max(|Y_j|, 1): roundoff
+// (eps |f| / h, |f| holding the dead weight's cancelling terms) and truncation (h^2 times f's
+// third derivative, f smooth on the scale of 1 rad, m or rad/s) both near 1e-10 of J. Forward
+// steps of 1e-8 left 2e-4 errors in the excavator's weak swing-boom coupling (measured against
+// Richardson-extrapolated differences).
+constexpr double kJacobianStep = 1e-5;
+// Central-difference step of df/dp where no closed form is known, relative to the parameter's
+// scale: exact to roundoff (~1e-12) for forces affine in p, O(h^2) ~ 1e-8 otherwise.
+constexpr double kParameterStep = 1e-4;
 
 // Owners of SUNDIALS objects; each deleter is the matching SUNDIALS destructor.
 struct ContextDeleter {
@@ -103,6 +115,9 @@ class CvodesIntegrator::Impl {
   }
 
   void set_time_dependent_inputs(TimeDependentInputs hook) { hook_ = std::move(hook); }
+  void set_parameter_force_derivative(ParameterForceDerivative derivative) {
+    parameter_force_derivative_ = std::move(derivative);
+  }
   void set_multibody_system(const SimTK::MultibodySystem* system) { multibody_ = system; }
   void set_jacobian(Eigen::MatrixXd jacobian) { jacobian_ = std::move(jacobian); }
 
@@ -237,7 +252,10 @@ class CvodesIntegrator::Impl {
       throw std::invalid_argument("CvodesIntegrator: invalid SensitivityOptions: " + why);
     }
     const bool fixed_point = nonlinear_solver_ != nullptr;
-    if (fixed_point && options.corrector == SensitivityOptions::Corrector::kSimultaneous &&
+    const bool own_rhs =
+        options.right_hand_side == SensitivityOptions::RightHandSide::kStateJacobian;
+    if (!own_rhs && fixed_point &&
+        options.corrector == SensitivityOptions::Corrector::kSimultaneous &&
         options.difference_quotient == SensitivityOptions::DifferenceQuotient::kForward) {
       // Found on the crane: SUNDIALS 6.4.1's simultaneous fixed-point corrector with forward
       // quotients evaluates the right-hand side at NaN states at once.
@@ -262,9 +280,15 @@ class CvodesIntegrator::Impl {
     sensitivity_p_ = p;
     sensitivity_scale_ = scale;
     const bool simultaneous = options.corrector == SensitivityOptions::Corrector::kSimultaneous;
-    Check(CVodeSensInit1(cv, count, simultaneous ? CV_SIMULTANEOUS : CV_STAGGERED, nullptr,
-                         sensitivity_vectors_.get()),
-          "CVodeSensInit1");
+    jacobian_cached_ = false;
+    const int corrector = simultaneous ? CV_SIMULTANEOUS : CV_STAGGERED;
+    if (own_rhs) {
+      Check(CVodeSensInit(cv, count, corrector, &Impl::SensitivityRhs, sensitivity_vectors_.get()),
+            "CVodeSensInit");
+    } else {
+      Check(CVodeSensInit1(cv, count, corrector, nullptr, sensitivity_vectors_.get()),
+            "CVodeSensInit1");
+    }
     sensitivity_count_ = count;
     Check(CVodeSetSensParams(cv, sensitivity_p_.data(), sensitivity_scale_.data(), nullptr),
           "CVodeSetSensParams");
@@ -275,9 +299,11 @@ class CvodesIntegrator::Impl {
           "CVodeSensSStolerances");
     const bool centered =
         options.difference_quotient == SensitivityOptions::DifferenceQuotient::kCentered;
-    // rhomax = 0: perturb Y and p together, one quotient per sensitivity.
-    Check(CVodeSetSensDQMethod(cv, centered ? CV_CENTERED : CV_FORWARD, 0.0),
-          "CVodeSetSensDQMethod");
+    if (!own_rhs) {
+      // rhomax = 0: perturb Y and p together, one quotient per sensitivity.
+      Check(CVodeSetSensDQMethod(cv, centered ? CV_CENTERED : CV_FORWARD, 0.0),
+            "CVodeSetSensDQMethod");
+    }
     Check(CVodeSetSensErrCon(cv, options.error_control ? SUNTRUE : SUNFALSE), "CVodeSetSensErrCon");
     if (fixed_point) {
       // Without a linear solver the sensitivities need fixed-point iteration too; CVODES'
@@ -321,6 +347,8 @@ class CvodesIntegrator::Impl {
       CVodeGetNumLinRhsEvals(cv, &s.rhs_evaluations_for_jacobian);
     }
     if (sensitivity_count_ > 0) CVodeGetNumRhsEvalsSens(cv, &s.rhs_evaluations_for_sensitivities);
+    s.rhs_evaluations_for_sensitivities += own_sensitivity_rhs_;
+    s.sensitivity_jacobians = sensitivity_jacobians_;
     return s;
   }
 
@@ -334,6 +362,9 @@ class CvodesIntegrator::Impl {
     sensitivity_nonlinear_solver_.reset();
     sensitivity_vectors_.Reset();
     sensitivities_.resize(0, 0);
+    jacobian_cached_ = false;
+    own_sensitivity_rhs_ = 0;
+    sensitivity_jacobians_ = 0;
     nonlinear_solver_.reset();
     linear_solver_.reset();
     matrix_.reset();
@@ -433,6 +464,119 @@ class CvodesIntegrator::Impl {
     return self->rhs_failures_ > kMaxRhsFailuresPerCall ? -1 : 1;
   }
 
+  // s_i' = J s_i + df/dp_i for CVODES (kStateJacobian); J and df/dp come from the cache of
+  // (t, Y), so every sensitivity and corrector iteration at one point shares one J.
+  static int SensitivityRhs(int count, realtype t, N_Vector y, N_Vector /*y_dot*/, N_Vector* s,
+                            N_Vector* s_dot, void* user_data, N_Vector, N_Vector) {
+    auto* self = static_cast<Impl*>(user_data);
+    if (self->rhs_failures_ > kMaxRhsFailuresPerCall) return -1;
+    try {
+      self->UpdateSensitivityJacobian(t, N_VGetArrayPointer(y));
+      const Eigen::Index ny = self->state_jacobian_.rows();
+      for (int i = 0; i < count; ++i) {
+        const Eigen::Map<const Eigen::VectorXd> s_i(N_VGetArrayPointer(s[i]), ny);
+        Eigen::Map<Eigen::VectorXd> s_dot_i(N_VGetArrayPointer(s_dot[i]), ny);
+        s_dot_i.noalias() = self->state_jacobian_ * s_i;
+        s_dot_i += self->parameter_derivative_.col(i);
+      }
+      return 0;
+    } catch (const std::exception& e) {
+      self->RecordRhsError(t, e.what());
+    } catch (...) {
+      self->RecordRhsError(t, "unknown exception");
+    }
+    return self->rhs_failures_ > kMaxRhsFailuresPerCall ? -1 : 1;
+  }
+
+  // J = df/dY and df/dp at (t, Y) unless they are cached for these very bits.
+  void UpdateSensitivityJacobian(double t, const realtype* y) {
+    const int ny = state_.getNY();
+    if (jacobian_cached_ && t == jacobian_time_ && std::equal(y, y + ny, jacobian_y_.data())) {
+      return;
+    }
+    jacobian_cached_ = false;
+    const int nq = state_.getNQ();
+    const int nu = state_.getNU();
+    const int count = sensitivity_count_;
+    state_jacobian_.resize(ny, ny);
+    parameter_derivative_.resize(ny, count);
+    f_forward_.resize(ny);
+    column_.resize(ny);
+    SetTimeAndY(t, y);  // nominal parameters: the input hook applies sensitivity_p_ as it is
+    system_->realize(state_, SimTK::Stage::Position);  // for M^-1 below
+    // df/dp_k = [0 | M^-1 dF/dp_k] where the forces' derivative is known, while the state is
+    // realized at (t, Y) (M^-1 reuses its articulated-body inertias); the rest by differences.
+    std::vector<int> differenced;
+    mobility_force_.resize(nu);
+    for (int k = 0; k < count; ++k) {
+      bool known = forward_dynamics_operator_ && parameter_force_derivative_ &&
+                   parameter_force_derivative_(state_, k, dforce_);
+      if (known && dforce_.size() != nu) {
+        throw std::logic_error(
+            "CvodesIntegrator: the parameter force derivative has the wrong size; expected NU "
+            "entries");
+      }
+      if (!known) {
+        differenced.push_back(k);
+        continue;
+      }
+      parameter_derivative_.col(k).setZero();
+      for (int i = 0; i < nu; ++i) mobility_force_[i] = dforce_[i];
+      multibody_->getMatterSubsystem().multiplyByMInv(state_, mobility_force_, m_inv_force_);
+      for (int i = 0; i < nu; ++i) parameter_derivative_(nq + i, k) = m_inv_force_[i];
+    }
+    // Columns of J: only the perturbed entry changes, so a speed keeps the Position stage.
+    for (int j = 0; j < ny; ++j) {
+      const double h = kJacobianStep * std::max(std::abs(y[j]), 1.0);
+      const double forward = y[j] + h;
+      const double backward = y[j] - h;
+      SetEntry(j, nq, nu, forward);
+      CalcDerivative(column_.data());
+      f_forward_ = column_;
+      SetEntry(j, nq, nu, backward);
+      CalcDerivative(column_.data());
+      SetEntry(j, nq, nu, y[j]);
+      state_jacobian_.col(j) = (f_forward_ - column_) / (forward - backward);
+    }
+    own_sensitivity_rhs_ += 2 * ny;
+    for (int k : differenced) {
+      // The input hook reads the parameters from sensitivity_p_ (as for CVODES' quotients).
+      const double nominal = sensitivity_p_[k];
+      const double h = kParameterStep * sensitivity_scale_[k];
+      auto evaluate_at = [&](double value) {
+        sensitivity_p_[k] = value;
+        if (hook_) hook_(state_);
+        CalcDerivative(column_.data());
+        ++own_sensitivity_rhs_;
+        return Eigen::VectorXd(column_);
+      };
+      try {
+        const Eigen::VectorXd plus = evaluate_at(nominal + h);
+        parameter_derivative_.col(k) = (plus - evaluate_at(nominal - h)) / (2 * h);
+      } catch (...) {
+        sensitivity_p_[k] = nominal;
+        throw;
+      }
+      sensitivity_p_[k] = nominal;
+      if (hook_) hook_(state_);
+    }
+    ++sensitivity_jacobians_;
+    jacobian_time_ = t;
+    jacobian_y_.assign(y, y + ny);
+    jacobian_cached_ = true;
+  }
+
+  // Y_j of the working state, through q, u or z so that only the stages above it are redone.
+  void SetEntry(int j, int nq, int nu, double value) {
+    if (j < nq) {
+      state_.updQ()[j] = value;
+    } else if (j < nq + nu) {
+      state_.updU()[j - nq] = value;
+    } else {
+      state_.updZ()[j - nq - nu] = value;
+    }
+  }
+
   // Y' of the working state (t and Y set, inputs applied) into `out` (NY values).
   void CalcDerivative(realtype* out) {
     if (!forward_dynamics_operator_) {
@@ -489,7 +633,18 @@ class CvodesIntegrator::Impl {
   IntegratorOptions options_;
   IntegratorOptions::Method method_ = IntegratorOptions::Method::kBdf;  // the one running
   TimeDependentInputs hook_;
+  ParameterForceDerivative parameter_force_derivative_;
   Eigen::MatrixXd jacobian_;  // empty: difference quotients
+  // kStateJacobian's cache: J and df/dp at (jacobian_time_, jacobian_y_), and scratch.
+  bool jacobian_cached_ = false;
+  double jacobian_time_ = 0.0;
+  std::vector<double> jacobian_y_;
+  Eigen::MatrixXd state_jacobian_;
+  Eigen::MatrixXd parameter_derivative_;
+  Eigen::VectorXd f_forward_, column_, dforce_;
+  SimTK::Vector mobility_force_, m_inv_force_;
+  long own_sensitivity_rhs_ = 0;
+  long sensitivity_jacobians_ = 0;
   SimTK::State state_;
   bool has_state_ = false;
   bool initialized_ = false;  // CVODES is ready to advance state_.
@@ -528,6 +683,9 @@ CvodesIntegrator& CvodesIntegrator::operator=(CvodesIntegrator&&) noexcept = def
 
 void CvodesIntegrator::set_time_dependent_inputs(TimeDependentInputs hook) {
   impl_->set_time_dependent_inputs(std::move(hook));
+}
+void CvodesIntegrator::set_parameter_force_derivative(ParameterForceDerivative derivative) {
+  impl_->set_parameter_force_derivative(std::move(derivative));
 }
 void CvodesIntegrator::set_jacobian(Eigen::MatrixXd jacobian) {
   impl_->set_jacobian(std::move(jacobian));

@@ -46,6 +46,10 @@ bool SensitivityOptions::IsValid(std::string* why) const {
     if (why != nullptr) *why = std::move(reason);
     return false;
   };
+  if (right_hand_side != RightHandSide::kStateJacobian &&
+      right_hand_side != RightHandSide::kCvodesQuotients) {
+    return fail("right_hand_side: unknown value; expected kStateJacobian or kCvodesQuotients");
+  }
   if (corrector != Corrector::kSimultaneous && corrector != Corrector::kStaggered) {
     return fail("corrector: unknown value; expected kSimultaneous or kStaggered");
   }
@@ -74,6 +78,7 @@ IntegratorStatistics& IntegratorStatistics::operator+=(const IntegratorStatistic
   jacobian_evaluations += later.jacobian_evaluations;
   rhs_evaluations_for_jacobian += later.rhs_evaluations_for_jacobian;
   rhs_evaluations_for_sensitivities += later.rhs_evaluations_for_sensitivities;
+  sensitivity_jacobians += later.sensitivity_jacobians;
   last_step_s = later.last_step_s;
   last_order = later.last_order;
   method = later.method;

@@ -121,6 +121,24 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
       }
     }
   });
+  // The forces' derivatives in closed form where the model knows them: no right-hand side per
+  // parameter. Initial-state directions are not read by the right-hand side (df/dp = 0).
+  std::vector<model::MechanicalModel::ForceDerivative> force_derivatives;
+  for (const std::string& name : model_parameters) {
+    force_derivatives.push_back(simulated.MakeParameterForceDerivative(name));
+  }
+  integrator.set_parameter_force_derivative(
+      [&](const SimTK::State& state, int k, Eigen::VectorXd& dforce) {
+        if (k >= model_count) {
+          dforce.setZero(n);
+          return true;
+        }
+        const model::MechanicalModel::ForceDerivative& derivative =
+            force_derivatives[static_cast<size_t>(k)];
+        if (!derivative) return false;
+        derivative(state, dforce);
+        return true;
+      });
   // As in Simulate: the linearization as Newton Jacobian, for the state and the sensitivities.
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
   SimTK::State initial = simulated.MakeState(result.initial_q, zero);

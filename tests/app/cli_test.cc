@@ -66,7 +66,7 @@ const BadScenario kBadScenarios[] = {
     {"UnknownModelType", "type: truck_crane", "type: truck_crain", "model.type", "truck_crane"},
     {"NegativeNoise", "noise_std_rad: 1.0e-05", "noise_std_rad: -1.0e-05", "sensors.noise_std_rad",
      ">= 0"},
-    {"UnknownIntegrator", "method: bdf", "method: rk4", "simulation.integrator.method", "adams"},
+    {"UnknownIntegrator", "method: auto", "method: rk4", "simulation.integrator.method", "adams"},
     {"MissingModel", "model:\n  type: truck_crane", "modell:\n  type: truck_crane", "modell",
      "model"},
 };

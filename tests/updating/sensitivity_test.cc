@@ -59,8 +59,9 @@ void CheckAgainstDifferences(const Crane& crane, double duration_s,
   SensorOptions sensors;
   sensors.sample_rate_hz = 50.0;               // the sensitivities do not depend on the sampling
   sensors.channels = {"psi", "phi", "theta"};  // outputs and a coordinate channel
-  // The settings of the fit: the scenario's BDF at 1e-8, interpolated outputs; CVODES'
-  // quotients centered (the simulation layer's default) and forward (the fit's default).
+  // The settings of the fit: the scenario's method (auto: Adams here) at 1e-8, interpolated
+  // outputs; CVODES' quotients centered (the simulation layer's default) and forward (the fit's
+  // default).
   options.integrator.interpolate_outputs = true;
   SensitivityOptions forward;
   forward.difference_quotient = SensitivityOptions::DifferenceQuotient::kForward;

@@ -71,6 +71,14 @@ class MechanicalModel {
   // sensitivities. Invalidates the state's Instance stage. Same checks as SetParameter.
   virtual void ApplyParameterToState(SimTK::State& state, const std::string& name,
                                      double value) const = 0;
+  // dF/dp: the derivative of the generalized applied forces (one per coordinate, N*m or N per
+  // unit of p) by parameter `name` at a state's q and u, for parameters the forces are affine
+  // in, resolved once per name. Empty where the model has no closed form: callers then
+  // difference the right-hand side in p (forward sensitivities, simulation/sensitivity.h).
+  using ForceDerivative = std::function<void(const SimTK::State& state, Eigen::VectorXd& dforce)>;
+  virtual ForceDerivative MakeParameterForceDerivative(const std::string& /*name*/) const {
+    return {};
+  }
 
   // The Simbody system; realized to Topology.
   virtual const SimTK::MultibodySystem& system() const = 0;

@@ -39,6 +39,9 @@ class MultibodyModel final : public MechanicalModel {
   void SetParameter(const std::string& name, double value) override;
   void ApplyParameterToState(SimTK::State& state, const std::string& name,
                              double value) const override;
+  // -q_i e_i for c_i (the preload rule keeps the spring force -c q - g_0 affine in c), -u_i e_i
+  // for d_i.
+  ForceDerivative MakeParameterForceDerivative(const std::string& name) const override;
 
   const SimTK::MultibodySystem& system() const override;
   SimTK::State MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const override;

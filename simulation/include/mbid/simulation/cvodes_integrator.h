@@ -94,8 +94,17 @@ class CvodesIntegrator {
   // Initialize() and std::invalid_argument for t < time().
   const SimTK::State& AdvanceTo(double t, Realization realization = Realization::kAccelerations);
 
-  // Forward sensitivities s_i = dY/dp_i of parameters p (CVodeSensInit1 with CVODES' own
-  // difference quotients of the right-hand side). CVODES perturbs the values it reads through
+  // The derivative dF/dp_k of the applied generalized forces (NU entries, mobility forces per
+  // unit of p_k) by sensitivity parameter k at `state` (t, Y set, nominal parameters applied,
+  // realized to Position): true if known in closed form, false to let the integrator difference
+  // f in p_k. Sensitivity right-hand side kStateJacobian turns it into df/dp_k = [0 | M^-1 dF]
+  // (forward-dynamics operator systems only).
+  using ParameterForceDerivative =
+      std::function<bool(const SimTK::State& state, int k, Eigen::VectorXd& dforce)>;
+  void set_parameter_force_derivative(ParameterForceDerivative derivative);
+
+  // Forward sensitivities s_i = dY/dp_i of parameters p (CVodeSensInit1; the right-hand side as
+  // options.right_hand_side says). Difference quotients in p perturb the values read through
   // sensitivity_parameters(), so the right-hand side must take its parameters from there: the
   // input hook applies them to the working state. `scale` (p_scale_i > 0) sets the size of the
   // perturbations and the sensitivities' absolute tolerance; `initial` (NY x Np) is s_i at

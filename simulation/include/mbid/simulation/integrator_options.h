@@ -45,10 +45,22 @@ IntegratorOptions::Method ChooseMethod(const Eigen::MatrixXd& jacobian);
 // "bdf", "adams" or "auto".
 const char* MethodName(IntegratorOptions::Method method);
 
-// How CvodesIntegrator integrates forward sensitivities s_i = dY/dp_i (CVODES, with difference
-// quotients of the right-hand side itself; docs/toolchain.md). Checked by IsValid() when the
-// sensitivities are initialized.
+// How CvodesIntegrator integrates forward sensitivities s_i = dY/dp_i (CVODES; docs/toolchain.md).
+// Checked by IsValid() when the sensitivities are initialized.
 struct SensitivityOptions {
+  // Where the sensitivity right-hand side s_i' = J s_i + df/dp_i comes from.
+  enum class RightHandSide {
+    // CVODES' own difference quotients of f along (s_i, p_i): one (forward) or two (centered)
+    // right-hand sides per sensitivity and corrector iteration.
+    kCvodesQuotients,
+    // J = df/dY formed once per distinct (t, Y) by central differences of f (2 NY right-hand
+    // sides) and reused for every sensitivity and corrector iteration; df/dp_i in closed form
+    // where CvodesIntegrator::set_parameter_force_derivative knows it, else central differences
+    // of f in p_i alone. Cheaper than forward quotients only for more than 2 NY sensitivities
+    // (the crane, 8 parameters and NY = 8: 1.9x their right-hand sides), but as close to
+    // Richardson-extrapolated differences as centered ones (docs/performance.md, session 8).
+    kStateJacobian,
+  };
   enum class Corrector {
     kSimultaneous,  // state and sensitivities in one nonlinear system (CV_SIMULTANEOUS)
     kStaggered,     // sensitivities corrected after the state has converged (CV_STAGGERED)
@@ -58,7 +70,9 @@ struct SensitivityOptions {
     kForward,   // one right-hand side per sensitivity, error O(delta)
   };
 
+  RightHandSide right_hand_side = RightHandSide::kCvodesQuotients;
   Corrector corrector = Corrector::kSimultaneous;
+  // kCvodesQuotients only.
   DifferenceQuotient difference_quotient = DifferenceQuotient::kCentered;
   // Local error test of the sensitivities: rtol_s * |s_i| + atol_s / p_scale_i. Looser than the
   // state's on purpose: at the state's tolerance (<= 1e-9) the internal difference quotients are
@@ -83,8 +97,11 @@ struct IntegratorStatistics {
   long jacobian_evaluations = 0;
   // Calls of the right-hand side for difference-quotient Jacobians (BDF only).
   long rhs_evaluations_for_jacobian = 0;
-  // Calls of the right-hand side for the sensitivities' difference quotients.
+  // Calls of the right-hand side for the sensitivities: CVODES' difference quotients, or the
+  // columns of J and the parameter differences of kStateJacobian.
   long rhs_evaluations_for_sensitivities = 0;
+  // State Jacobians J formed for the sensitivities (kStateJacobian).
+  long sensitivity_jacobians = 0;
   double last_step_s = 0.0;
   int last_order = 0;
   // The method CVODES ran (`auto` resolved).
