@@ -75,6 +75,12 @@ void CheckAgainstDifferences(const Crane& crane, double duration_s,
   adams.integrator.method = IntegratorOptions::Method::kAdams;
   const SensitivityResult result_adams =
       SimulateWithSensitivities(*crane.model, crane.excitation, adams, sensors, names, {}, forward);
+  // The sensitivity right-hand side from the state Jacobian (an option; docs/performance.md).
+  SensitivityOptions jacobian;
+  jacobian.right_hand_side = SensitivityOptions::RightHandSide::kStateJacobian;
+  const SensitivityResult result_jacobian = SimulateWithSensitivities(
+      *crane.model, crane.excitation, options, sensors, names, {}, jacobian);
+  EXPECT_GT(result_jacobian.statistics.sensitivity_jacobians, 0);
   ASSERT_EQ(result.output_sensitivities.size(), names.size());
   EXPECT_GT(result.statistics.rhs_evaluations_for_sensitivities, 0);
   // One right-hand side per sensitivity instead of two.
@@ -92,9 +98,11 @@ void CheckAgainstDifferences(const Crane& crane, double duration_s,
     const double error = RelativeError(result.output_sensitivities[k], expected);
     const double error_forward = RelativeError(result_forward.output_sensitivities[k], expected);
     const double error_adams = RelativeError(result_adams.output_sensitivities[k], expected);
-    ::testing::Test::RecordProperty(
-        "relative_error_" + names[k],
-        Sci(error) + " forward " + Sci(error_forward) + " adams " + Sci(error_adams));
+    const double error_jacobian = RelativeError(result_jacobian.output_sensitivities[k], expected);
+    ::testing::Test::RecordProperty("relative_error_" + names[k],
+                                    Sci(error) + " forward " + Sci(error_forward) + " adams " +
+                                        Sci(error_adams) + " jacobian " + Sci(error_jacobian));
+    EXPECT_LT(error_jacobian, 1e-4) << names[k] << " (state-Jacobian right-hand side)";
     EXPECT_LT(error, 1e-4) << names[k];
     EXPECT_LT(error_forward, 1e-4) << names[k] << " (forward quotients)";
     EXPECT_LT(error_adams, 1e-4) << names[k] << " (Adams, forward quotients)";
@@ -116,6 +124,10 @@ TEST(SensitivityTest, RateOutputsOfADescribedMachineMatchCentralDifferences) {
   const std::vector<std::string> names{"c_boom", "c_swing", "d_stick", "d_boom"};
   const SensitivityResult result = SimulateWithSensitivities(*machine.model, machine.excitation,
                                                              options, sensors, names, {}, {});
+  SensitivityOptions jacobian;
+  jacobian.right_hand_side = SensitivityOptions::RightHandSide::kStateJacobian;
+  const SensitivityResult result_jacobian = SimulateWithSensitivities(
+      *machine.model, machine.excitation, options, sensors, names, {}, jacobian);
   const SimulationOptions tight = Tight(options);
   for (size_t k = 0; k < names.size(); ++k) {
     auto simulate_at = [&](double value) {
@@ -132,6 +144,9 @@ TEST(SensitivityTest, RateOutputsOfADescribedMachineMatchCentralDifferences) {
       ::testing::Test::RecordProperty("relative_error_" + names[k] + "_" + sensors.channels[c],
                                       Sci(error));
       EXPECT_LT(error, 1e-4) << names[k] << " " << sensors.channels[c];
+      const double error_jacobian =
+          RelativeError(result_jacobian.output_sensitivities[k].col(c), expected.col(c));
+      EXPECT_LT(error_jacobian, 1e-4) << names[k] << " " << sensors.channels[c] << " (Jacobian)";
     }
   }
 }
