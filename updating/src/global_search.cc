@@ -18,6 +18,7 @@
 #include "mbid/common/error.h"
 #include "mbid/model/linear_model.h"
 #include "mbid/updating/characteristic.h"
+#include "output_error_fit.h"
 
 namespace mbid::updating {
 namespace {
@@ -307,17 +308,26 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     UpdateOptions probe = local;
     probe.max_iterations = 1;
     probe.refit_after_noise_estimate = false;
-    std::vector<Run> probes(candidates.size());
+    // A start's cost alone: without continuation it is one evaluation without sensitivities (a
+    // sixth of a one-iteration fit); with it, the first window's, which a fit reports.
+    std::vector<double> start_costs(candidates.size(), std::numeric_limits<double>::quiet_NaN());
     if (std::isfinite(best_cost)) {
       RunParallel(static_cast<int>(candidates.size()), search.threads, [&](int i) {
         const SearchStart& start = candidates[static_cast<size_t>(i)];
-        probes[static_cast<size_t>(i)] = fit_full(start.label, start.values, probe);
+        const UpdateOptions at_start = StartOptions(probe, settings, start.values);
+        try {
+          start_costs[static_cast<size_t>(i)] =
+              probe.continuation_fractions.empty()
+                  ? internal::CalcStartCost(model, weighted, at_start)
+                  : UpdateModel(model, weighted, at_start).initial_cost;
+        } catch (const std::exception&) {
+          // A start whose simulation fails is not promising.
+        }
       });
     }
     std::vector<SearchStart> promising;
     for (size_t i = 0; i < candidates.size(); ++i) {
-      if (!std::isfinite(best_cost) ||
-          (!probes[i].failed && probes[i].fit.initial_cost <= kPromisingCostRatio * best_cost)) {
+      if (!std::isfinite(best_cost) || start_costs[i] <= kPromisingCostRatio * best_cost) {
         promising.push_back(candidates[i]);
       }
     }

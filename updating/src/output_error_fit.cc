@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "fit_unknowns.h"
+#include "mbid/common/error.h"
 #include "prepared_test.h"
 #include "statistics.h"
 #include "test_evaluator.h"
@@ -360,6 +361,17 @@ double CalcInitialCost(FitProblem& fit, const std::vector<double>* report_start)
 }
 
 }  // namespace
+
+double CalcStartCost(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
+                     const UpdateOptions& options) {
+  FitProblem fit(model, tests, options);
+  double cost = 0;
+  // No Jacobian asked: the evaluators simulate without sensitivities.
+  if (!fit.problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr)) {
+    throw NumericalError("updating", "no cost at the start: " + fit.work.last_error);
+  }
+  return cost;
+}
 
 UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
                  const UpdateOptions& options, int first_stage, const std::string& stage_label,

@@ -17,4 +17,10 @@ UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestReco
                  const UpdateOptions& options, int first_stage, const std::string& stage_label,
                  const std::vector<double>* report_start);
 
+// The cost (0.5 sum of squared weighted residuals) at the options' starts: what one Ceres
+// iteration reports as its initial cost, from simulations without sensitivities. Throws
+// NumericalError if a simulation fails there.
+double CalcStartCost(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
+                     const UpdateOptions& options);
+
 }  // namespace mbid::updating::internal
