@@ -89,6 +89,7 @@ std::vector<PlotSeries> ModeSeries(const std::vector<nlohmann::ordered_json>& ro
 std::vector<std::string> WriteCampaignReport(const Campaign& campaign,
                                              const std::vector<nlohmann::ordered_json>& rows,
                                              const std::string& folder, const StudyReport& study) {
+  report::FigureBatch batch;  // the figures in one gnuplot process, drawn before report.md
   std::map<std::string, int> by_status;
   std::vector<const nlohmann::ordered_json*> failures;
   for (const auto& row : rows) {
@@ -174,6 +175,7 @@ std::vector<std::string> WriteCampaignReport(const Campaign& campaign,
     }
   }
   md << study.markdown;
+  batch.Draw();
 
   AtomicFile report((fs::path(folder) / "report.md").string());
   {

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -104,65 +105,121 @@ bool GnuplotAvailable() {
   return Spawn({"gnuplot", "-e", "set terminal pngcairo"}, "/dev/null") == 0;
 }
 
-void DrawFigure(const Figure& figure, const std::string& png_path) {
-  AtomicFile png(png_path);
-  const ScratchFile data(png.temp_path() + ".dat");
-  const ScratchFile script_file(png.temp_path() + ".gp");
-  const ScratchFile log(png.temp_path() + ".log");
-  {
-    // One data block per series, separated by two blank lines (gnuplot's "index").
-    std::ofstream out(data.path());
-    for (const PlotSeries& series : figure.series) {
-      for (Eigen::Index i = 0; i < series.x.size(); ++i) {
-        out << fmt::format("{:.10g} {:.10g}\n", series.x[i], series.y[i]);
-      }
-      out << "\n\n";
+namespace {
+
+// The batch that DrawFigure adds to on this thread, if any.
+thread_local FigureBatch* active_batch = nullptr;
+
+void WriteData(const Figure& figure, const std::string& path) {
+  // One data block per series, separated by two blank lines (gnuplot's "index").
+  std::ofstream out(path);
+  for (const PlotSeries& series : figure.series) {
+    for (Eigen::Index i = 0; i < series.x.size(); ++i) {
+      out << fmt::format("{:.10g} {:.10g}\n", series.x[i], series.y[i]);
     }
-    CheckWritten(out, data.path());
+    out << "\n\n";
   }
+  CheckWritten(out, path);
+}
+
+// The commands of one figure; `reset` first, so that nothing of the figure before carries over.
+void WriteCommands(const Figure& figure, const std::string& data_path, const std::string& png_path,
+                   std::ostream& script) {
+  script << "reset\n";
+  script << fmt::format("set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n",
+                        figure.width_px, figure.height_px);
+  script << "set output " << Quote(png_path) << "\n";
+  script << "set title " << Quote(figure.title) << "\n";
+  script << "set xlabel " << Quote(figure.x_label) << "\n";
+  script << "set ylabel " << Quote(figure.y_label) << "\n";
+  script << "set grid\nset key " << figure.key << "\nset offsets 0, 0, graph 0.05, graph 0.05\n";
+  if (figure.log_y) script << "set logscale y\nset format y '%.0e'\n";
+  if (figure.log_x) script << "set logscale x\nset format x '%g'\n";
+  if (!figure.x_range.empty()) script << "set xrange " << figure.x_range << "\n";
+  if (!figure.y_range.empty()) script << "set yrange " << figure.y_range << "\n";
+  if (figure.pad_x) script << "set offsets graph 0.03, graph 0.03, graph 0.05, graph 0.05\n";
+  script << "plot ";
+  for (size_t k = 0; k < figure.series.size(); ++k) {
+    if (k > 0) script << ", \\\n     ";
+    script << Quote(data_path) << " index " << k << " using 1:2 with " << figure.series[k].style
+           << " title " << Quote(figure.series[k].title);
+  }
+  // Closing the output completes the file before the next figure opens its own.
+  script << "\nunset output\n";
+}
+
+std::string ReadLog(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Every figure in one gnuplot process: a process start and the cairo set-up cost about as much
+// as drawing a figure (docs/performance.md). Each PNG is committed only when all were drawn.
+void DrawAll(const std::vector<std::pair<Figure, std::string>>& figures) {
+  if (figures.empty()) return;
+  std::vector<std::unique_ptr<AtomicFile>> pngs;
+  std::vector<std::unique_ptr<ScratchFile>> scratch;
+  for (const auto& [figure, png_path] : figures) {
+    pngs.push_back(std::make_unique<AtomicFile>(png_path));
+    scratch.push_back(std::make_unique<ScratchFile>(pngs.back()->temp_path() + ".dat"));
+    WriteData(figure, scratch.back()->path());
+  }
+  const std::string& first = pngs.front()->temp_path();
+  const ScratchFile script_file(first + ".gp");
+  const ScratchFile log(first + ".log");
   {
     std::ofstream script(script_file.path());
-    script << fmt::format("set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n",
-                          figure.width_px, figure.height_px);
-    script << "set output " << Quote(png.temp_path()) << "\n";
-    script << "set title " << Quote(figure.title) << "\n";
-    script << "set xlabel " << Quote(figure.x_label) << "\n";
-    script << "set ylabel " << Quote(figure.y_label) << "\n";
-    script << "set grid\nset key " << figure.key << "\nset offsets 0, 0, graph 0.05, graph 0.05\n";
-    if (figure.log_y) script << "set logscale y\nset format y '%.0e'\n";
-    if (figure.log_x) script << "set logscale x\nset format x '%g'\n";
-    if (!figure.x_range.empty()) script << "set xrange " << figure.x_range << "\n";
-    if (!figure.y_range.empty()) script << "set yrange " << figure.y_range << "\n";
-    if (figure.pad_x) script << "set offsets graph 0.03, graph 0.03, graph 0.05, graph 0.05\n";
-    script << "plot ";
-    for (size_t k = 0; k < figure.series.size(); ++k) {
-      if (k > 0) script << ", \\\n     ";
-      script << Quote(data.path()) << " index " << k << " using 1:2 with " << figure.series[k].style
-             << " title " << Quote(figure.series[k].title);
+    for (size_t i = 0; i < figures.size(); ++i) {
+      WriteCommands(figures[i].first, scratch[i]->path(), pngs[i]->temp_path(), script);
     }
-    script << "\n";
     CheckWritten(script, script_file.path());
   }
+  const std::string& named = figures.front().second;
+  const std::string what =
+      figures.size() == 1 ? named
+                          : fmt::format("{} and {} other figure(s)", named, figures.size() - 1);
   const int status = Spawn({"gnuplot", AsArgument(script_file.path())}, log.path());
   if (status < 0) {
-    throw std::runtime_error("cannot start gnuplot for " + png_path + ": " + std::strerror(errno));
+    throw std::runtime_error("cannot start gnuplot for " + what + ": " + std::strerror(errno));
   }
-  if (status != 0) {
-    std::ifstream in(log.path());
-    std::stringstream text;
-    text << in.rdbuf();
-    throw std::runtime_error("gnuplot failed on " + png_path + ": " + text.str());
+  if (status != 0)
+    throw std::runtime_error("gnuplot failed on " + what + ": " + ReadLog(log.path()));
+  for (size_t i = 0; i < figures.size(); ++i) {
+    std::error_code ignored;
+    if (std::filesystem::file_size(pngs[i]->temp_path(), ignored) == 0 || ignored) {
+      // gnuplot reports a failed write of its output on standard error but exits with 0.
+      const std::string text = ReadLog(log.path());
+      throw std::runtime_error("cannot write " + figures[i].second + ": gnuplot wrote no figure (" +
+                               (text.empty() ? "no message" : text) + ")");
+    }
   }
-  std::error_code ignored;
-  if (std::filesystem::file_size(png.temp_path(), ignored) == 0 || ignored) {
-    // gnuplot reports a failed write of its output on standard error but exits with 0.
-    std::ifstream in(log.path());
-    std::stringstream text;
-    text << in.rdbuf();
-    throw std::runtime_error("cannot write " + png_path + ": gnuplot wrote no figure (" +
-                             (text.str().empty() ? "no message" : text.str()) + ")");
+  for (const auto& png : pngs) png->Commit();
+}
+
+}  // namespace
+
+void DrawFigure(const Figure& figure, const std::string& png_path) {
+  if (active_batch != nullptr) {
+    active_batch->Add(figure, png_path);
+    return;
   }
-  png.Commit();
+  DrawAll({{figure, png_path}});
+}
+
+FigureBatch::FigureBatch() : outer_(active_batch) { active_batch = this; }
+
+FigureBatch::~FigureBatch() { active_batch = outer_; }
+
+void FigureBatch::Add(const Figure& figure, const std::string& png_path) {
+  figures_.emplace_back(figure, png_path);
+}
+
+void FigureBatch::Draw() {
+  std::vector<std::pair<Figure, std::string>> figures;
+  figures.swap(figures_);
+  DrawAll(figures);
 }
 
 }  // namespace mbid::report

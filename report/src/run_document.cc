@@ -86,6 +86,7 @@ int WriteRunReport(const std::string& folder, const Scenario& scenario,
   const bool draw = GnuplotAvailable();
   if (!draw) say("gnuplot with pngcairo not found: the report has no figures");
   int figure_count = 0;
+  FigureBatch batch;  // every figure of the report in one gnuplot process, at the end
 
   std::ofstream report(fs::path(folder) / "report.md");
   report << "# mbid run: " << scenario.name << "\n\n";
@@ -137,6 +138,7 @@ int WriteRunReport(const std::string& folder, const Scenario& scenario,
            << TestsTableMarkdown(names, results) << "\n";
   }
   report << "## Verdict\n\n**" << verdict << "**\n";
+  batch.Draw();
   if (draw) say(fmt::format("drew {} figures", figure_count));
   return figure_count;
 }

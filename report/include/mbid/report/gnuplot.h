@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mbid::report {
@@ -31,8 +32,30 @@ struct Figure {
 };
 
 // Draws `figure` into `png_path` (atomically: a failed plot leaves no file). Throws
-// std::runtime_error naming gnuplot's complaint if it fails or is not installed.
+// std::runtime_error naming gnuplot's complaint if it fails or is not installed. While a
+// FigureBatch is alive on this thread, the figure is only added to it.
 void DrawFigure(const Figure& figure, const std::string& png_path);
+
+// Collects the figures DrawFigure is asked for on this thread while it lives, and draws them all
+// in one gnuplot process at Draw(): one process start instead of one per figure. Figures not
+// drawn when it ends are dropped (an exception unwound past the report). Batches nest: the
+// innermost one collects.
+class FigureBatch {
+ public:
+  FigureBatch();
+  ~FigureBatch();
+  FigureBatch(const FigureBatch&) = delete;
+  FigureBatch& operator=(const FigureBatch&) = delete;
+
+  void Add(const Figure& figure, const std::string& png_path);
+  // Draws every figure added so far; each PNG is committed only if all were drawn. Throws as
+  // DrawFigure does.
+  void Draw();
+
+ private:
+  FigureBatch* outer_;
+  std::vector<std::pair<Figure, std::string>> figures_;
+};
 
 // True if a gnuplot with the pngcairo terminal is on PATH.
 bool GnuplotAvailable();
