@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -16,7 +17,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
 namespace {
 
-void Run(const std::vector<uint8_t>& bytes) { LLVMFuzzerTestOneInput(bytes.data(), bytes.size()); }
+// MBID_FUZZ_LAST_INPUT=<file>: each input is written there before it runs, so that the input of
+// a crash is left behind to become a regression test.
+void Run(const std::vector<uint8_t>& bytes) {
+  static const char* keep = std::getenv("MBID_FUZZ_LAST_INPUT");
+  if (keep != nullptr && *keep != '\0') {
+    std::ofstream(keep, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(bytes.data()),
+               static_cast<std::streamsize>(bytes.size()));
+  }
+  LLVMFuzzerTestOneInput(bytes.data(), bytes.size());
+}
 
 std::vector<uint8_t> ReadFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -34,6 +34,7 @@ dict=""
 # The first finding stops the run; a reader that returns NULL from a huge malloc is tested
 # rather than killed by ASan.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-halt_on_error=1:allocator_may_return_null=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$source_dir/fuzz/lsan.supp}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
 # shellcheck disable=SC2086
 exec "$build/fuzz/fuzz_$reader" "$corpus" $seeds $dict \

@@ -11,6 +11,7 @@
 
 #include <csignal>
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 
 #include "test_util.h"
@@ -431,6 +432,54 @@ TEST_F(Hdf5BadInputTest, ChannelDatasetOfStrings) {
   const InputError e = Read();
   EXPECT_EQ(e.field(), "/measurement/phi");
   EXPECT_EQ(e.problem(), "is of string type");
+}
+
+// Dimensions of 2^40 samples in a file of a few KB (chunked, nothing written): refused before
+// anything that size is allocated (it was std::bad_alloc, exit 1).
+TEST_F(Hdf5BadInputTest, AbsurdDimensionsAreRefusedBeforeAllocating) {
+  DamageWithHdf5([](H5::H5File& f) {
+    f.unlink("/measurement/time");
+    const hsize_t dims[1] = {hsize_t{1} << 40};
+    const hsize_t chunk[1] = {1024};
+    H5::DSetCreatPropList properties;
+    properties.setChunk(1, chunk);
+    f.createDataSet("/measurement/time", H5::PredType::NATIVE_DOUBLE, H5::DataSpace(1, dims),
+                    properties);
+  });
+  const InputError e = Read();
+  EXPECT_EQ(e.field(), "/measurement/time");
+  EXPECT_THAT(e.problem(), HasSubstr("has dimensions beyond 100000000 elements"));
+}
+
+// A channel name that is not UTF-8 is refused where it is read, naming the attribute (it used
+// to pass and fail only when the JSON summary was written).
+TEST_F(Hdf5BadInputTest, ChannelNameThatIsNotUtf8) {
+  DamageWithHdf5([](H5::H5File& f) {
+    H5::Group group = f.openGroup("/measurement");
+    group.removeAttr("channels");
+    const H5::StrType type(H5::PredType::C_S1, 8);
+    const hsize_t dims[1] = {2};
+    H5::Attribute attribute = group.createAttribute("channels", type, H5::DataSpace(1, dims));
+    const char names[16] = {'p', 's', 'i', 0, 0, 0, 0, 0, 'p', 'h', '\xE9', 0, 0, 0, 0, 0};
+    attribute.write(type, names);
+  });
+  const InputError e = Read();
+  EXPECT_EQ(e.field(), "/measurement attribute 'channels'");
+  EXPECT_EQ(e.problem(), "string 2 is not UTF-8 (byte 0xE9 at byte 3)");
+}
+
+// A file that crashes libhdf5 1.10.8 when read (a damaged group B-tree found by fuzz_mat; the
+// library's own reads of MAT v7.3 and mbid's HDF5 files go through the same code) ends in an
+// InputError: the read is tried in a child process first.
+TEST(Hdf5IoTest, AFileThatCrashesLibhdf5IsAnInputError) {
+  TempDir dir;
+  const std::string path = dir.File("corrupt.h5");
+  std::filesystem::copy_file(
+      std::string(MBID_SOURCE_DIR) + "/tests/data/records/hostile/mat73_corrupt_group_btree.mat",
+      path);
+  const InputError e = CatchInputError([&] { ReadMeasurementH5(path); });
+  EXPECT_EQ(e.source(), path);
+  EXPECT_THAT(e.problem(), HasSubstr("the HDF5 library crashed reading the file"));
 }
 
 // A full disk, made by a file-size limit (writes fail with EFBIG as they would with ENOSPC). HDF5
