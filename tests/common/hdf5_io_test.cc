@@ -482,6 +482,20 @@ TEST(Hdf5IoTest, AFileThatCrashesLibhdf5IsAnInputError) {
   EXPECT_THAT(e.problem(), HasSubstr("the HDF5 library crashed reading the file"));
 }
 
+// The case: a variable-length string attribute whose global-heap read loops for ever in
+// libhdf5 1.10.8 (H5Aread -> H5T__conv_vlen; found by fuzz_hdf5). The child process that tries
+// the read first is stopped after 5 s and the file refused.
+TEST(Hdf5IoTest, AFileThatHangsLibhdf5IsAnInputError) {
+  TempDir dir;
+  const std::string path = dir.File("loop.h5");
+  std::filesystem::copy_file(
+      std::string(MBID_SOURCE_DIR) + "/tests/data/records/hostile/vlen_string_attribute_loop.h5",
+      path);
+  const InputError e = CatchInputError([&] { ReadScenarioYaml(path); });
+  EXPECT_EQ(e.source(), path);
+  EXPECT_THAT(e.problem(), HasSubstr("the HDF5 library did not finish reading the file in 5 s"));
+}
+
 // A full disk, made by a file-size limit (writes fail with EFBIG as they would with ENOSPC). HDF5
 // 1.10.8 crashed (SIGSEGV) when the writer closed the file a second time after the failed close.
 // In a child process: the limit and the HDF5 state after the failure must not reach other tests.
