@@ -149,6 +149,20 @@ TEST(HostileFileTest, MatV73ThatCrashesLibhdf5) {
   EXPECT_THAT(e.problem(), HasSubstr("matio crashed reading the file"));
 }
 
+// A 58b header whose byte count fits the file when the header is read but not after the 11
+// ASCII records (found by fuzz_logger: the reader read past the end of its buffer).
+TEST(HostileFileTest, Uff58bByteCountPastTheEnd) {
+  TempDir dir;
+  const std::string path = dir.File("short.uff");
+  std::filesystem::copy_file(
+      std::string(MBID_SOURCE_DIR) + "/tests/data/records/hostile/uff58b_byte_count_past_end.uff",
+      path);
+  const InputError e = CatchInputError([&] { ImportMeasurement(path); });
+  EXPECT_EQ(e.field(), "dataset 2 (line 17), header");
+  EXPECT_THAT(e.problem(), HasSubstr("byte count 64 with"));
+  EXPECT_THAT(e.problem(), HasSubstr("bytes left after the ASCII records"));
+}
+
 TEST(HostileFileTest, LvmChannelNameThatIsNotUtf8) {
   TempDir dir;
   const std::string path = dir.File("latin1.lvm");
