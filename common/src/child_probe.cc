@@ -1,6 +1,7 @@
 // SurviveInChild: a library call that may crash on a corrupt file, tried in a child process.
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <pthread.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -35,6 +36,12 @@ void SurviveInChild(const std::string& path, const std::string& expected,
   const pid_t child = fork();
   if (child < 0) return;  // no process to spare: read as before rather than refuse the file
   if (child == 0) {
+    // The parent's lock came along, owned by a thread the child does not have; the child is
+    // single-threaded, so a fresh lock is safe (the reads in `body` take it).
+    pthread_mutexattr_t recursive;
+    pthread_mutexattr_init(&recursive);
+    pthread_mutexattr_settype(&recursive, PTHREAD_MUTEX_RECURSIVE);
+    pthread_mutex_init(H5Mutex().native_handle(), &recursive);
     // The child leaves without exit handlers; its messages and core dumps are of no use.
     const rlimit no_core{0, 0};
     setrlimit(RLIMIT_CORE, &no_core);

@@ -225,6 +225,7 @@ void ProbeFile(const std::string& path) {
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (file < 0) return;
   H5Ovisit2(file, H5_INDEX_NAME, H5_ITER_NATIVE, ProbeObject, nullptr, H5O_INFO_BASIC);
+  H5Fclose(file);
 }
 
 }  // namespace
@@ -391,7 +392,7 @@ struct H5Reader::Impl {
   }
 };
 
-H5Reader::H5Reader(const std::string& path) {
+H5Reader::H5Reader(const std::string& path, Probe probe) {
   H5Lock lock(H5Mutex());
   H5::Exception::dontPrint();
   internal::CheckReadable(path, kExpectedH5);
@@ -402,7 +403,7 @@ H5Reader::H5Reader(const std::string& path) {
     H5Eclear2(H5E_DEFAULT);
   }
   if (!is_hdf5) throw InputError(path, "", "not an HDF5 file", kExpectedH5);
-  internal::ProbeHdf5InChild(path, kExpectedH5);
+  if (probe == Probe::kEverything) internal::ProbeHdf5InChild(path, kExpectedH5);
   impl_ = std::make_unique<Impl>();
   impl_->path = path;
   try {
@@ -565,9 +566,20 @@ std::string H5Reader::ReadScenarioYaml() const {
 
 // ---- free functions -----------------------------------------------------------------------
 
-Measurement ReadMeasurementH5(const std::string& path) { return H5Reader(path).ReadMeasurement(); }
+// The child makes exactly the calls this process makes next, from the same library state (the
+// fork's copy): a survey of the file can miss a path, and libhdf5 looped in-process on a
+// variable-length string the survey had read without harm.
+Measurement ReadMeasurementH5(const std::string& path) {
+  const auto read = [&] { return H5Reader(path, H5Reader::Probe::kNone).ReadMeasurement(); };
+  internal::SurviveInChild(path, kExpectedH5, "the HDF5 library", read);
+  return read();
+}
 
-std::string ReadScenarioYaml(const std::string& path) { return H5Reader(path).ReadScenarioYaml(); }
+std::string ReadScenarioYaml(const std::string& path) {
+  const auto read = [&] { return H5Reader(path, H5Reader::Probe::kNone).ReadScenarioYaml(); };
+  internal::SurviveInChild(path, kExpectedH5, "the HDF5 library", read);
+  return read();
+}
 
 Measurement ReadMeasurement(const std::string& path) {
   const std::string accepted = "a measurement file ending in .h5, .hdf5 or .csv";
