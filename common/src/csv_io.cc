@@ -15,6 +15,7 @@
 #include "internal.h"
 #include "mbid/common/atomic_file.h"
 #include "mbid/common/error.h"
+#include "mbid/common/utf8.h"
 
 namespace mbid {
 namespace {
@@ -83,6 +84,7 @@ void ParseMetadataComment(const std::string& comment, int line, CsvMetadata* met
 
 Measurement ReadMeasurementCsv(const std::string& path) {
   const std::string text = internal::ReadTextFile(path, kExpectedFile);
+  ValidateUtf8Text(text, path);
   std::istringstream stream(text);
   std::string line;
   int line_number = 0;

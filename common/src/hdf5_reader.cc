@@ -13,6 +13,7 @@
 #include "mbid/common/csv_io.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
+#include "mbid/common/utf8.h"
 
 namespace mbid {
 using internal::AttributeField;
@@ -56,7 +57,37 @@ std::string TypeClassName(H5T_class_t type_class) {
   }
 }
 
-// Strings of an attribute or dataset, variable- or fixed-length (h5py and MATLAB write both).
+// Limits checked before anything is allocated: a damaged or hostile file may state any size.
+// 1e8 samples is the records readers' limit too; names and the scenario text are far smaller.
+constexpr hsize_t kMaxNumbers = 100000000;
+constexpr hsize_t kMaxStrings = 1000000;
+constexpr size_t kMaxStringBytes = size_t{64} << 20;
+
+// The number of elements of a dataspace and its dimensions, refused beyond `limit`.
+hsize_t CountElements(hid_t space, hsize_t limit, std::vector<hsize_t>* dims) {
+  const H5S_class_t space_class = H5Sget_simple_extent_type(space);
+  dims->clear();
+  if (space_class == H5S_NULL) return 0;
+  if (space_class == H5S_SCALAR) return 1;
+  if (space_class != H5S_SIMPLE) throw H5::Exception("H5Sget_simple_extent_type", "failed");
+  const int rank = H5Sget_simple_extent_ndims(space);
+  if (rank < 0 || rank > H5S_MAX_RANK) throw H5::Exception("H5Sget_simple_extent_ndims", "failed");
+  dims->assign(static_cast<size_t>(rank), 0);
+  Check(H5Sget_simple_extent_dims(space, dims->data(), nullptr), "H5Sget_simple_extent_dims");
+  hsize_t count = 1;
+  for (const hsize_t d : *dims) {
+    // Checked per factor so that the product cannot overflow before the comparison.
+    if (d != 0 && count > limit / d) {
+      throw ReadProblem{fmt::format("has dimensions beyond {} elements", limit),
+                        fmt::format("at most {} elements", limit)};
+    }
+    count *= d;
+  }
+  return count;
+}
+
+// Strings of an attribute or dataset, variable- or fixed-length (h5py and MATLAB write both),
+// each checked as UTF-8 (they become channel names, units and scenario text).
 std::vector<std::string> ReadStringData(hid_t id, bool is_attribute) {
   const Handle file_type(is_attribute ? H5Aget_type(id) : H5Dget_type(id), H5Tclose, "H5Xget_type");
   const H5T_class_t type_class = H5Tget_class(file_type.get());
@@ -64,8 +95,8 @@ std::vector<std::string> ReadStringData(hid_t id, bool is_attribute) {
     throw ReadProblem{"is of " + TypeClassName(type_class) + " type", "strings"};
   }
   const Handle space(is_attribute ? H5Aget_space(id) : H5Dget_space(id), H5Sclose, "H5Xget_space");
-  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
-  if (n < 0) throw H5::Exception("H5Sget_simple_extent_npoints", "failed");
+  std::vector<hsize_t> dims;
+  const hsize_t n = CountElements(space.get(), kMaxStrings, &dims);
   std::vector<std::string> out;
   const auto read = [&](hid_t memory_type, void* buffer) {
     Check(is_attribute ? H5Aread(id, memory_type, buffer)
@@ -75,29 +106,139 @@ std::vector<std::string> ReadStringData(hid_t id, bool is_attribute) {
   const htri_t variable = H5Tis_variable_str(file_type.get());
   Check(variable, "H5Tis_variable_str");
   if (variable > 0) {
+    // libhdf5 1.10 can crash or loop on a corrupt global heap here; H5Reader's constructor
+    // has read every string of the file in a child process first (SurvivesInChild).
     const Handle memory_type(H5Tcopy(H5T_C_S1), H5Tclose, "H5Tcopy");
     Check(H5Tset_size(memory_type.get(), H5T_VARIABLE), "H5Tset_size");
     // HDF5 does not convert between character sets: read in the file's own.
     Check(H5Tset_cset(memory_type.get(), H5Tget_cset(file_type.get())), "H5Tset_cset");
     std::vector<char*> pointers(static_cast<size_t>(n), nullptr);
     if (n > 0) read(memory_type.get(), pointers.data());
-    for (char* p : pointers) out.emplace_back(p == nullptr ? "" : p);
+    size_t total = 0;
+    for (char* p : pointers) {
+      out.emplace_back(p == nullptr ? "" : p);
+      total += out.back().size();
+    }
     if (n > 0) H5Dvlen_reclaim(memory_type.get(), space.get(), H5P_DEFAULT, pointers.data());
+    if (total > kMaxStringBytes) {
+      throw ReadProblem{fmt::format("holds {} bytes of text", total),
+                        fmt::format("at most {} bytes", kMaxStringBytes)};
+    }
   } else {
     const size_t size = H5Tget_size(file_type.get());
+    if (size == 0 || (n > 0 && size > kMaxStringBytes / n)) {
+      throw ReadProblem{fmt::format("holds {} strings of {} bytes", n, size),
+                        fmt::format("at most {} bytes of text", kMaxStringBytes)};
+    }
     const Handle memory_type(H5Tcopy(file_type.get()), H5Tclose, "H5Tcopy");
     std::vector<char> buffer(size * static_cast<size_t>(n) + 1, '\0');
     if (n > 0) read(memory_type.get(), buffer.data());
     const bool space_padded = H5Tget_strpad(file_type.get()) == H5T_STR_SPACEPAD;
-    for (hssize_t i = 0; i < n; ++i) {
+    for (hsize_t i = 0; i < n; ++i) {
       std::string s(buffer.data() + static_cast<size_t>(i) * size, size);
       s = s.substr(0, s.find('\0'));
       if (space_padded) s = s.substr(0, s.find_last_not_of(' ') + 1);
       out.push_back(s);
     }
   }
+  for (size_t i = 0; i < out.size(); ++i) {
+    const size_t bad = FindInvalidUtf8(out[i]);
+    if (bad != std::string::npos) {
+      throw ReadProblem{
+          fmt::format("string {} is not UTF-8 (byte 0x{:02X} at byte {})", i + 1,
+                      static_cast<unsigned>(static_cast<unsigned char>(out[i][bad])), bad + 1),
+          "UTF-8 text"};
+    }
+  }
   return out;
 }
+
+// A numeric attribute or dataset as row-major doubles, its dimensions in `dims`; the rank is
+// checked against `rank` unless that is negative.
+std::vector<double> ReadNumericData(hid_t id, bool is_attribute, int rank,
+                                    std::vector<hsize_t>* dims) {
+  const Handle file_type(is_attribute ? H5Aget_type(id) : H5Dget_type(id), H5Tclose, "H5Xget_type");
+  const H5T_class_t type_class = H5Tget_class(file_type.get());
+  if (type_class != H5T_FLOAT && type_class != H5T_INTEGER) {
+    throw ReadProblem{"is of " + TypeClassName(type_class) + " type", "float64 numbers"};
+  }
+  const Handle space(is_attribute ? H5Aget_space(id) : H5Dget_space(id), H5Sclose, "H5Xget_space");
+  const hsize_t n = CountElements(space.get(), kMaxNumbers, dims);
+  const int actual_rank = static_cast<int>(dims->size());
+  if (rank >= 0 && actual_rank != rank) {
+    throw ReadProblem{fmt::format("has {} dimensions", actual_rank),
+                      fmt::format("{} dimensions", rank)};
+  }
+  std::vector<double> data(static_cast<size_t>(n));
+  if (n > 0) {
+    Check(is_attribute ? H5Aread(id, H5T_NATIVE_DOUBLE, data.data())
+                       : H5Dread(id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
+          "H5Xread");
+  }
+  return data;
+}
+
+// ---- the probe in a child process ----------------------------------------------------------
+
+// Reads every string and number of one attribute or dataset as H5Reader would; problems that
+// H5Reader reports as InputErrors do not matter here, only whether libhdf5 survives.
+void ProbeData(hid_t id, bool is_attribute) {
+  try {
+    const Handle type(is_attribute ? H5Aget_type(id) : H5Dget_type(id), H5Tclose, "H5Xget_type");
+    const H5T_class_t type_class = H5Tget_class(type.get());
+    if (type_class == H5T_STRING) {
+      ReadStringData(id, is_attribute);
+    } else if (type_class == H5T_FLOAT || type_class == H5T_INTEGER) {
+      std::vector<hsize_t> dims;
+      ReadNumericData(id, is_attribute, -1, &dims);
+    }
+  } catch (const H5::Exception&) {
+  } catch (const ReadProblem&) {
+  }
+}
+
+herr_t ProbeAttribute(hid_t object, const char* name, const H5A_info_t*, void*) {
+  const hid_t attribute = H5Aopen(object, name, H5P_DEFAULT);
+  if (attribute >= 0) {
+    ProbeData(attribute, true);
+    H5Aclose(attribute);
+  }
+  return 0;
+}
+
+herr_t ProbeObject(hid_t root, const char* name, const H5O_info_t* info, void*) {
+  const hid_t object = H5Oopen(root, name, H5P_DEFAULT);
+  if (object < 0) return 0;
+  hsize_t index = 0;
+  H5Aiterate2(object, H5_INDEX_NAME, H5_ITER_NATIVE, &index, ProbeAttribute, nullptr);
+  if (info->type == H5O_TYPE_DATASET) ProbeData(object, false);
+  if (info->type == H5O_TYPE_GROUP) {
+    H5G_info_t group_info;  // the link count, as H5Reader's lookups walk the same B-tree
+    H5Gget_info(object, &group_info);
+  }
+  H5Oclose(object);
+  return 0;
+}
+
+// What the child does: open the file and read all of it.
+void ProbeFile(const std::string& path) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file < 0) return;
+  H5Ovisit2(file, H5_INDEX_NAME, H5_ITER_NATIVE, ProbeObject, nullptr, H5O_INFO_BASIC);
+  H5Fclose(file);
+}
+
+}  // namespace
+
+namespace internal {
+
+void ProbeHdf5InChild(const std::string& path, const std::string& expected) {
+  SurviveInChild(path, expected, "the HDF5 library", [&] { ProbeFile(path); });
+}
+
+}  // namespace internal
+
+namespace {
 
 void CheckNumeric(H5T_class_t type_class) {
   if (type_class != H5T_FLOAT && type_class != H5T_INTEGER) {
@@ -247,22 +388,11 @@ struct H5Reader::Impl {
   std::vector<double> ReadNumeric(const std::string& object, int rank,
                                   std::vector<hsize_t>* dims) const {
     const H5::DataSet dataset = OpenDataSet(object, "a float64 dataset");
-    CheckNumeric(dataset.getTypeClass());
-    const H5::DataSpace space = dataset.getSpace();
-    const int actual_rank = space.getSimpleExtentNdims();
-    if (actual_rank != rank) {
-      throw ReadProblem{fmt::format("has {} dimensions", actual_rank),
-                        fmt::format("{} dimensions", rank)};
-    }
-    dims->assign(static_cast<size_t>(rank), 0);
-    if (rank > 0) space.getSimpleExtentDims(dims->data());
-    std::vector<double> data(static_cast<size_t>(space.getSimpleExtentNpoints()));
-    if (!data.empty()) dataset.read(data.data(), H5::PredType::NATIVE_DOUBLE);
-    return data;
+    return ReadNumericData(dataset.getId(), false, rank, dims);
   }
 };
 
-H5Reader::H5Reader(const std::string& path) {
+H5Reader::H5Reader(const std::string& path, Probe probe) {
   H5Lock lock(H5Mutex());
   H5::Exception::dontPrint();
   internal::CheckReadable(path, kExpectedH5);
@@ -273,6 +403,7 @@ H5Reader::H5Reader(const std::string& path) {
     H5Eclear2(H5E_DEFAULT);
   }
   if (!is_hdf5) throw InputError(path, "", "not an HDF5 file", kExpectedH5);
+  if (probe == Probe::kEverything) internal::ProbeHdf5InChild(path, kExpectedH5);
   impl_ = std::make_unique<Impl>();
   impl_->path = path;
   try {
@@ -324,7 +455,9 @@ double H5Reader::ReadScalar(const std::string& group, const std::string& name) c
   const std::string object = JoinPath(group, name);
   return impl_->Run(object, [&] {
     std::vector<hsize_t> dims;
-    return impl_->ReadNumeric(object, 0, &dims).at(0);
+    const std::vector<double> data = impl_->ReadNumeric(object, 0, &dims);
+    if (data.empty()) throw ReadProblem{"is empty (a null dataspace)", "a scalar number"};
+    return data.front();
   });
 }
 
@@ -433,9 +566,20 @@ std::string H5Reader::ReadScenarioYaml() const {
 
 // ---- free functions -----------------------------------------------------------------------
 
-Measurement ReadMeasurementH5(const std::string& path) { return H5Reader(path).ReadMeasurement(); }
+// The child makes exactly the calls this process makes next, from the same library state (the
+// fork's copy): a survey of the file can miss a path, and libhdf5 looped in-process on a
+// variable-length string the survey had read without harm.
+Measurement ReadMeasurementH5(const std::string& path) {
+  const auto read = [&] { return H5Reader(path, H5Reader::Probe::kNone).ReadMeasurement(); };
+  internal::SurviveInChild(path, kExpectedH5, "the HDF5 library", read);
+  return read();
+}
 
-std::string ReadScenarioYaml(const std::string& path) { return H5Reader(path).ReadScenarioYaml(); }
+std::string ReadScenarioYaml(const std::string& path) {
+  const auto read = [&] { return H5Reader(path, H5Reader::Probe::kNone).ReadScenarioYaml(); };
+  internal::SurviveInChild(path, kExpectedH5, "the HDF5 library", read);
+  return read();
+}
 
 Measurement ReadMeasurement(const std::string& path) {
   const std::string accepted = "a measurement file ending in .h5, .hdf5 or .csv";

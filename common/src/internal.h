@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -86,6 +87,17 @@ inline void CheckReadable(const std::string& path, const std::string& expected) 
   if (failed)
     throw InputError(path, "", std::string("cannot read: ") + std::strerror(error), expected);
 }
+
+// libhdf5 1.10 (and matio over it) can crash or loop for ever on a corrupt file, e.g. in its
+// global-heap reads of variable-length strings, and no check before a call can rule that out.
+// SurviveInChild runs `body` (the read) in a child process first and throws an InputError
+// ("<library> crashed reading the file", with `expected`) if the child crashes or does not
+// finish in time; a file it survives is then read in this process. Errors `body` throws are
+// left to that second read. MBID_NO_CHILD_PROBE=1 turns it off (to debug a crash in-process).
+void SurviveInChild(const std::string& path, const std::string& expected,
+                    const std::string& library, const std::function<void()>& body);
+// SurviveInChild with every attribute and dataset of an HDF5 file read as H5Reader reads them.
+void ProbeHdf5InChild(const std::string& path, const std::string& expected);
 
 // Writes `bytes` as the whole content of `path` (created or truncated); throws
 // std::runtime_error naming the file and the system's reason (ENOSPC, EFBIG, EIO).

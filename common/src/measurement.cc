@@ -6,6 +6,7 @@
 #include <set>
 
 #include "mbid/common/error.h"
+#include "mbid/common/utf8.h"
 
 namespace mbid {
 namespace {
@@ -55,6 +56,9 @@ void Measurement::Validate(const std::string& origin) const {
   std::set<std::string> seen;
   for (size_t i = 0; i < channels.size(); ++i) {
     const std::string& name = channels[i];
+    // Checked first: the other messages would quote the bad bytes.
+    ValidateUtf8(name, origin, fmt::format("channel {} name", i + 1));
+    ValidateUtf8(units[i], origin, fmt::format("channel {} unit", i + 1));
     if (name.empty()) {
       throw InputError(origin, fmt::format("channel {}", i), "empty channel name",
                        "a non-empty name");
@@ -71,6 +75,7 @@ void Measurement::Validate(const std::string& origin) const {
       throw InputError(origin, name, "empty unit", "a unit such as 'rad'");
     }
   }
+  ValidateUtf8(source, origin, "source");
   if (!std::isfinite(sample_interval_s) || sample_interval_s <= 0) {
     throw InputError(origin, "sample_interval_s",
                      fmt::format("sample interval {} s", sample_interval_s),

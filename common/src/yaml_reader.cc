@@ -10,6 +10,7 @@
 
 #include "internal.h"
 #include "mbid/common/error.h"
+#include "mbid/common/utf8.h"
 
 namespace mbid {
 namespace {
@@ -107,6 +108,7 @@ YamlReader YamlReader::FromFile(const std::string& path) {
 }
 
 YamlReader YamlReader::FromString(const std::string& text, const std::string& source) {
+  ValidateUtf8Text(text, source);
   try {
     return YamlReader(YAML::Load(text), source, "");
   } catch (const YAML::ParserException& e) {

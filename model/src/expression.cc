@@ -7,16 +7,21 @@
 #include <stdexcept>
 
 namespace mbid::model {
+namespace {
+constexpr size_t kMaxNameLength = 64;
+}  // namespace
 
 void ExpressionContext::Define(const std::string& name, double value) {
+  // muparser refuses identifiers longer than 100 characters, with an exception of its own.
   const bool valid =
-      !name.empty() && std::isalpha(static_cast<unsigned char>(name[0])) &&
+      !name.empty() && name.size() <= kMaxNameLength &&
+      std::isalpha(static_cast<unsigned char>(name[0])) &&
       name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
           std::string::npos;
   if (!valid) {
     throw std::invalid_argument("'" + name +
                                 "' is not a parameter name (letters, digits, '_', starting with "
-                                "a letter)");
+                                "a letter, at most 64 characters)");
   }
   if (name == "pi") throw std::invalid_argument("'pi' is reserved for the constant");
   values_[name] = value;
@@ -24,13 +29,13 @@ void ExpressionContext::Define(const std::string& name, double value) {
 
 double ExpressionContext::Evaluate(const std::string& text) const {
   mu::Parser parser;
-  // muparser names its constant _pi; the contract says pi. Variables are bound to copies the
-  // parser reads at Eval().
-  parser.DefineConst("pi", M_PI);
   std::map<std::string, double> copies = values_;
-  for (auto& [name, value] : copies) parser.DefineVar(name, &value);
   double value = 0.0;
   try {
+    // muparser names its constant _pi; the contract says pi. Variables are bound to copies the
+    // parser reads at Eval(). Inside the try: muparser's errors are not std::exceptions.
+    parser.DefineConst("pi", M_PI);
+    for (auto& [name, copy] : copies) parser.DefineVar(name, &copy);
     parser.SetExpr(text);
     value = parser.Eval();
   } catch (const mu::Parser::exception_type& error) {

@@ -15,6 +15,7 @@
 #include "internal.h"
 #include "iso_time.h"
 #include "mbid/common/error.h"
+#include "mbid/common/utf8.h"
 #include "readers.h"
 
 namespace mbid::records::internal {
@@ -68,6 +69,7 @@ void ReadComment(const std::string& line, int number, char separator, Metadata* 
 
 RawTable ReadCsv(const std::string& path) {
   const std::string text = mbid::internal::ReadTextFile(path, kExpected);
+  ValidateUtf8Text(text, path);
   CsvDialect dialect;
   const std::vector<TextLine> lines = SplitLines(text, &dialect.bom, &dialect.crlf);
   if (!DetectDialect(lines, &dialect)) {

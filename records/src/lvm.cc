@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "mbid/common/error.h"
+#include "mbid/common/utf8.h"
 #include "raw_table.h"
 #include "text_util.h"
 
@@ -474,6 +475,7 @@ class LvmReader {
 
 RawTable ReadLvm(const std::string& path) {
   const std::string text = ReadWholeFile(path, kExpectedFile);
+  ValidateUtf8Text(text, path);
   return LvmReader(path, text).Read();
 }
 

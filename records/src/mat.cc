@@ -922,7 +922,13 @@ MatVar DoubleVar(const char* name, const double* data, size_t rows) {
 
 }  // namespace
 
-RawTable ReadMat(const std::string& path) { return MatReader(path).Read(); }
+RawTable ReadMat(const std::string& path) {
+  // matio trusts much of a file (and libhdf5 under it, for v7.3, can crash on a corrupt one):
+  // the whole read is tried in a child process first.
+  SilenceMatio();
+  mbid::internal::SurviveInChild(path, kExpectedFile, "matio", [&] { MatReader(path).Read(); });
+  return MatReader(path).Read();
+}
 
 }  // namespace internal
 

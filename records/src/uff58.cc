@@ -345,6 +345,13 @@ class Uff58Reader {
                                      value_count, width),
                          fmt::format("{} bytes", value_count * width));
       }
+      // The header's count was checked against the file before records 1-11; they took some.
+      if (static_cast<size_t>(byte_count) > lines_.remaining()) {
+        throw InputError(path_, fmt::format("{}, header", d.where),
+                         fmt::format("byte count {} with {} bytes left after the ASCII records",
+                                     byte_count, lines_.remaining()),
+                         "the number of bytes of binary data, within the file");
+      }
       numbers = DecodeBinary(lines_.Bytes(static_cast<size_t>(byte_count)), width, big_endian);
       ExpectClosing(d, /*binary=*/true);
     } else {

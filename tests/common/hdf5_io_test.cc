@@ -11,6 +11,7 @@
 
 #include <csignal>
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 
 #include "test_util.h"
@@ -431,6 +432,75 @@ TEST_F(Hdf5BadInputTest, ChannelDatasetOfStrings) {
   const InputError e = Read();
   EXPECT_EQ(e.field(), "/measurement/phi");
   EXPECT_EQ(e.problem(), "is of string type");
+}
+
+// Dimensions of 2^40 samples in a file of a few KB (chunked, nothing written): refused before
+// anything that size is allocated (it was std::bad_alloc, exit 1).
+TEST_F(Hdf5BadInputTest, AbsurdDimensionsAreRefusedBeforeAllocating) {
+  DamageWithHdf5([](H5::H5File& f) {
+    f.unlink("/measurement/time");
+    const hsize_t dims[1] = {hsize_t{1} << 40};
+    const hsize_t chunk[1] = {1024};
+    H5::DSetCreatPropList properties;
+    properties.setChunk(1, chunk);
+    f.createDataSet("/measurement/time", H5::PredType::NATIVE_DOUBLE, H5::DataSpace(1, dims),
+                    properties);
+  });
+  const InputError e = Read();
+  EXPECT_EQ(e.field(), "/measurement/time");
+  EXPECT_THAT(e.problem(), HasSubstr("has dimensions beyond 100000000 elements"));
+}
+
+// A channel name that is not UTF-8 is refused where it is read, naming the attribute (it used
+// to pass and fail only when the JSON summary was written).
+TEST_F(Hdf5BadInputTest, ChannelNameThatIsNotUtf8) {
+  DamageWithHdf5([](H5::H5File& f) {
+    H5::Group group = f.openGroup("/measurement");
+    group.removeAttr("channels");
+    const H5::StrType type(H5::PredType::C_S1, 8);
+    const hsize_t dims[1] = {2};
+    H5::Attribute attribute = group.createAttribute("channels", type, H5::DataSpace(1, dims));
+    const char names[16] = {'p', 's', 'i', 0, 0, 0, 0, 0, 'p', 'h', '\xE9', 0, 0, 0, 0, 0};
+    attribute.write(type, names);
+  });
+  const InputError e = Read();
+  EXPECT_EQ(e.field(), "/measurement attribute 'channels'");
+  EXPECT_EQ(e.problem(), "string 2 is not UTF-8 (byte 0xE9 at byte 3)");
+}
+
+// The cases, found by fuzz_hdf5: a variable-length string attribute whose global-heap
+// read in libhdf5 1.10.8 (H5Aread -> H5T__conv_vlen -> H5HG_read) crashes with SIGSEGV, or
+// loops for ever, on mbid's own read path. The read is tried in a child process first; the file
+// ends in an InputError (exit 2), after 5 s for the loop.
+InputError ReadHostile(const std::string& name) {
+  TempDir dir;
+  const std::string path = dir.File("hostile.h5");
+  std::filesystem::copy_file(std::string(MBID_SOURCE_DIR) + "/tests/data/records/hostile/" + name,
+                             path);
+  const InputError e = CatchInputError([&] { ReadMeasurementH5(path); });
+  EXPECT_EQ(e.source(), path);
+  return e;
+}
+
+TEST(Hdf5IoTest, AFileThatCrashesLibhdf5IsAnInputError) {
+  EXPECT_THAT(ReadHostile("vlen_string_global_heap_crash.h5").problem(),
+              HasSubstr("the HDF5 library crashed reading the file (signal 11"));
+}
+
+TEST(Hdf5IoTest, AFileThatHangsLibhdf5IsAnInputError) {
+  EXPECT_THAT(ReadHostile("vlen_string_global_heap_loop.h5").problem(),
+              HasSubstr("the HDF5 library did not finish reading the file in 5 s"));
+}
+
+// H5Reader used directly (not through ReadMeasurementH5) surveys the whole file in the child.
+TEST(Hdf5IoTest, H5ReaderSurveysTheWholeFileFirst) {
+  TempDir dir;
+  const std::string path = dir.File("hostile.h5");
+  std::filesystem::copy_file(
+      std::string(MBID_SOURCE_DIR) + "/tests/data/records/hostile/vlen_string_global_heap_crash.h5",
+      path);
+  const InputError e = CatchInputError([&] { H5Reader reader(path); });
+  EXPECT_THAT(e.problem(), HasSubstr("the HDF5 library crashed reading the file"));
 }
 
 // A full disk, made by a file-size limit (writes fail with EFBIG as they would with ENOSPC). HDF5

@@ -497,7 +497,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"payload point unknown", "payload_point: tip", "payload_point: hook",
                 "model.payload_point", "unknown point"},
         BadCase{"unknown output type", "type: angular_velocity", "type: angular_rate",
-                "model.outputs.jib_rate.type", "angular_rate"}),
+                "model.outputs.jib_rate.type", "angular_rate"},
+        // Found by fuzz_machine: muparser refused the name with an exception of its own that
+        // escaped as exit 1.
+        BadCase{"parameter name too long", "parameters: {tilt_deg: 12.0}",
+                "parameters: {tilt_deg: 12.0, "
+                "a_name_of_one_hundred_and_one_characters_xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx"
+                "xxxxxxxxxxxxxxxxxxxx: 1}",
+                "model.parameters", "at most 64 characters"}),
     [](const ::testing::TestParamInfo<BadCase>& param_info) {
       std::string name = param_info.param.name;
       for (char& c : name) {

@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "mbid/common/error.h"
 #include "mbid/records/records.h"
 #include "test_util.h"
@@ -43,6 +45,8 @@ const BadFile kBadFiles[] = {
     {"NoHeader", "0;1\n1;2\n", "", "no header", "header"},
     {"TwoUnits", "t [s];x [mm]\ns;m\n0;1\n1;2\n", "line 1, column 2", "'mm' in the header",
      "one unit"},
+    // A Latin-1 export: refused where it is read, not when the JSON summary is written.
+    {"NotUtf8", "t [s];Winkel [\xB0]\n0;1\n1;2\n", "line 1", "byte 0xB0 at column 15", "UTF-8"},
 };
 
 void PrintTo(const BadFile& bad, std::ostream* os) { *os << bad.name; }
@@ -124,6 +128,48 @@ TEST(BadOptionsTest, UnsupportedExtension) {
   const InputError e = CatchInputError([&] { ImportMeasurement(path); });
   EXPECT_THAT(e.problem(), HasSubstr(".xlsx"));
   EXPECT_THAT(e.expected(), HasSubstr(".csv"));
+}
+
+}  // namespace
+}  // namespace mbid::records
+
+namespace mbid::records {
+namespace {
+
+// Hostile files found by fuzzing (fuzz/, docs/reliability.md), each a regression test: the
+// reader ends in an InputError naming the file instead of crashing.
+TEST(HostileFileTest, MatV73ThatCrashesLibhdf5) {
+  TempDir dir;
+  const std::string path = dir.File("corrupt.mat");
+  std::filesystem::copy_file(
+      std::string(MBID_SOURCE_DIR) + "/tests/data/records/hostile/mat73_corrupt_group_btree.mat",
+      path);
+  const InputError e = CatchInputError([&] { ImportMeasurement(path); });
+  EXPECT_EQ(e.source(), path);
+  EXPECT_THAT(e.problem(), HasSubstr("matio crashed reading the file"));
+}
+
+// A 58b header whose byte count fits the file when the header is read but not after the 11
+// ASCII records (found by fuzz_logger: the reader read past the end of its buffer).
+TEST(HostileFileTest, Uff58bByteCountPastTheEnd) {
+  TempDir dir;
+  const std::string path = dir.File("short.uff");
+  std::filesystem::copy_file(
+      std::string(MBID_SOURCE_DIR) + "/tests/data/records/hostile/uff58b_byte_count_past_end.uff",
+      path);
+  const InputError e = CatchInputError([&] { ImportMeasurement(path); });
+  EXPECT_EQ(e.field(), "dataset 2 (line 17), header");
+  EXPECT_THAT(e.problem(), HasSubstr("byte count 64 with"));
+  EXPECT_THAT(e.problem(), HasSubstr("bytes left after the ASCII records"));
+}
+
+TEST(HostileFileTest, LvmChannelNameThatIsNotUtf8) {
+  TempDir dir;
+  const std::string path = dir.File("latin1.lvm");
+  WriteText(path, "LabVIEW Measurement\t\nX_Value\tWinkel \xE4\n0\t1\n1\t2\n");
+  const InputError e = CatchInputError([&] { ImportMeasurement(path); });
+  EXPECT_EQ(e.field(), "line 2");
+  EXPECT_EQ(e.problem(), "invalid UTF-8: byte 0xE4 at column 16");
 }
 
 }  // namespace

@@ -60,8 +60,14 @@ class H5Writer {
 // double; strings may be variable- or fixed-length.
 class H5Reader {
  public:
-  // Throws InputError if the file cannot be opened or is not an HDF5 file.
-  explicit H5Reader(const std::string& path);
+  // How the constructor guards against files that crash libhdf5 (docs/reliability.md).
+  enum class Probe {
+    kEverything,  // every attribute and dataset is read in a child process first
+    kNone,        // nothing (a file this program wrote, or a caller that probed the exact reads)
+  };
+  // Throws InputError if the file cannot be opened or is not an HDF5 file, or if reading it
+  // crashes or hangs libhdf5 in the child process.
+  explicit H5Reader(const std::string& path, Probe probe = Probe::kEverything);
   ~H5Reader();
   H5Reader(const H5Reader&) = delete;
   H5Reader& operator=(const H5Reader&) = delete;
