@@ -2,7 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <string_view>
 #include <utility>
+
+#include "mbid/common/utf8.h"
 
 namespace mbid {
 namespace {
@@ -16,51 +19,24 @@ std::string FormatInputError(const std::string& source, const std::string& field
   return OneLine(message);
 }
 
-// Length of the valid UTF-8 sequence at text[i], 0 if it is not one (RFC 3629: no overlong
-// forms, no surrogates, nothing above U+10FFFF).
-size_t Utf8SequenceLength(const std::string& text, size_t i) {
-  const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
-  const unsigned char lead = byte(i);
-  size_t length = 0;
-  unsigned char low = 0x80, high = 0xBF;
-  if (lead >= 0xC2 && lead <= 0xDF) {
-    length = 2;
-  } else if (lead >= 0xE0 && lead <= 0xEF) {
-    length = 3;
-    if (lead == 0xE0) low = 0xA0;
-    if (lead == 0xED) high = 0x9F;
-  } else if (lead >= 0xF0 && lead <= 0xF4) {
-    length = 4;
-    if (lead == 0xF0) low = 0x90;
-    if (lead == 0xF4) high = 0x8F;
-  } else {
-    return 0;
-  }
-  if (i + length > text.size()) return 0;
-  if (byte(i + 1) < low || byte(i + 1) > high) return 0;
-  for (size_t k = 2; k < length; ++k) {
-    if (byte(i + k) < 0x80 || byte(i + k) > 0xBF) return 0;
-  }
-  return length;
-}
-
 }  // namespace
 
 std::string OneLine(const std::string& text) {
   std::string line;
   line.reserve(text.size());
+  const auto escape = [&line](unsigned char c) { line += fmt::format("\\x{:02x}", c); };
   for (size_t i = 0; i < text.size();) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    if (c >= 0x20 && c < 0x7F) {
-      line += text[i++];
-    } else if (c >= 0x80 && Utf8SequenceLength(text, i) > 0) {
-      const size_t length = Utf8SequenceLength(text, i);
-      line.append(text, i, length);
-      i += length;
-    } else {
-      line += fmt::format("\\x{:02x}", c);  // a control character or a stray byte
-      ++i;
+    const size_t bad = FindInvalidUtf8(std::string_view(text).substr(i));
+    const size_t end = bad == std::string_view::npos ? text.size() : i + bad;
+    for (; i < end; ++i) {  // valid UTF-8: only control characters to escape
+      const auto c = static_cast<unsigned char>(text[i]);
+      if (c < 0x20 || c == 0x7F) {
+        escape(c);
+      } else {
+        line += text[i];
+      }
     }
+    if (i < text.size()) escape(static_cast<unsigned char>(text[i++]));  // a stray byte
   }
   return line;
 }

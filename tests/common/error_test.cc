@@ -31,5 +31,17 @@ TEST(ErrorTest, NumericalErrorMessageIsStageAndReason) {
   EXPECT_EQ(e.reason(), "too much work at t = 1.5");
 }
 
+TEST(ErrorTest, MessagesStayOneLineAndUtf8) {
+  // A quoted line break, tab or NUL and bytes that are not UTF-8 (a stray 0xff, a sequence cut
+  // short) become \xNN; valid UTF-8 (an umlaut, a euro sign) stays as it is.
+  EXPECT_EQ(OneLine("a\nb\tc"), "a\\x0ab\\x09c");
+  EXPECT_EQ(OneLine(std::string("x\0y", 3)), "x\\x00y");
+  EXPECT_EQ(OneLine("M\xc3\xa4rz \xe2\x82\xac"), "M\xc3\xa4rz \xe2\x82\xac");
+  EXPECT_EQ(OneLine("bad\xff byte"), "bad\\xff byte");
+  EXPECT_EQ(OneLine("cut \xe2\x82"), "cut \\xe2\\x82");
+  const InputError e("f.yaml", "line 3", "unknown escape \x01\n", "valid YAML");
+  EXPECT_STREQ(e.what(), "f.yaml:line 3: unknown escape \\x01\\x0a; expected valid YAML");
+}
+
 }  // namespace
 }  // namespace mbid
