@@ -450,18 +450,26 @@ class CvodesIntegrator::Impl {
   // Y' = f(t, Y) for CVODES: Simbody's own derivative of [q | u | z].
   static int Rhs(realtype t, N_Vector y, N_Vector y_dot, void* user_data) {
     auto* self = static_cast<Impl*>(user_data);
-    if (self->rhs_failures_ > kMaxRhsFailuresPerCall) return -1;
-    try {
+    return self->Guarded(t, [&] {
       self->SetTimeAndY(t, N_VGetArrayPointer(y));
       self->CalcDerivative(N_VGetArrayPointer(y_dot));
+    });
+  }
+
+  // Runs a callback's `body` for CVODES: an exception is recoverable (CVODES retries with a
+  // smaller step) until the failure persists.
+  template <typename Body>
+  int Guarded(double t, Body&& body) {
+    if (rhs_failures_ > kMaxRhsFailuresPerCall) return -1;
+    try {
+      body();
       return 0;
     } catch (const std::exception& e) {
-      self->RecordRhsError(t, e.what());
+      RecordRhsError(t, e.what());
     } catch (...) {
-      self->RecordRhsError(t, "unknown exception");
+      RecordRhsError(t, "unknown exception");
     }
-    // Recoverable (CVODES retries with a smaller step) until the failure persists.
-    return self->rhs_failures_ > kMaxRhsFailuresPerCall ? -1 : 1;
+    return rhs_failures_ > kMaxRhsFailuresPerCall ? -1 : 1;
   }
 
   // s_i' = J s_i + df/dp_i for CVODES (kStateJacobian); J and df/dp come from the cache of
@@ -469,8 +477,7 @@ class CvodesIntegrator::Impl {
   static int SensitivityRhs(int count, realtype t, N_Vector y, N_Vector /*y_dot*/, N_Vector* s,
                             N_Vector* s_dot, void* user_data, N_Vector, N_Vector) {
     auto* self = static_cast<Impl*>(user_data);
-    if (self->rhs_failures_ > kMaxRhsFailuresPerCall) return -1;
-    try {
+    return self->Guarded(t, [&] {
       self->UpdateSensitivityJacobian(t, N_VGetArrayPointer(y));
       const Eigen::Index ny = self->state_jacobian_.rows();
       for (int i = 0; i < count; ++i) {
@@ -479,13 +486,7 @@ class CvodesIntegrator::Impl {
         s_dot_i.noalias() = self->state_jacobian_ * s_i;
         s_dot_i += self->parameter_derivative_.col(i);
       }
-      return 0;
-    } catch (const std::exception& e) {
-      self->RecordRhsError(t, e.what());
-    } catch (...) {
-      self->RecordRhsError(t, "unknown exception");
-    }
-    return self->rhs_failures_ > kMaxRhsFailuresPerCall ? -1 : 1;
+    });
   }
 
   // J = df/dY and df/dp at (t, Y) unless they are cached for these very bits.
