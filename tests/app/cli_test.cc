@@ -176,8 +176,9 @@ TEST_F(CliTest, SimulateWritesTheMeasurementFileH5pyReads) {
   EXPECT_EQ(summary["samples"], 801);  // 8 s at 100 Hz, both ends
   // reference-crane.md: the drop starts from alpha = 5.846515e-04 rad (7 digits).
   EXPECT_NEAR(summary["initial_q"]["alpha"].get<double>(), 5.846515e-04, 1e-10);
-  // The scenario names BDF; the summary says what ran, with its counters.
-  EXPECT_EQ(summary["integrator"]["method"], "bdf");
+  // The scenario names `auto`, which picks Adams on this crane (ChooseMethod); the summary says
+  // what ran, with its counters.
+  EXPECT_EQ(summary["integrator"]["method"], "adams");
   EXPECT_GT(summary["integrator"]["steps"].get<int>(), 0);
   if (!fs::exists("/usr/bin/python3") ||
       std::system("/usr/bin/python3 -c 'import h5py' 2>/dev/null") != 0) {

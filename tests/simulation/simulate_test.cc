@@ -317,7 +317,10 @@ TEST(SimulateTest, ReadsScenarioSections) {
   const SimulationOptions options = ReadSimulationOptions(root.Child("simulation"));
   EXPECT_EQ(options.duration_s, 8.0);
   EXPECT_EQ(options.integrator.relative_tolerance, 1e-8);
-  EXPECT_EQ(options.integrator.method, IntegratorOptions::Method::kBdf);  // as the file says
+  EXPECT_EQ(options.integrator.method, IntegratorOptions::Method::kAuto);  // as the file says
+  const YamlReader bdf =
+      YamlReader::FromString("integrator: {method: bdf}\nduration_s: 1\n", "inline.yaml");
+  EXPECT_EQ(ReadSimulationOptions(bdf).integrator.method, IntegratorOptions::Method::kBdf);
   const YamlReader automatic =
       YamlReader::FromString("integrator: {method: auto}\nduration_s: 1\n", "inline.yaml");
   EXPECT_EQ(ReadSimulationOptions(automatic).integrator.method, IntegratorOptions::Method::kAuto);
