@@ -196,7 +196,7 @@ TEST_F(CliTest, SimulateWritesTheMeasurementFileH5pyReads) {
       "assert 'load_drop' in f['scenario'].attrs['yaml']\n"
       "assert f['truth/parameters/c_alpha'][()] == 4.9e7\n"
       "assert f['truth/modes/frequency_hz'].shape == (4,)\n"
-      "assert f['simulation'].attrs['integrator'] == 'cvodes_bdf'\n"
+      "assert f['simulation'].attrs['integrator'] == 'cvodes_adams'\n"
       "assert f['simulation/statistics/steps'][()] > 0\n"
       "print('ok')\n";
   const fs::path script_path = dir_ / "check.py";
