@@ -1,5 +1,7 @@
 #include "mbid/model/machine_description.h"
 
+#include <fmt/format.h>
+
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -203,7 +205,8 @@ void MachineDescription::Validate() const {
     }
     // 1e9 kg is far past any machine and keeps inertias and their products finite.
     if (!(std::isfinite(body.mass_kg) && body.mass_kg >= 0 && body.mass_kg <= 1e9)) {
-      Fail(field + ".mass_kg", "mass " + std::to_string(body.mass_kg), "a mass from 0 to 1e9 kg");
+      Fail(field + ".mass_kg", fmt::format("mass {:g} kg", body.mass_kg),
+           "a mass from 0 to 1e9 kg");
     }
     if (!body.com_m.allFinite()) Fail(field + ".com_m", "non-finite position", "finite, in m");
     CheckInertia(body, field + ".inertia_kgm2");

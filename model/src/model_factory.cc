@@ -1,5 +1,7 @@
 #include "mbid/model/model_factory.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 
 #include "mbid/common/error.h"
@@ -17,7 +19,7 @@ constexpr double kMaxLength_m = 1000.0;
 double ReadMass(const YamlReader& reader, const std::string& key) {
   const double mass_kg = reader.PositiveDouble(key);
   if (mass_kg > kMaxMass_kg) {
-    reader.FailAt(key, "mass " + std::to_string(mass_kg) + " kg", "a mass up to 1e9 kg");
+    reader.FailAt(key, fmt::format("mass {:g} kg", mass_kg), "a mass up to 1e9 kg");
   }
   return mass_kg;
 }
@@ -85,7 +87,7 @@ TruckCraneParameters ReadTruckCraneParameters(const YamlReader& model) {
   p.boom_mass_kg = ReadMass(boom, "mass_kg");
   p.boom_length_m = boom.PositiveDouble("length_m");
   if (p.boom_length_m > kMaxLength_m) {
-    boom.FailAt("length_m", "length " + std::to_string(p.boom_length_m) + " m",
+    boom.FailAt("length_m", fmt::format("length {:g} m", p.boom_length_m),
                 "a boom length up to 1000 m");
   }
   p.boom_axial_inertia_kgm2 = boom.PositiveDouble("axial_inertia_kgm2");
