@@ -42,10 +42,9 @@ void RemoveStaleTemporaries(const std::string& path) {
         rest.find('-', dash + 1) != std::string::npos || dash + 1 == rest.size()) {
       continue;
     }
-    const pid_t pid = static_cast<pid_t>(std::stol(rest.substr(0, dash)));
+    const int pid = std::stoi(rest.substr(0, dash));
     std::error_code ignored;
-    if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH &&
-        entry.is_regular_file(ignored)) {
+    if (internal::ProcessIsGone(pid) && entry.is_regular_file(ignored)) {
       fs::remove(entry.path(), ignored);
     }
   }
@@ -73,6 +72,8 @@ void WriteWholeFile(const std::string& path, const std::vector<char>& bytes) {
                              std::error_code(error, std::generic_category()).message());
   }
 }
+
+bool ProcessIsGone(int pid) { return pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH; }
 
 void SyncFile(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);

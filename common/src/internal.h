@@ -109,4 +109,8 @@ void SyncFile(const std::string& path);
 // systems that cannot sync folders (EINVAL) are not an error.
 void SyncFolder(const std::string& path);
 
+// True when no process `pid` exists (kill(pid, 0) fails with ESRCH; EPERM means it exists and is
+// not ours) and it is not this one: its temporaries will never be committed.
+bool ProcessIsGone(int pid);
+
 }  // namespace mbid::internal

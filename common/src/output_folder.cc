@@ -40,9 +40,6 @@ pid_t ParseTemporary(const std::string& entry, const char* tag, std::string* fin
   return static_cast<pid_t>(std::stol(digits));
 }
 
-// kill(pid, 0) fails with ESRCH only when no such process exists (EPERM: it exists, not ours).
-bool ProcessIsGone(pid_t pid) { return pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH; }
-
 // Files first, then the folders that hold them, so that the rename commits synced entries.
 void SyncTree(const fs::path& folder) {
   for (const auto& entry : fs::recursive_directory_iterator(folder)) {
@@ -94,11 +91,13 @@ OutputFolder::OutputFolder(const fs::path& final_path, std::string kind, bool ov
     std::error_code ignored;
     if (!entry.is_directory(ignored)) continue;
     if (const pid_t pid = ParseTemporary(name, ".tmp-", &final_name)) {
-      if (ProcessIsGone(pid) && (HasMarker(entry.path(), "") || is_previous_(entry.path()))) {
+      if (internal::ProcessIsGone(pid) &&
+          (HasMarker(entry.path(), "") || is_previous_(entry.path()))) {
         fs::remove_all(entry.path(), ignored);
       }
     } else if (const pid_t old_pid = ParseTemporary(name, ".old-", &final_name)) {
-      if (!ProcessIsGone(old_pid) || !(HasMarker(entry.path(), "") || is_previous_(entry.path())))
+      if (!internal::ProcessIsGone(old_pid) ||
+          !(HasMarker(entry.path(), "") || is_previous_(entry.path())))
         continue;
       // Renamed aside for a replacement that never arrived: the results are still wanted.
       const fs::path original = parent / final_name;
