@@ -64,9 +64,8 @@ bool IsHalfCreated(const fs::path& dir) {
   for (const auto& entry : fs::directory_iterator(dir, error)) {
     const std::string name = entry.path().filename().string();
     if (name == "cases" && fs::is_directory(entry.path()) && fs::is_empty(entry.path())) continue;
+    // WriteJson commits through AtomicFile: "campaign.json.tmp-<pid>-<n>".
     if (name.rfind(kManifest, 0) == 0 && name.find(".tmp-") != std::string::npos) continue;
-    if (name.rfind(std::string(".") + kManifest, 0) == 0 && name.find(".tmp-") != std::string::npos)
-      continue;
     return false;
   }
   return !error;
@@ -125,51 +124,43 @@ ResultsFolder::State ResultsFolder::Prepare(const Campaign& campaign, bool resum
 }
 
 ResultsFolder::Scan ResultsFolder::ScanCommitted(const Campaign& campaign) const {
-  const fs::path cases = fs::path(dir_) / "cases";
+  std::map<std::string, size_t> index;
+  for (size_t i = 0; i < campaign.cases.size(); ++i) index[campaign.cases[i].id] = i;
+  Scan scan;
+  scan.committed.assign(campaign.cases.size(), false);
   std::error_code error;
-  // Temporaries of a process that was killed: AtomicFile names them "<file>.tmp-<pid>-<n>";
-  // unsealed case files lost their process before the checksummed rename.
-  for (const auto& entry : fs::directory_iterator(cases, error)) {
+  // Temporaries of a process that was killed (AtomicFile names them "<file>.tmp-<pid>-<n>"),
+  // unsealed case files that lost their process before the checksummed rename, and files of
+  // cases this campaign does not have go; committed cases are checked against their CRC-32.
+  for (const auto& entry : fs::directory_iterator(fs::path(dir_) / "cases", error)) {
+    const std::string path = entry.path().string();
     const std::string name = entry.path().filename().string();
     std::string id;
-    uint32_t crc = 0;
-    if (name.find(".tmp-") != std::string::npos || !ParseCommittedName(name, &id, &crc)) {
+    uint32_t expected = 0;
+    const auto it = ParseCommittedName(name, &id, &expected) ? index.find(id) : index.end();
+    if (name.find(".tmp-") != std::string::npos || it == index.end()) {
       fs::remove(entry.path(), error);
+      continue;
     }
+    std::string why;
+    try {
+      const uint32_t actual = FileCrc32(path);
+      if (actual == expected) {
+        ReadCaseRow(path);
+        scan.committed[it->second] = true;
+        continue;
+      }
+      why = fmt::format("damaged file (CRC-32 {:08x}, committed as {:08x})", actual, expected);
+    } catch (const std::exception& failure) {
+      why = failure.what();
+    }
+    fs::remove(entry.path(), error);
+    scan.damaged.push_back(id + ": " + why);
   }
   for (const auto& entry : fs::directory_iterator(dir_, error)) {
     if (entry.path().filename().string().find(".tmp-") != std::string::npos) {
       fs::remove_all(entry.path(), error);
     }
-  }
-  std::map<std::string, size_t> index;
-  for (size_t i = 0; i < campaign.cases.size(); ++i) index[campaign.cases[i].id] = i;
-  Scan scan;
-  scan.committed.assign(campaign.cases.size(), false);
-  for (const auto& [id, path] : FindCommittedCases()) {
-    const auto it = index.find(id);
-    std::string why;
-    if (it == index.end()) {
-      why = "not a case of this campaign";
-    } else {
-      std::string name;
-      uint32_t expected = 0;
-      ParseCommittedName(fs::path(path).filename().string(), &name, &expected);
-      try {
-        const uint32_t actual = FileCrc32(path);
-        if (actual != expected) {
-          why = fmt::format("damaged file (CRC-32 {:08x}, committed as {:08x})", actual, expected);
-        } else {
-          ReadCaseRow(path);
-          scan.committed[it->second] = true;
-          continue;
-        }
-      } catch (const std::exception& failure) {
-        why = failure.what();
-      }
-    }
-    fs::remove(path, error);
-    if (it != index.end()) scan.damaged.push_back(id + ": " + why);
   }
   return scan;
 }
