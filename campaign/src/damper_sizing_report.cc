@@ -42,20 +42,27 @@ void AddSmallestMarker(const JointSizing& joint, const std::string& target, doub
 }
 
 // The damping ratio of every mode against d_joint; returns the PNG's name in `folder`.
+// The axes both figures of a joint's damper sweep share: d_<joint> along x, `quantity` up.
+Figure DampingSweepFigure(const DamperSizingSpec& spec, const JointSizing& joint,
+                          const std::string& quantity, const std::string& y_label) {
+  Figure figure;
+  figure.title = fmt::format("{} vs d_{}", quantity, joint.joint);
+  figure.x_label = fmt::format("d_{}, N*m*s/rad", joint.joint);
+  figure.y_label = y_label;
+  figure.log_x = spec.log_spacing;
+  figure.x_range = XRange(spec, joint);
+  figure.y_range = "[0:*]";
+  figure.key = "outside right top box";
+  return figure;
+}
+
 std::string DrawDampingRatioFigure(const DamperSizingSpec& spec, const JointSizing& joint,
                                    const std::string& folder) {
   const Eigen::Index n = joint.damping_Nms_per_rad.size();
   const double d_low = joint.damping_Nms_per_rad.minCoeff();
   const double d_high = joint.damping_Nms_per_rad.maxCoeff();
-  const std::string x_range = XRange(spec, joint);
-  Figure figure;
-  figure.title = fmt::format("Damping ratio of every mode vs d_{}", joint.joint);
-  figure.x_label = fmt::format("d_{}, N*m*s/rad", joint.joint);
-  figure.y_label = "damping ratio, 1";
-  figure.log_x = spec.log_spacing;
-  figure.x_range = x_range;
-  figure.y_range = "[0:*]";
-  figure.key = "outside right top box";
+  Figure figure =
+      DampingSweepFigure(spec, joint, "Damping ratio of every mode", "damping ratio, 1");
   for (Eigen::Index k = 0; k < joint.damping_ratio.cols(); ++k) {
     std::vector<double> x, y;
     for (Eigen::Index i = 0; i < n; ++i) {
@@ -91,15 +98,8 @@ std::string DrawSettlingTimeFigure(const DamperSizingSpec& spec, const JointSizi
   const Eigen::Index n = joint.damping_Nms_per_rad.size();
   const double d_low = joint.damping_Nms_per_rad.minCoeff();
   const double d_high = joint.damping_Nms_per_rad.maxCoeff();
-  const std::string x_range = XRange(spec, joint);
-  Figure figure;
-  figure.title = fmt::format("Settling time of the outputs vs d_{}", joint.joint);
-  figure.x_label = fmt::format("d_{}, N*m*s/rad", joint.joint);
-  figure.y_label = "settling time, s";
-  figure.log_x = spec.log_spacing;
-  figure.x_range = x_range;
-  figure.y_range = "[0:*]";
-  figure.key = "outside right top box";
+  Figure figure =
+      DampingSweepFigure(spec, joint, "Settling time of the outputs", "settling time, s");
   std::vector<double> x, y;
   double y_max = spec.max_settling_time_s;
   for (Eigen::Index i = 0; i < n; ++i) {
