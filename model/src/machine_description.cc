@@ -203,8 +203,7 @@ void MachineDescription::Validate() const {
     if (!joint.in_parent_m.allFinite() || !joint.in_body_m.allFinite()) {
       Fail(field + ".joint", "non-finite joint position", "finite positions in m");
     }
-    // 1e9 kg is far past any machine and keeps inertias and their products finite.
-    if (!(std::isfinite(body.mass_kg) && body.mass_kg >= 0 && body.mass_kg <= 1e9)) {
+    if (!(std::isfinite(body.mass_kg) && body.mass_kg >= 0 && body.mass_kg <= kMaxBodyMass_kg)) {
       Fail(field + ".mass_kg", fmt::format("mass {:g} kg", body.mass_kg),
            "a mass from 0 to 1e9 kg");
     }

@@ -11,14 +11,12 @@
 namespace mbid::model {
 namespace {
 
-// Bounds far past any machine (the largest weigh ~1e7 kg, the longest booms ~250 m) that keep
-// masses, inertias and their products finite: 1e308 kg would overflow to inf in the model.
-constexpr double kMaxMass_kg = 1e9;
+// Far past any crane (the longest booms ~250 m), like kMaxBodyMass_kg for masses.
 constexpr double kMaxLength_m = 1000.0;
 
 double ReadMass(const YamlReader& reader, const std::string& key) {
   const double mass_kg = reader.PositiveDouble(key);
-  if (mass_kg > kMaxMass_kg) {
+  if (mass_kg > kMaxBodyMass_kg) {
     reader.FailAt(key, fmt::format("mass {:g} kg", mass_kg), "a mass up to 1e9 kg");
   }
   return mass_kg;

@@ -27,6 +27,10 @@ struct JointDescription {
   Eigen::Matrix3d in_body_rotation = Eigen::Matrix3d::Identity();  // R_BM
 };
 
+// The largest body mass accepted: far past any machine (the largest weigh ~1e7 kg), it keeps
+// masses, inertias and their products finite (1e308 kg would overflow to inf in the model).
+constexpr double kMaxBodyMass_kg = 1e9;
+
 struct BodyDescription {
   std::string name;
   std::string parent;  // "ground" or a body listed before this one
