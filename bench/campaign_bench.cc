@@ -6,10 +6,19 @@
 //   total_cases_per_s  cases over the whole command (folder checks, merge into campaign.h5,
 //                      summary.csv, report figures)
 //   efficiency         cases_per_s / (units * cases_per_s with 1 worker): the parallel efficiency
+//   cpu_ms_per_case    CPU time (user + system, all threads or all ranks and mpiexec) of the
+//                      whole command per case: unlike rates, unaffected by other load on a
+//                      shared host
+//   cpu_ratio          cpu_ms_per_case / the same with 1 worker: what running in parallel costs
 // The MPI run is the mbid binary under mpiexec; its case-phase rate is the one mbid reports.
 #include <benchmark/benchmark.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -18,9 +27,12 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "mbid/campaign/campaign.h"
 #include "mbid/campaign/campaign_runner.h"
+
+extern char** environ;
 
 namespace {
 
@@ -51,13 +63,31 @@ double& SingleWorkerRate() {
   static double rate = 0;
   return rate;
 }
+double& SingleWorkerCpu() {
+  static double cpu = 0;
+  return cpu;
+}
 
-void Report(benchmark::State& state, int units, double cases_s, double total_s) {
+// User + system CPU seconds of this process (RUSAGE_SELF) or of its waited-for children.
+double CpuSeconds(int who) {
+  rusage usage{};
+  ::getrusage(who, &usage);
+  auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * t.tv_usec; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+void Report(benchmark::State& state, int units, double cases_s, double total_s, double cpu_s) {
   const double rate = kCases / cases_s;
-  if (units == 1) SingleWorkerRate() = rate;
+  const double cpu_ms = 1e3 * cpu_s / kCases;
+  if (units == 1) {
+    SingleWorkerRate() = rate;
+    SingleWorkerCpu() = cpu_ms;
+  }
   state.counters["cases_per_s"] = rate;
   state.counters["total_cases_per_s"] = kCases / total_s;
+  state.counters["cpu_ms_per_case"] = cpu_ms;
   if (SingleWorkerRate() > 0) state.counters["efficiency"] = rate / (units * SingleWorkerRate());
+  if (SingleWorkerCpu() > 0) state.counters["cpu_ratio"] = cpu_ms / SingleWorkerCpu();
 }
 
 void BM_CampaignThreads(benchmark::State& state) {
@@ -71,13 +101,15 @@ void BM_CampaignThreads(benchmark::State& state) {
     options.workers = workers;
     options.quiet = true;
     const auto start = std::chrono::steady_clock::now();
+    const double cpu_start = CpuSeconds(RUSAGE_SELF);
     const mbid::campaign::CampaignRunSummary summary =
         mbid::campaign::RunCampaign(campaign, out.string(), options);
+    const double cpu = CpuSeconds(RUSAGE_SELF) - cpu_start;
     const double total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     state.SetIterationTime(total);
     if (summary.failed > 0) state.SkipWithError("some cases failed");
-    Report(state, workers, summary.cases_wall_s, total);
+    Report(state, workers, summary.cases_wall_s, total, cpu);
   }
 }
 BENCHMARK(BM_CampaignThreads)
@@ -99,16 +131,35 @@ void BM_CampaignMpiRanks(benchmark::State& state) {
   ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
   ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
   ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
+  static const std::string kMpiexec = MBID_MPIEXEC, kDashN = "-n", kCampaign = "campaign",
+                           kDashO = "-o", kWorkers = "--workers", kOne = "1";
   for (auto _ : state) {
     const fs::path out = WorkDir() / ("mpi_" + std::to_string(ranks));
     const fs::path log = WorkDir() / "mpi.log";
     fs::remove_all(out);
-    const std::string command = std::string(MBID_MPIEXEC) + " -n " + std::to_string(ranks) + " " +
-                                MBID_BINARY_DIR + "/app/mbid campaign " +
-                                (WorkDir() / "bench.yaml").string() + " -o " + out.string() +
-                                " --workers 1 2> " + log.string();
+    // An argument vector, no shell; mbid's stderr (its "ran ... cases" line) into the log.
+    const std::string n = std::to_string(ranks), yaml = (WorkDir() / "bench.yaml").string(),
+                      binary = std::string(MBID_BINARY_DIR) + "/app/mbid", out_dir = out.string();
+    std::vector<char*> argv;
+    for (const std::string* arg : {&kMpiexec, &kDashN, &n, &binary, &kCampaign, &yaml, &kDashO,
+                                   &out_dir, &kWorkers, &kOne}) {
+      argv.push_back(const_cast<char*>(arg->c_str()));
+    }
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(),
+                                     O_WRONLY | O_CREAT | O_TRUNC, 0644);
     const auto start = std::chrono::steady_clock::now();
-    const int status = std::system(command.c_str());
+    const double cpu_start = CpuSeconds(RUSAGE_CHILDREN);
+    pid_t pid = -1;
+    int status = -1;
+    if (posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ) == 0) {
+      while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+    }
+    posix_spawn_file_actions_destroy(&actions);
+    const double cpu = CpuSeconds(RUSAGE_CHILDREN) - cpu_start;
     const double total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     state.SetIterationTime(total);
@@ -123,7 +174,7 @@ void BM_CampaignMpiRanks(benchmark::State& state) {
       state.SkipWithError(("mpiexec failed: " + err).c_str());
       continue;
     }
-    Report(state, ranks, std::stod(match[2].str()), total);
+    Report(state, ranks, std::stod(match[2].str()), total, cpu);
   }
 #endif
 }

@@ -139,4 +139,42 @@ BENCHMARK(BM_SimbodyRungeKuttaMersonEqualError)->Unit(benchmark::kMillisecond);
 void BM_SimbodyCPodes(benchmark::State& state) { RunSimbody<SimTK::CPodesIntegrator>(state); }
 BENCHMARK(BM_SimbodyCPodes)->Unit(benchmark::kMillisecond);
 
+// One right-hand side Y' of the crane at a new q and u (what every CVODES evaluation costs), three
+// ways: Simbody's realize(Acceleration) (the anchor), realize(Dynamics) + the forward-dynamics
+// operator (the integrator's path until session 9), and the model's state derivative after
+// realize(Velocity) (MechanicalModel::MakeStateDerivative, the path now).
+void BM_RightHandSide(benchmark::State& state) {
+  const mbid::model::MultibodyModel& crane = Crane();
+  const int path = static_cast<int>(state.range(0));
+  const Eigen::VectorXd q0 = crane.SolveStaticEquilibrium(crane.CalcPayloadLoads(650.0));
+  SimTK::State s = crane.MakeState(q0, Eigen::VectorXd::Constant(4, 0.01));
+  const mbid::model::MechanicalModel::StateDerivative derivative = crane.MakeStateDerivative();
+  const SimTK::SimbodyMatterSubsystem& matter = crane.system().getMatterSubsystem();
+  SimTK::Vector u_dot;
+  SimTK::Vector_<SimTK::SpatialVec> body_accelerations;
+  double y_dot[8];
+  double sum = 0;
+  int k = 0;
+  for (auto _ : state) {
+    s.updQ()[k % 4] += 1e-9;  // a new point, as in an integration
+    ++k;
+    if (path == 0) {
+      crane.system().realize(s, SimTK::Stage::Acceleration);
+      sum += s.getUDot()[0];
+    } else if (path == 1) {
+      crane.system().realize(s, SimTK::Stage::Dynamics);
+      matter.calcAccelerationIgnoringConstraints(
+          s, crane.system().getMobilityForces(s, SimTK::Stage::Dynamics),
+          crane.system().getRigidBodyForces(s, SimTK::Stage::Dynamics), u_dot, body_accelerations);
+      sum += u_dot[0];
+    } else {
+      crane.system().realize(s, SimTK::Stage::Velocity);
+      derivative(s, y_dot);
+      sum += y_dot[4];
+    }
+  }
+  benchmark::DoNotOptimize(sum);
+}
+BENCHMARK(BM_RightHandSide)->ArgName("path")->Arg(0)->Arg(1)->Arg(2);
+
 }  // namespace

@@ -84,6 +84,14 @@ struct MultibodyModel::Impl {
   struct Coordinate {
     int spring = -1;  // index into springs/dampers, -1 for a free coordinate
     bool translational = false;
+    SimTK::MobilizedBodyIndex mobod;  // its mobilizer and the mobility in it
+    int mobility = 0;
+    int q = 0, u = 0;  // its entries of the state's q and u
+  };
+  struct Weight {
+    SimTK::MobilizedBodyIndex body;
+    Vec3 force_G;        // m g
+    Vec3 mass_center_B;  // where it acts
   };
   // Output data resolved to indices, directions unit.
   struct Output {
@@ -180,13 +188,13 @@ struct MultibodyModel::Impl {
         AddCoordinate(body, which, mobods.back(), static_cast<int>(which));
       }
     }
-    SimTK::Force::Custom(
-        forces, new ExternalLoadForce(matter, external_load, [this](const std::string& point) {
-          const PointDescription& p = FindPoint(point);
-          return std::make_pair(
-              mobods[static_cast<size_t>(body_index.at(p.body))].getMobilizedBodyIndex(),
-              ToVec3(p.at_m));
-        }));
+    locate_point = [this](const std::string& point) {
+      const PointDescription& p = FindPoint(point);
+      return std::make_pair(
+          mobods[static_cast<size_t>(body_index.at(p.body))].getMobilizedBodyIndex(),
+          ToVec3(p.at_m));
+    };
+    SimTK::Force::Custom(forces, new ExternalLoadForce(matter, external_load, locate_point));
     system.realizeTopology();
     default_state = system.getDefaultState();
     system.realizeModel(default_state);
@@ -197,6 +205,18 @@ struct MultibodyModel::Impl {
     for (const Coordinate& c : coordinate_data)
       coordinate_units.push_back(c.translational ? "m" : "rad");
 
+    for (Coordinate& c : coordinate_data) {
+      const MobilizedBody& mobod = matter.getMobilizedBody(c.mobod);
+      c.q = mobod.getFirstQIndex(default_state) + c.mobility;
+      c.u = mobod.getFirstUIndex(default_state) + c.mobility;
+    }
+    // Gravity's share of each mobilized body (the mass properties are fixed at Topology).
+    for (SimTK::MobilizedBodyIndex b(1); b < matter.getNumBodies(); ++b) {
+      const SimTK::MassProperties& mass =
+          matter.getMobilizedBody(b).getBodyMassProperties(default_state);
+      weights.push_back(
+          {b, mass.getMass() * Vec3(0, 0, -machine.gravity_mps2), mass.getMassCenter()});
+    }
     PrepareKinematics();
     ResolveOutputs();
     unloaded_gravity_force = CalcUnloadedGravityForce();
@@ -251,6 +271,8 @@ struct MultibodyModel::Impl {
                      int mobility) {
     Coordinate coordinate;
     coordinate.translational = body.joint.type == JointType::kPrismatic;
+    coordinate.mobod = mobod.getMobilizedBodyIndex();
+    coordinate.mobility = mobility;
     const SpringDescription* spring = machine.FindSpring(body.joint.coordinates[which]);
     if (spring != nullptr) {
       coordinate.spring = static_cast<int>(springs.size());
@@ -489,6 +511,8 @@ struct MultibodyModel::Impl {
   std::vector<std::string> output_units;
   std::vector<int> output_orders;
   MechanicalModel::ExternalLoadFunction external_load;
+  LoadPointLocator locate_point;
+  std::vector<Weight> weights;
   SimTK::State default_state;
   Eigen::VectorXd unloaded_gravity_force;
   std::shared_ptr<RestMatrices> rest = std::make_shared<RestMatrices>();
@@ -707,6 +731,48 @@ MechanicalModel::ForceDerivative MultibodyModel::MakeParameterForceDerivative(
                                                              Eigen::VectorXd& dforce) {
     dforce.setZero(n);
     dforce[coordinate] = stiffness ? -state.getQ()[coordinate] : -state.getU()[coordinate];
+  };
+}
+
+MechanicalModel::StateDerivative MultibodyModel::MakeStateDerivative() const {
+  struct Scratch {
+    SimTK::Vector mobility_forces, residual, u_dot;
+    SimTK::Vector_<SimTK::SpatialVec> body_forces;
+  };
+  auto scratch = std::make_shared<Scratch>();
+  return [&m = *impl_, scratch](const SimTK::State& state, double* y_dot) {
+    SimTK::Vector& mobility = scratch->mobility_forces;
+    SimTK::Vector_<SimTK::SpatialVec>& body = scratch->body_forces;
+    mobility.resize(state.getNU());
+    mobility = 0;
+    body.resize(m.matter.getNumBodies());
+    body = SimTK::SpatialVec(Vec3(0), Vec3(0));
+    // Force::UniformGravity: m g at the mass center, about the body origin, in Ground.
+    for (const Impl::Weight& w : m.weights) {
+      const Vec3 r = m.matter.getMobilizedBody(w.body).getBodyRotation(state) * w.mass_center_B;
+      body[w.body] += SimTK::SpatialVec(r % w.force_G, w.force_G);
+    }
+    // Force::MobilityLinearSpring and MobilityLinearDamper: -c (q - q_0) - d u on the mobility.
+    const SimTK::Vector& q = state.getQ();
+    const SimTK::Vector& u = state.getU();
+    for (const Impl::Coordinate& c : m.coordinate_data) {
+      if (c.spring < 0) continue;
+      const SimTK::Force::MobilityLinearSpring& spring = m.springs[static_cast<size_t>(c.spring)];
+      mobility[c.u] += -spring.getStiffness(state) * (q[c.q] - spring.getQZero(state)) -
+                       m.dampers[static_cast<size_t>(c.spring)].getDamping(state) * u[c.u];
+    }
+    AddExternalLoads(m.matter, m.external_load, m.locate_point, state, body, mobility);
+    // u' = M^-1 (f_applied - f_inertial): Simbody's forward-dynamics operator needs the Dynamics
+    // stage, its inverse dynamics (residual = f_inertial - f_applied at u' = 0) and M^-1 only
+    // Velocity.
+    m.matter.calcResidualForceIgnoringConstraints(state, mobility, body, SimTK::Vector(),
+                                                  scratch->residual);
+    scratch->residual *= -1;
+    m.matter.multiplyByMInv(state, scratch->residual, scratch->u_dot);
+    const SimTK::Vector& q_dot = state.getQDot();
+    const int nq = q_dot.size();
+    for (int i = 0; i < nq; ++i) y_dot[i] = q_dot[i];
+    for (int i = 0; i < scratch->u_dot.size(); ++i) y_dot[nq + i] = scratch->u_dot[i];
   };
 }
 

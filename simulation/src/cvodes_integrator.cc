@@ -119,6 +119,9 @@ class CvodesIntegrator::Impl {
     parameter_force_derivative_ = std::move(derivative);
   }
   void set_multibody_system(const SimTK::MultibodySystem* system) { multibody_ = system; }
+  void set_state_derivative(StateDerivative derivative) {
+    state_derivative_ = std::move(derivative);
+  }
   void set_jacobian(Eigen::MatrixXd jacobian) { jacobian_ = std::move(jacobian); }
 
   // Takes the state by value: a caller's copy (`initial` may be our own working state) or a
@@ -442,7 +445,9 @@ class CvodesIntegrator::Impl {
   }
 
   void SetTimeAndY(double t, const realtype* y) {
-    state_.setTime(t);
+    // setTime() invalidates the Time stage even for the same time; the corrector iterations
+    // and difference quotients of one step all evaluate at one t.
+    if (state_.getTime() != t) state_.setTime(t);
     CopyToState(y);
     if (hook_) hook_(state_);
   }
@@ -586,6 +591,11 @@ class CvodesIntegrator::Impl {
       for (int i = 0; i < y_dot.size(); ++i) out[i] = y_dot[i];
       return;
     }
+    if (state_derivative_) {
+      system_->realize(state_, SimTK::Stage::Velocity);
+      state_derivative_(state_, out);
+      return;
+    }
     system_->realize(state_, SimTK::Stage::Dynamics);
     multibody_->getMatterSubsystem().calcAccelerationIgnoringConstraints(
         state_, multibody_->getMobilityForces(state_, SimTK::Stage::Dynamics),
@@ -629,6 +639,7 @@ class CvodesIntegrator::Impl {
   // side, used when the state has no z), else null.
   const SimTK::MultibodySystem* multibody_ = nullptr;
   bool forward_dynamics_operator_ = false;
+  StateDerivative state_derivative_;
   SimTK::Vector u_dot_;                                   // scratch of CalcDerivative
   SimTK::Vector_<SimTK::SpatialVec> body_accelerations_;  // scratch of CalcDerivative
   IntegratorOptions options_;
@@ -687,6 +698,9 @@ void CvodesIntegrator::set_time_dependent_inputs(TimeDependentInputs hook) {
 }
 void CvodesIntegrator::set_parameter_force_derivative(ParameterForceDerivative derivative) {
   impl_->set_parameter_force_derivative(std::move(derivative));
+}
+void CvodesIntegrator::set_state_derivative(StateDerivative derivative) {
+  impl_->set_state_derivative(std::move(derivative));
 }
 void CvodesIntegrator::set_jacobian(Eigen::MatrixXd jacobian) {
   impl_->set_jacobian(std::move(jacobian));

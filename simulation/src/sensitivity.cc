@@ -108,6 +108,7 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   const double forcing_end_s = excitation.CalcForcingEndTime();
 
   CvodesIntegrator integrator(simulated.system(), options.integrator);
+  integrator.set_state_derivative(simulated.MakeStateDerivative());
   // The right-hand side reads the parameters CVODES perturbs; only changed ones are applied
   // (each invalidates the state's Instance stage).
   std::vector<double> applied(p.begin(), p.begin() + model_count);

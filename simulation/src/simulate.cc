@@ -45,6 +45,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
       simulated.MakeState(result.initial_q, Eigen::VectorXd::Zero(model.coordinate_count()));
   const Eigen::MatrixXd jacobian = internal::CalcNewtonJacobian(simulated, initial);
   integrator.set_jacobian(jacobian);
+  integrator.set_state_derivative(simulated.MakeStateDerivative());
   integrator.Initialize(std::move(initial));
 
   Measurement exact;
@@ -66,6 +67,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
       before_restart = integrator.statistics();
       integrator = CvodesIntegrator(simulated.system(), options.integrator);
       integrator.set_jacobian(jacobian);
+      integrator.set_state_derivative(simulated.MakeStateDerivative());
       integrator.Initialize(std::move(at_end));
       forcing_done = true;
     }

@@ -138,9 +138,11 @@ TEST(PlanCraneTest, AfterThePapersLoadDropAnEtaDeflectionDeterminesDEta) {
   ASSERT_EQ(plan.candidates.size(), 3u);
   const auto d_eta = static_cast<Eigen::Index>(
       std::find(plan.parameters.begin(), plan.parameters.end(), "d_eta") - plan.parameters.begin());
-  // The recorded drop alone: the plan's current std is UpdateModel's (same J^T J), 1e-6.
+  // The recorded drop alone: the plan's current std is UpdateModel's (same J^T J from its own
+  // integration, equal to roundoff; d_eta is the least determined direction, 32%, where
+  // (J^T J)^-1 magnifies roundoff of 1e-9 in J to about 2e-6): 1e-5.
   EXPECT_NEAR(plan.current_relative_std[d_eta], first.Find("d_eta").relative_std,
-              1e-6 * first.Find("d_eta").relative_std);
+              1e-5 * first.Find("d_eta").relative_std);
   std::string ranking;
   for (const CandidateScore& score : plan.candidates) {
     ranking += score.name + " " + std::to_string(score.score) + " d_eta " +

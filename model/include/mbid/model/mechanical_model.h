@@ -80,6 +80,15 @@ class MechanicalModel {
     return {};
   }
 
+  // Y' = [q'; u'] of a state realized to Stage::Velocity, computed without realizing the
+  // Dynamics stage: the model sums its force elements' forces itself and calls Simbody's
+  // forward-dynamics operator, which saves about a third of a right-hand side (Simbody's force
+  // subsystem and its caches). Must equal realize(Acceleration)'s Y' to round-off. Each
+  // returned function has its own scratch (give each integrator its own); the model must
+  // outlive it. Empty where the model has no such shortcut.
+  using StateDerivative = std::function<void(const SimTK::State& state, double* y_dot)>;
+  virtual StateDerivative MakeStateDerivative() const { return {}; }
+
   // The Simbody system; realized to Topology.
   virtual const SimTK::MultibodySystem& system() const = 0;
   // A state at time 0 with coordinates q and speeds u (rad, rad/s), carrying the current

@@ -42,6 +42,9 @@ class MultibodyModel final : public MechanicalModel {
   // -q_i e_i for c_i (the preload rule keeps the spring force -c q - g_0 affine in c), -u_i e_i
   // for d_i.
   ForceDerivative MakeParameterForceDerivative(const std::string& name) const override;
+  // Gravity, the joints' springs and dampers and the external loads, summed as Simbody's force
+  // elements sum them.
+  StateDerivative MakeStateDerivative() const override;
 
   const SimTK::MultibodySystem& system() const override;
   SimTK::State MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const override;

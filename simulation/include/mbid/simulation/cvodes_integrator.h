@@ -54,6 +54,13 @@ class CvodesIntegrator {
   // multistep history at the discontinuity.
   void set_time_dependent_inputs(TimeDependentInputs hook);
 
+  // Y' of a state realized to Stage::Velocity, in place of realizing the Dynamics stage and
+  // calling Simbody's forward-dynamics operator (MechanicalModel::MakeStateDerivative). Used
+  // with the MultibodySystem constructor on systems without auxiliary states; empty (the
+  // default) realizes the force subsystem.
+  using StateDerivative = std::function<void(const SimTK::State& state, double* y_dot)>;
+  void set_state_derivative(StateDerivative derivative);
+
   // A constant approximation of the Jacobian df/dY (NY x NY), e.g. the model's linearization,
   // for the Newton iteration; empty (the default) forms it from difference quotients of f (NY
   // right-hand sides each time CVODES refreshes it). Newton with an approximate Jacobian only
