@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <udunits2.h>
 
+#include <algorithm>
 #include <cctype>
 #include <map>
 #include <memory>
@@ -149,8 +150,21 @@ bool IsUnit(const std::string& text) {
   return Parse(text) != nullptr;
 }
 
+const std::vector<std::string>& SelfSiUnits() {
+  static const std::vector<std::string> units{"rad",   "rad/s", "rad/s^2", "m", "m/s",
+                                              "m/s^2", "s",     "kg",      "N", "N*m"};
+  return units;
+}
+
 std::string SiUnitFor(const std::string& unit, const std::string& source,
                       const std::string& field) {
+  const std::vector<std::string>& self = SelfSiUnits();
+  if (std::find(self.begin(), self.end(), unit) != self.end()) return unit;
+  return SiUnitByUdunits(unit, source, field);
+}
+
+std::string SiUnitByUdunits(const std::string& unit, const std::string& source,
+                            const std::string& field) {
   RefuseBareG(unit, source, field);
   const std::lock_guard<std::mutex> lock(UnitsMutex());
   const UnitPtr parsed = Parse(unit);

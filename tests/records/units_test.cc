@@ -35,6 +35,15 @@ TEST(UnitsTest, SiUnitOfEachDimension) {
   EXPECT_EQ(SiUnitFor("%", "f", "c"), "1");
 }
 
+// The units answered without udunits2 are the ones udunits2 maps to themselves.
+TEST(UnitsTest, SelfSiUnitsAreTheirOwnSiUnit) {
+  ASSERT_FALSE(SelfSiUnits().empty());
+  for (const std::string& unit : SelfSiUnits()) {
+    EXPECT_EQ(SiUnitByUdunits(unit, "f", "c"), unit);
+    EXPECT_EQ(SiUnitFor(unit, "f", "c"), unit);
+  }
+}
+
 TEST(UnitsTest, ConversionFactors) {
   // udunits' factors against the definitions; 1e-15 relative: the last bits of its products.
   EXPECT_NEAR(FindConversion("deg", "rad", "f", "c").scale, M_PI / 180, 1e-15 * M_PI / 180);
