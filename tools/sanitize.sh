@@ -27,5 +27,14 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$here/tool
 #   python_module, example_python: the interpreter is not instrumented and cannot load an ASan
 #     module unless libasan is preloaded into Python itself (its own allocations then leak);
 #   install_package, example_cpp: configure and build other projects (with their own flags).
+#   the MPI campaign test runs on its own below, without leak checks: OpenMPI unloads its
+#     components (dlclose) in MPI_Finalize, so their leftovers at exit have no library name a
+#     suppression could match; memory errors are still checked.
+#   OutputSafetyTest.AWorkerThreadThatCannotStart... skips itself: it runs under ulimit -v,
+#     where ASan cannot map its shadow memory.
+status=0
 ctest --test-dir "$build" -j2 --timeout 3600 --output-on-failure \
-  -E '^(python_module|example_python|install_package|example_cpp)$' "$@"
+  -E '^(python_module|example_python|install_package|example_cpp)$|Mpi' "$@" || status=1
+ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" \
+  ctest --test-dir "$build" --timeout 3600 --output-on-failure -R 'Mpi' "$@" || status=1
+exit $status

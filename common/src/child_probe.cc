@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -42,6 +43,11 @@ void SurviveInChild(const std::string& path, const std::string& expected,
     pthread_mutexattr_init(&recursive);
     pthread_mutexattr_settype(&recursive, PTHREAD_MUTEX_RECURSIVE);
     pthread_mutex_init(H5Mutex().native_handle(), &recursive);
+    // A crash ends the child by its signal, whatever handler the parent installed (a
+    // sanitizer's, a host program's around the Python module), so that it is told as a crash.
+    for (int signal_number : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
+      std::signal(signal_number, SIG_DFL);
+    }
     // The child leaves without exit handlers; its messages and core dumps are of no use.
     const rlimit no_core{0, 0};
     setrlimit(RLIMIT_CORE, &no_core);
