@@ -87,6 +87,21 @@ UpdateResult Update(const Scenario& scenario, const std::vector<Measurement>& re
   if (records.empty()) {
     throw InputError("Update", "records", "no record", "at least one recorded test");
   }
+  return Update(scenario, records,
+                std::vector<simulation::Excitation>(records.size(), scenario.RequireExcitation()));
+}
+
+UpdateResult Update(const Scenario& scenario, const std::vector<Measurement>& records,
+                    const std::vector<simulation::Excitation>& excitations) {
+  if (records.empty()) {
+    throw InputError("Update", "records", "no record", "at least one recorded test");
+  }
+  if (excitations.size() != records.size()) {
+    throw InputError(
+        "Update", "excitations",
+        fmt::format("{} excitations for {} records", excitations.size(), records.size()),
+        "one excitation per record");
+  }
   const std::unique_ptr<model::MechanicalModel> model = scenario.MakeModel();
   const identification::IdentificationOptions identification = scenario.ReadIdentification();
   updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
@@ -95,8 +110,8 @@ UpdateResult Update(const Scenario& scenario, const std::vector<Measurement>& re
   for (size_t i = 0; i < records.size(); ++i) {
     const std::string origin = fmt::format("record {}", i + 1);
     records[i].Validate(origin);
-    tests.push_back(validation::PrepareTest(records[i], origin, scenario.RequireExcitation(),
-                                            *model, identification));
+    tests.push_back(
+        validation::PrepareTest(records[i], origin, excitations[i], *model, identification));
   }
   const validation::RecordedUpdate update =
       validation::UpdateFromTests(*model, tests, settings, [](const std::string&) {});

@@ -100,6 +100,11 @@ struct UpdateResult {
 // Tunes the scenario's model (its `updating:` section says which parameters) to `records`, each
 // one test of the scenario's excitation, cut at its release.
 UpdateResult Update(const Scenario& scenario, const std::vector<Measurement>& records);
+// The same with each record's own test, `excitations[i]` for `records[i]` (e.g. drops of
+// different payloads, which the scenario's one excitation would tune as the same drop). An
+// InputError unless there is one excitation per record.
+UpdateResult Update(const Scenario& scenario, const std::vector<Measurement>& records,
+                    const std::vector<simulation::Excitation>& excitations);
 
 enum class Verdict { kPassed, kFailed, kInconclusive };
 
