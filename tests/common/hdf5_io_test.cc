@@ -482,9 +482,17 @@ InputError ReadHostile(const std::string& name) {
   return e;
 }
 
+// What the child probe reports for this file: its crash (SIGSEGV inside libhdf5); under
+// AddressSanitizer the wild read is caught first, in an intercepted libc call, and the child
+// ends with ASan's report (exit status 1). Either way the file is refused, named.
+#if defined(__SANITIZE_ADDRESS__)
+const char* const kLibhdf5Crash = "the HDF5 library failed reading the file (status 1)";
+#else
+const char* const kLibhdf5Crash = "the HDF5 library crashed reading the file (signal 11";
+#endif
+
 TEST(Hdf5IoTest, AFileThatCrashesLibhdf5IsAnInputError) {
-  EXPECT_THAT(ReadHostile("vlen_string_global_heap_crash.h5").problem(),
-              HasSubstr("the HDF5 library crashed reading the file (signal 11"));
+  EXPECT_THAT(ReadHostile("vlen_string_global_heap_crash.h5").problem(), HasSubstr(kLibhdf5Crash));
 }
 
 TEST(Hdf5IoTest, AFileThatHangsLibhdf5IsAnInputError) {
@@ -500,7 +508,7 @@ TEST(Hdf5IoTest, H5ReaderSurveysTheWholeFileFirst) {
       std::string(MBID_SOURCE_DIR) + "/tests/data/records/hostile/vlen_string_global_heap_crash.h5",
       path);
   const InputError e = CatchInputError([&] { H5Reader reader(path); });
-  EXPECT_THAT(e.problem(), HasSubstr("the HDF5 library crashed reading the file"));
+  EXPECT_THAT(e.problem(), HasSubstr(kLibhdf5Crash));
 }
 
 // A full disk, made by a file-size limit (writes fail with EFBIG as they would with ENOSPC). HDF5
