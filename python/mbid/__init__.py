@@ -5,9 +5,10 @@ stiffness and damping to them and validate the result (docs/python.md)."""
 
 import os as _os
 
-from ._mbid import (InputError, ModalResult, Mode, NumericalError, Parameter, Record, Scenario,
-                    UpdateResult, ValidationResult, identify, identify_arrays, load_scenario,
-                    load_scenario_text, read_record, run, simulate, update)
+from ._mbid import (IdentificationOptions, InputError, ModalResult, Mode, NumericalError,
+                    Parameter, Record, Scenario, UpdateResult, ValidationResult, identify,
+                    identify_arrays, load_scenario, load_scenario_text, read_record, run,
+                    simulate, update)
 from ._mbid import default_scenario_path as _default_scenario_path
 
 # Installed as <prefix>/lib/python3/dist-packages/mbid: the data are in <prefix>/share/mbid.
@@ -20,7 +21,7 @@ def default_scenario_path():
     return _default_scenario_path(_DATA_DIR)
 
 
-__all__ = ["InputError", "ModalResult", "Mode", "NumericalError", "Parameter", "Record",
+__all__ = ["IdentificationOptions", "InputError", "ModalResult", "Mode", "NumericalError", "Parameter", "Record",
            "Scenario", "UpdateResult", "ValidationResult", "default_scenario_path", "identify",
            "identify_arrays", "load_scenario", "load_scenario_text", "read_record", "run",
            "simulate", "update"]

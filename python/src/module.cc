@@ -122,6 +122,70 @@ PYBIND11_MODULE(_mbid, m) {
                std::to_string(r.channel_count()) + " channels>";
       });
 
+  using mbid::identification::IdentificationOptions;
+  using mbid::identification::ReleaseMode;
+  py::class_<IdentificationOptions>(
+      m, "IdentificationOptions",
+      "What identify() is told (as the scenario's identification: section and the identify "
+      "command's flags): method, release, window, band, channels, modes.")
+      .def(py::init<>())
+      .def_property(
+          "method",
+          [](const IdentificationOptions& o) { return mbid::identification::MethodName(o.method); },
+          [](IdentificationOptions& o, const std::string& name) {
+            if (!mbid::identification::ParseMethod(name, &o.method)) {
+              std::string known;
+              for (const std::string& n : mbid::identification::MethodNames())
+                known += (known.empty() ? "" : ", ") + n;
+              throw mbid::InputError("IdentificationOptions", "method",
+                                     "unknown method '" + name + "'", "one of " + known);
+            }
+          })
+      .def_property(
+          "release",
+          [](const IdentificationOptions& o) {
+            return o.release == ReleaseMode::kDetect  ? "detect"
+                   : o.release == ReleaseMode::kGiven ? "given"
+                                                      : "none";
+          },
+          [](IdentificationOptions& o, const std::string& mode) {
+            if (mode == "detect") {
+              o.release = ReleaseMode::kDetect;
+            } else if (mode == "given") {
+              o.release = ReleaseMode::kGiven;
+            } else if (mode == "none") {
+              o.release = ReleaseMode::kNone;
+            } else {
+              throw mbid::InputError("IdentificationOptions", "release",
+                                     "unknown release mode '" + mode + "'",
+                                     "detect, given (with release_time_s) or none");
+            }
+          })
+      .def_property(
+          "release_time_s", [](const IdentificationOptions& o) { return o.release_time_s; },
+          [](IdentificationOptions& o, double t) {
+            o.release_time_s = t;
+            o.release = ReleaseMode::kGiven;  // a time is only read with kGiven
+          })
+      .def_readwrite("window_start_s", &IdentificationOptions::window_start_s)
+      .def_readwrite("window_end_s", &IdentificationOptions::window_end_s)
+      .def_readwrite("channels", &IdentificationOptions::channels)
+      .def_readwrite("decimation", &IdentificationOptions::decimation)
+      .def_readwrite("min_frequency_hz", &IdentificationOptions::min_frequency_hz)
+      .def_readwrite("max_frequency_hz", &IdentificationOptions::max_frequency_hz)
+      .def_readwrite("min_damping_ratio", &IdentificationOptions::min_damping_ratio)
+      .def_readwrite("max_damping_ratio", &IdentificationOptions::max_damping_ratio)
+      .def_readwrite("max_modes", &IdentificationOptions::max_modes)
+      .def_readwrite("min_correlation", &IdentificationOptions::min_correlation)
+      .def_readwrite("drop_insignificant", &IdentificationOptions::drop_insignificant)
+      .def_readwrite("compute_spectrum", &IdentificationOptions::compute_spectrum)
+      .def_readwrite("compute_stabilization", &IdentificationOptions::compute_stabilization)
+      .def_readwrite("compute_uncertainty", &IdentificationOptions::compute_uncertainty)
+      .def("__repr__", [](const IdentificationOptions& o) {
+        return "<mbid.IdentificationOptions method='" + mbid::identification::MethodName(o.method) +
+               "'>";
+      });
+
   py::class_<mbid::identification::IdentifiedMode>(m, "Mode")
       .def_readonly("frequency_hz", &mbid::identification::IdentifiedMode::frequency_hz)
       .def_readonly("decay_rate_per_s", &mbid::identification::IdentifiedMode::decay_rate_per_s)
@@ -202,24 +266,34 @@ PYBIND11_MODULE(_mbid, m) {
       "read_record", [](const std::string& path) { return mbid::ReadRecord(path); },
       py::arg("path"), "Reads a record file (CSV, HDF5, MAT, UFF58, LVM), SI units.");
   m.def(
-      "identify", [](const mbid::Measurement& r) { return mbid::Identify(r); }, py::arg("record"),
-      py::call_guard<py::gil_scoped_release>(), "Identifies the modes of a free-decay record.");
+      "identify",
+      [](const mbid::Measurement& record, const IdentificationOptions& options) {
+        return mbid::Identify(record, options);
+      },
+      py::arg("record"), py::arg("options") = IdentificationOptions(),
+      py::call_guard<py::gil_scoped_release>(),
+      "Identifies the modes of a free-decay record (options: IdentificationOptions).");
   m.def(
       "identify_arrays",
       [](py::array_t<double, py::array::c_style | py::array::forcecast> time,
          const std::map<std::string,
                         py::array_t<double, py::array::c_style | py::array::forcecast>>& channels,
-         const std::map<std::string, std::string>& units) {
+         const std::map<std::string, std::string>& units, const IdentificationOptions& options) {
         const mbid::Measurement record = MakeRecord(time, channels, units);
         py::gil_scoped_release release;
-        return mbid::Identify(record);
+        return mbid::Identify(record, options);
       },
       py::arg("time"), py::arg("channels"), py::arg("units") = std::map<std::string, std::string>{},
+      py::arg("options") = IdentificationOptions(),
       "Identifies the modes of a free decay given as arrays: time (s, uniform) and {name: "
       "values}.");
-  m.def("update", &mbid::Update, py::arg("scenario"), py::arg("records"),
-        py::call_guard<py::gil_scoped_release>(),
-        "Tunes the scenario's model to the records: .parameters['c_alpha'].value, .std.");
+  m.def(
+      "update",
+      [](const mbid::Scenario& scenario, const std::vector<mbid::Measurement>& records) {
+        return mbid::Update(scenario, records);
+      },
+      py::arg("scenario"), py::arg("records"), py::call_guard<py::gil_scoped_release>(),
+      "Tunes the scenario's model to the records: .parameters['c_alpha'].value, .std.");
   m.def(
       "run",
       [](const mbid::Scenario& scenario, const std::string& output_folder, bool overwrite,

@@ -67,6 +67,32 @@ class IdentifyTest(unittest.TestCase):
         self.assertAlmostEqual(mode.damping_ratio,
                                0.3 / math.hypot(0.3, 2 * math.pi * 2.0), delta=1e-7)
 
+    def test_options_reach_the_identification(self):
+        # The two-mode decay above. A band up to 4 Hz keeps the 2 Hz mode alone (within two of
+        # its standard deviations), and since one mode cannot explain the record the result says
+        # so. The paper's prony-svd finds both modes (noise-free: to 1e-6 relative).
+        t = np.arange(2000) * 0.005
+        y = (np.exp(-0.3 * t) * np.cos(2 * np.pi * 2.0 * t)
+             + 0.5 * np.exp(-0.8 * t) * np.sin(2 * np.pi * 5.5 * t))
+        options = mbid.IdentificationOptions()
+        self.assertEqual(options.method, "hankel-nls")
+        options.max_frequency_hz = 4.0
+        banded = mbid.identify_arrays(t, {"x": y}, {"x": "m"}, options)
+        self.assertEqual(len(banded.modes), 1)
+        mode = banded.modes[0]
+        self.assertAlmostEqual(mode.frequency_hz, 2.0, delta=2 * mode.std_frequency_hz)
+        self.assertFalse(banded.reliable)
+        prony = mbid.IdentificationOptions()
+        prony.method = "prony-svd"
+        prony.release = "none"
+        record = mbid.identify_arrays(t, {"x": y}, {"x": "m"}, options=prony)
+        self.assertEqual(len(record.modes), 2)
+        self.assertAlmostEqual(record.modes[1].frequency_hz, 5.5, delta=5.5e-6)
+        with self.assertRaises(mbid.InputError):
+            prony.method = "fft"
+        with self.assertRaises(mbid.InputError):
+            prony.release = "later"
+
     def test_identify_of_a_record_equals_identify_of_its_arrays(self):
         record = mbid.simulate(mbid.load_scenario(REFERENCE))
         a = mbid.identify(record)
