@@ -1,6 +1,7 @@
 // The `updating:` scenario section (read strictly) and the glue between Route 1 and Route 2.
 #include "mbid/updating/settings.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "crane_fixture.h"
@@ -199,7 +200,9 @@ TEST(SettingsTest, AlgebraicAmbiguityMarksTheParametersTheRivalsDisagreeOn) {
   const std::vector<std::string> marked = MarkAlgebraicAmbiguity(algebraic, result);
   EXPECT_EQ(marked, (std::vector<std::string>{"c_gamma", "d_gamma"}));
   EXPECT_FALSE(result.Find("c_gamma").determined);
+  EXPECT_THAT(result.Find("c_gamma").why_undetermined, ::testing::HasSubstr("Route 1"));
   EXPECT_TRUE(result.Find("c_alpha").determined);
+  EXPECT_TRUE(result.Find("c_alpha").why_undetermined.empty());
   EXPECT_EQ(result.undetermined, marked);
   ASSERT_EQ(result.warnings.size(), 1u);
 }

@@ -358,7 +358,13 @@ std::vector<std::string> MarkAlgebraicAmbiguity(const CharacteristicResult& alge
   for (const std::string& name : names) {
     list += (list.empty() ? "" : ", ") + name;
     for (ParameterEstimate& estimate : result.parameters) {
-      if (estimate.name == name) estimate.determined = false;
+      if (estimate.name != name) continue;
+      estimate.determined = false;
+      if (estimate.why_undetermined.empty()) {
+        estimate.why_undetermined =
+            "Route 1 found another set of joint parameters that reproduces the test's initial "
+            "state about as well but differs in it: the record does not decide between them";
+      }
     }
     if (std::find(result.undetermined.begin(), result.undetermined.end(), name) ==
         result.undetermined.end()) {
