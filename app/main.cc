@@ -23,6 +23,8 @@ struct ImportFlags {
   std::vector<std::string> channels;
   std::vector<std::string> units;
   std::string fill_gaps;
+  std::string time_unit;
+  std::optional<double> sample_rate_hz;
   std::string release;
   std::optional<double> release_time_s;
 };
@@ -42,6 +44,10 @@ void AddImportFlags(CLI::App* command, ImportFlags* flags) {
       ->add_option("--fill-gaps", flags->fill_gaps,
                    "Empty or NaN cells: linear (interpolate and report) or none (refuse)")
       ->check(CLI::IsMember({"linear", "none"}));
+  command->add_option("--time-unit", flags->time_unit,
+                      "Unit of the file's time column, over what the file says, e.g. ms");
+  command->add_option("--sample-rate-hz", flags->sample_rate_hz,
+                      "For files without a time column: samples at j / rate, Hz");
   CLI::Option* release =
       command
           ->add_option("--release", flags->release,
@@ -63,6 +69,13 @@ mbid::validation::ImportOverrides MakeOverrides(const ImportFlags& flags) {
     overrides.fill_gaps =
         mbid::validation::ParseGapFill(flags.fill_gaps, "command line", "--fill-gaps");
   }
+  overrides.time_unit = flags.time_unit;
+  if (flags.sample_rate_hz &&
+      !(std::isfinite(*flags.sample_rate_hz) && *flags.sample_rate_hz > 0)) {
+    throw mbid::InputError("command line", "--sample-rate-hz",
+                           std::to_string(*flags.sample_rate_hz), "a finite sample rate > 0 Hz");
+  }
+  overrides.sample_rate_hz = flags.sample_rate_hz;
   overrides.release_none = flags.release == "none";
   if (flags.release_time_s && !std::isfinite(*flags.release_time_s)) {
     throw mbid::InputError("command line", "--release-time-s",

@@ -128,7 +128,7 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
       throw InputError(path, table.sample_lines.empty() ? "" : "header",
                        "no time column (named time, t, Zeit, timestamp, datetime or X_Value)",
                        "a time column, or the sample rate of a file without one "
-                       "(`sample_rate_hz:` in the scenario's record entry)");
+                       "(`sample_rate_hz:` in the scenario's record entry or --sample-rate-hz)");
     }
     m->start_time_s = 0.0;
     m->sample_interval_s = 1.0 / options.sample_rate_hz;

@@ -84,6 +84,34 @@ TEST_F(RecordsCliTest, IdentifyFillsGapsAndReportsTheImport) {
   EXPECT_EQ(summary["channels"], nlohmann::json({"psi", "phi"}));
 }
 
+// --sample-rate-hz gives a file without a time column its time base, --time-unit overrides the
+// time column's unit: the 1.5 Hz decay comes out at the frequency the stated time base makes of
+// it (x rate / 100 Hz; x 1000 when the logger's ms are read as us).
+TEST_F(RecordsCliTest, TimeBaseFlagsSetTheSampleRateAndTheTimeUnit) {
+  std::string text = "Boom angle;Slew\ndeg;deg\n";
+  for (int j = 0; j < 801; ++j) {
+    text += fmt::format("{:.9g};{:.9g}\n", Decay(j * 0.01), 0.5 * Decay(j * 0.01));
+  }
+  const fs::path data = Write("no_time.csv", text);
+  auto frequency = [&](const std::string& flags) {
+    const CommandResult result =
+        Run("identify " + data.string() + " --release none --json - " + flags);
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    const nlohmann::json summary = nlohmann::json::parse(result.out);
+    return summary["modes"].empty() ? 0.0 : summary["modes"][0]["frequency_hz"].get<double>();
+  };
+  // The damped frequency, 1.5 sqrt(1 - 0.02^2) Hz; 9 significant digits in the file: 1e-5.
+  const double damped_hz = 1.5 * std::sqrt(1 - 0.02 * 0.02);
+  EXPECT_NEAR(frequency("--sample-rate-hz 100"), damped_hz, 1e-5);
+  EXPECT_NEAR(frequency("--sample-rate-hz 200"), 2 * damped_hz, 2e-5);
+  ExpectOneErrorLine(Run("identify " + data.string()), "--sample-rate-hz");
+  ExpectOneErrorLine(Run("identify " + data.string() + " --sample-rate-hz 0"), "--sample-rate-hz");
+  const fs::path logger = WriteLogger("logger.csv");
+  const CommandResult us = Run("identify " + logger.string() + " --json - --time-unit us");
+  ASSERT_EQ(us.exit_code, 0) << us.err;
+  EXPECT_NEAR(nlohmann::json::parse(us.out)["modes"][0]["frequency_hz"].get<double>(), 1500.0, 1.0);
+}
+
 TEST_F(RecordsCliTest, BadFlagsAndUnknownColumnsAreInvalidInput) {
   const fs::path data = WriteLogger("logger.csv");
   ExpectOneErrorLine(Run("identify " + data.string() + " --channel psi"), "--channel");

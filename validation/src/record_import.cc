@@ -66,6 +66,8 @@ records::ImportOptions MergeImportOptions(const records::ImportOptions& base,
   if (!overrides.channel_columns.empty()) options.channel_columns = overrides.channel_columns;
   for (const auto& [column, unit] : overrides.units) options.units[column] = unit;
   if (overrides.fill_gaps) options.fill_gaps = *overrides.fill_gaps;
+  if (!overrides.time_unit.empty()) options.time_unit = overrides.time_unit;
+  if (overrides.sample_rate_hz) options.sample_rate_hz = *overrides.sample_rate_hz;
   if (model != nullptr) {
     const std::vector<std::string> coordinate_units = model->coordinate_units();
     for (size_t k = 0; k < model->coordinate_names().size(); ++k) {

@@ -22,6 +22,8 @@ struct ImportOverrides {
   std::vector<std::pair<std::string, std::string>> channel_columns;  // --channel NAME=COLUMN
   std::map<std::string, std::string> units;                          // --unit COLUMN=UNIT
   std::optional<records::GapFill> fill_gaps;                         // --fill-gaps
+  std::string time_unit;  // --time-unit: the time column's unit, over the file's (empty: keep)
+  std::optional<double> sample_rate_hz;  // --sample-rate-hz: for files without a time column
   // --release none (the record is the free decay) / --release-time-s T (in the file's time);
   // unset: the release is found in the record (identification/release.h).
   bool release_none = false;
