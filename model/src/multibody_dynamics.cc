@@ -1,0 +1,211 @@
+// The model's dynamics: the state derivative without the Dynamics stage, the rest matrices, static
+// equilibrium and the linearization.
+#include <Eigen/Dense>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mbid/common/error.h"
+#include "mbid/model/multibody_model.h"
+#include "multibody_model_impl.h"
+
+namespace mbid::model {
+
+void MultibodyModel::Impl::CalcRestMatrices(RestMatrices& result) const {
+  const Eigen::Index n = static_cast<Eigen::Index>(coordinates.size());
+  // One scratch state at q = 0 with springs and dampers off serves every evaluation (a Simbody
+  // State copy costs about four right-hand sides); M and H do not depend on the forces.
+  SimTK::State s = default_state;
+  for (size_t k = 0; k < springs.size(); ++k) {
+    springs[k].setStiffness(s, 0.0);
+    dampers[k].setDamping(s, 0.0);
+  }
+  s.updQ() = 0;
+  s.updU() = 0;
+  system.realize(s, SimTK::Stage::Position);
+  SimTK::Matrix M;
+  matter.calcM(s, M);
+  result.M = ToEigen(M);
+
+  // Geometric stiffness K_g = -d(gravity force)/dq by central differences with one Richardson
+  // step: error O(h^4) ~ 1e-12 relative on forces smooth on the scale of 1 rad or 1 m.
+  auto gravity_force = [&](const Eigen::VectorXd& q) { return CalcStaticForceAt(s, q, {}); };
+  auto central = [&](Eigen::Index j, double h) {
+    Eigen::VectorXd dq = Eigen::VectorXd::Zero(n);
+    dq[j] = h;
+    return Eigen::VectorXd((gravity_force(dq) - gravity_force(-dq)) / (2 * h));
+  };
+  Eigen::MatrixXd K_g(n, n);
+  const double h = 1e-3;
+  for (Eigen::Index j = 0; j < n; ++j) K_g.col(j) = -(4 * central(j, h / 2) - central(j, h)) / 3;
+  result.K_g = 0.5 * (K_g + K_g.transpose());  // a Hessian: symmetric up to roundoff
+
+  // H exactly: with q' = e_j at q = 0 every output's rate is its derivative by q_j; velocity
+  // and acceleration outputs are J q' and J q'' at rest, the same Jacobian rows.
+  result.H = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(outputs.size()), n);
+  s.updQ() = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    s.updU() = 0;
+    s.updU()[static_cast<int>(j)] = 1;
+    system.realize(s, SimTK::Stage::Velocity);
+    for (size_t i = 0; i < outputs.size(); ++i) {
+      const Output& output = outputs[i];
+      double rate = 0;
+      if (output.type == OutputType::kCoordinate) {
+        rate = output.coordinate == j ? 1.0 : 0.0;
+      } else {
+        const MobilizedBody& body = mobods[static_cast<size_t>(output.body)];
+        const Eigen::Matrix3d R_GB = ToEigen33(body.getBodyRotation(s).asMat33());
+        const Eigen::Vector3d w = ToEigen3(body.getBodyAngularVelocity(s));
+        const Eigen::Vector3d d = output.type == OutputType::kAzimuth ||
+                                          output.type == OutputType::kElevation || output.body_frame
+                                      ? Eigen::Vector3d(R_GB * output.direction)
+                                      : output.direction;
+        if (output.type == OutputType::kAzimuth || output.type == OutputType::kElevation) {
+          const Eigen::Vector3d du = w.cross(d);
+          const double rho2 = d[0] * d[0] + d[1] * d[1];
+          const double rho = std::sqrt(rho2);
+          rate =
+              output.type == OutputType::kAzimuth
+                  ? (d[0] * du[1] - d[1] * du[0]) / rho2
+                  : (rho2 * du[2] - d[2] * (d[0] * du[0] + d[1] * du[1])) / (rho * d.squaredNorm());
+        } else if (output.type == OutputType::kAngularVelocity) {
+          rate = w.dot(d);
+        } else {
+          rate = ToEigen3(body.findStationVelocityInGround(s, output.station)).dot(d);
+        }
+      }
+      result.H(static_cast<Eigen::Index>(i), j) = rate;
+    }
+  }
+}
+
+MechanicalModel::StateDerivative MultibodyModel::MakeStateDerivative() const {
+  struct Scratch {
+    SimTK::Vector mobility_forces, residual, u_dot;
+    SimTK::Vector_<SimTK::SpatialVec> body_forces;
+  };
+  auto scratch = std::make_shared<Scratch>();
+  return [&m = *impl_, scratch](const SimTK::State& state, double* y_dot) {
+    SimTK::Vector& mobility = scratch->mobility_forces;
+    SimTK::Vector_<SimTK::SpatialVec>& body = scratch->body_forces;
+    mobility.resize(state.getNU());
+    mobility = 0;
+    body.resize(m.matter.getNumBodies());
+    body = SimTK::SpatialVec(Vec3(0), Vec3(0));
+    // Force::UniformGravity: m g at the mass center, about the body origin, in Ground.
+    for (const Impl::Weight& w : m.weights) {
+      const Vec3 r = m.matter.getMobilizedBody(w.body).getBodyRotation(state) * w.mass_center_B;
+      body[w.body] += SimTK::SpatialVec(r % w.force_G, w.force_G);
+    }
+    // Force::MobilityLinearSpring and MobilityLinearDamper: -c (q - q_0) - d u on the mobility.
+    const SimTK::Vector& q = state.getQ();
+    const SimTK::Vector& u = state.getU();
+    for (const Impl::Coordinate& c : m.coordinate_data) {
+      if (c.spring < 0) continue;
+      const SimTK::Force::MobilityLinearSpring& spring = m.springs[static_cast<size_t>(c.spring)];
+      mobility[c.u] += -spring.getStiffness(state) * (q[c.q] - spring.getQZero(state)) -
+                       m.dampers[static_cast<size_t>(c.spring)].getDamping(state) * u[c.u];
+    }
+    AddExternalLoads(m.matter, m.external_load, m.locate_point, state, body, mobility);
+    // u' = M^-1 (f_applied - f_inertial): Simbody's forward-dynamics operator needs the Dynamics
+    // stage, its inverse dynamics (residual = f_inertial - f_applied at u' = 0) and M^-1 only
+    // Velocity.
+    m.matter.calcResidualForceIgnoringConstraints(state, mobility, body, SimTK::Vector(),
+                                                  scratch->residual);
+    scratch->residual *= -1;
+    m.matter.multiplyByMInv(state, scratch->residual, scratch->u_dot);
+    const SimTK::Vector& q_dot = state.getQDot();
+    const int nq = q_dot.size();
+    for (int i = 0; i < nq; ++i) y_dot[i] = q_dot[i];
+    for (int i = 0; i < scratch->u_dot.size(); ++i) y_dot[nq + i] = scratch->u_dot[i];
+  };
+}
+
+double MultibodyModel::CalcEnergy(const SimTK::State& state) const {
+  impl_->system.realize(state, SimTK::Stage::Dynamics);
+  return impl_->system.calcEnergy(state);
+}
+
+Eigen::VectorXd MultibodyModel::CalcStaticGeneralizedForce(
+    const Eigen::VectorXd& q, const std::vector<PointLoad>& loads) const {
+  SimTK::State s = MakeState(q, Eigen::VectorXd::Zero(q.size()));
+  return impl_->CalcStaticForceAt(s, q, loads);
+}
+
+Eigen::VectorXd MultibodyModel::SolveStaticEquilibrium(const std::vector<PointLoad>& loads) const {
+  // Newton's chord method on f(q) = 0: the tangent starts as the unloaded machine's -C at rest
+  // (springs plus the cached geometric stiffness: no evaluations), kept while the steps shrink
+  // fast and refreshed by central differences when they do not. The root's accuracy depends
+  // only on f, so the iteration reaches machine precision.
+  const Eigen::Index n = static_cast<Eigen::Index>(impl_->coordinates.size());
+  SimTK::State s = MakeState(Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n));
+  auto force = [&](const Eigen::VectorXd& q) { return impl_->CalcStaticForceAt(s, q, loads); };
+  auto tangent = [&](const Eigen::VectorXd& q) {
+    Eigen::MatrixXd jacobian(n, n);
+    const double h = 1e-7;  // rad or m; smooth forces, curvature scale ~1
+    for (Eigen::Index j = 0; j < n; ++j) {
+      Eigen::VectorXd dq = Eigen::VectorXd::Zero(n);
+      dq[j] = h;
+      jacobian.col(j) = (force(q + dq) - force(q - dq)) / (2 * h);
+    }
+    return Eigen::FullPivLU<Eigen::MatrixXd>(jacobian);
+  };
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd f = force(q);
+  if (f.lpNorm<Eigen::Infinity>() == 0) return q;
+  Eigen::MatrixXd rest_tangent = -impl_->rest_matrices().K_g;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const SpringDescription* spring =
+        impl_->machine.FindSpring(impl_->coordinates[static_cast<size_t>(i)]);
+    if (spring != nullptr) rest_tangent(i, i) -= spring->stiffness;
+  }
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(rest_tangent);
+  if (!lu.isInvertible()) {
+    throw NumericalError("static equilibrium",
+                         "the machine has no stiffness against a load on a free coordinate");
+  }
+  double last_step = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    const Eigen::VectorXd step = lu.solve(-f);
+    q += step;
+    f = force(q);
+    const double step_norm = step.lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(step_norm)) break;
+    // Converged when the step is at roundoff of q, or stops shrinking after being tiny.
+    if (step_norm <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, q.norm()) ||
+        (step_norm < 1e-12 && step_norm >= last_step)) {
+      return q;
+    }
+    if (step_norm > 0.1 * last_step) lu = tangent(q);  // slow contraction: refresh the tangent
+    last_step = step_norm;
+  }
+  throw NumericalError("static equilibrium", "Newton did not converge in 50 iterations; residual " +
+                                                 std::to_string(f.norm()));
+}
+
+LinearModel MultibodyModel::Linearize() const {
+  const Impl::RestMatrices& rest = impl_->rest_matrices();
+  const Eigen::Index n = static_cast<Eigen::Index>(impl_->coordinates.size());
+  LinearModel linear;
+  linear.coordinates = impl_->coordinates;
+  linear.outputs = impl_->output_names;
+  linear.output_orders = impl_->output_orders;
+  linear.coordinate_units = impl_->coordinate_units;
+  linear.output_units = impl_->output_units;
+  linear.M = rest.M;
+  linear.H = rest.H;
+  linear.C = rest.K_g;
+  linear.D = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const SpringDescription* spring =
+        impl_->machine.FindSpring(impl_->coordinates[static_cast<size_t>(i)]);
+    if (spring == nullptr) continue;
+    linear.C(i, i) += spring->stiffness;
+    // Dampers are the only velocity-dependent forces at rest; gyroscopic terms are quadratic in u.
+    linear.D(i, i) = spring->damping;
+  }
+  return linear;
+}
+
+}  // namespace mbid::model
