@@ -131,20 +131,23 @@ void BM_CampaignMpiRanks(benchmark::State& state) {
   ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
   ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
   ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
-  static const std::string kMpiexec = MBID_MPIEXEC, kDashN = "-n", kCampaign = "campaign",
-                           kDashO = "-o", kWorkers = "--workers", kOne = "1";
   for (auto _ : state) {
     const fs::path out = WorkDir() / ("mpi_" + std::to_string(ranks));
     const fs::path log = WorkDir() / "mpi.log";
     fs::remove_all(out);
     // An argument vector, no shell; mbid's stderr (its "ran ... cases" line) into the log.
-    const std::string n = std::to_string(ranks), yaml = (WorkDir() / "bench.yaml").string(),
-                      binary = std::string(MBID_BINARY_DIR) + "/app/mbid", out_dir = out.string();
+    const std::vector<std::string> args{MBID_MPIEXEC,
+                                        "-n",
+                                        std::to_string(ranks),
+                                        std::string(MBID_BINARY_DIR) + "/app/mbid",
+                                        "campaign",
+                                        (WorkDir() / "bench.yaml").string(),
+                                        "-o",
+                                        out.string(),
+                                        "--workers",
+                                        "1"};
     std::vector<char*> argv;
-    for (const std::string* arg : {&kMpiexec, &kDashN, &n, &binary, &kCampaign, &yaml, &kDashO,
-                                   &out_dir, &kWorkers, &kOne}) {
-      argv.push_back(const_cast<char*>(arg->c_str()));
-    }
+    for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
     argv.push_back(nullptr);
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);

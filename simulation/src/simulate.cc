@@ -40,12 +40,16 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   // where the load switches off. The free decay may use dense output.
   IntegratorOptions forced_options = options.integrator;
   forced_options.interpolate_outputs = false;
-  CvodesIntegrator integrator(simulated.system(), forced ? forced_options : options.integrator);
   SimTK::State initial =
       simulated.MakeState(result.initial_q, Eigen::VectorXd::Zero(model.coordinate_count()));
   const Eigen::MatrixXd jacobian = internal::CalcNewtonJacobian(simulated, initial);
-  integrator.set_jacobian(jacobian);
-  integrator.set_state_derivative(simulated.MakeStateDerivative());
+  auto make_integrator = [&](const IntegratorOptions& integrator_options) {
+    CvodesIntegrator made(simulated.system(), integrator_options);
+    made.set_jacobian(jacobian);
+    made.set_state_derivative(simulated.MakeStateDerivative());
+    return made;
+  };
+  CvodesIntegrator integrator = make_integrator(forced ? forced_options : options.integrator);
   integrator.Initialize(std::move(initial));
 
   Measurement exact;
@@ -65,9 +69,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
       // multistep history there.
       SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s, kUnrealized);
       before_restart = integrator.statistics();
-      integrator = CvodesIntegrator(simulated.system(), options.integrator);
-      integrator.set_jacobian(jacobian);
-      integrator.set_state_derivative(simulated.MakeStateDerivative());
+      integrator = make_integrator(options.integrator);
       integrator.Initialize(std::move(at_end));
       forcing_done = true;
     }

@@ -81,8 +81,8 @@ class MechanicalModel {
   }
 
   // Y' = [q'; u'] of a state realized to Stage::Velocity, computed without realizing the
-  // Dynamics stage: the model sums its force elements' forces itself and calls Simbody's
-  // forward-dynamics operator, which saves about a third of a right-hand side (Simbody's force
+  // Dynamics stage: the model sums its force elements' forces itself and solves with Simbody's
+  // inverse dynamics and M^-1, which saves about a fifth of a right-hand side (Simbody's force
   // subsystem and its caches). Must equal realize(Acceleration)'s Y' to round-off. Each
   // returned function has its own scratch (give each integrator its own); the model must
   // outlive it. Empty where the model has no such shortcut.
