@@ -18,10 +18,11 @@ UpdateResult MakeResult() {
   UpdateResult result;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   ParameterEstimate c{"c_theta", "N*m/rad",   "",   true,  9.4e6, 8e6,  8e4, 8e8,
-                      2e4,       2e4 / 9.4e6, true, false, -kInf, kInf, ""};
+                      2e4,       2e4 / 9.4e6, true, false, -kInf, kInf, "",  {}};
   ParameterEstimate d{"d_eta", "N*m*s/rad", "",    true, 4e4,
                       5e4,     5e2,         5e6,   kNaN, kNaN,
-                      false,   false,       -kInf, kInf, "no standard deviation"};
+                      false,   false,       -kInf, kInf, "no standard deviation",
+                      {}};
   ParameterEstimate m{"drop/1:payload_mass_kg",
                       "kg",
                       "drop/1",
@@ -36,7 +37,8 @@ UpdateResult MakeResult() {
                       false,
                       -kInf,
                       kInf,
-                      ""};
+                      "",
+                      {}};
   result.parameters = {c, d, m};
   result.correlation = Eigen::Matrix3d::Identity();
   result.correlation(1, 1) = kNaN;

@@ -109,4 +109,20 @@ std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,
   return unknowns;
 }
 
+void StartNuisanceAt(const UpdateResult& result, std::vector<TestRecord>& tests) {
+  for (const ParameterEstimate& estimate : result.parameters) {
+    if (estimate.test.empty()) continue;
+    for (TestRecord& test : tests) {
+      if (test.name != estimate.test) continue;
+      const std::string prefix = test.name + ":deflection_";
+      if (estimate.name == test.name + ":payload_mass_kg") {
+        test.excitation.get<simulation::LoadDrop>().payload_mass_kg = estimate.value;
+      } else if (estimate.name.compare(0, prefix.size(), prefix) == 0) {
+        test.excitation.get<simulation::InitialDeflection>()
+            .deflection_rad[estimate.name.substr(prefix.size())] = estimate.value;
+      }
+    }
+  }
+}
+
 }  // namespace mbid::updating::internal

@@ -37,4 +37,8 @@ std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,
                                      const std::vector<TestRecord>& tests,
                                      const UpdateOptions& options);
 
+// Moves the tests' nuisance starts (a load drop's payload mass, initial deflections) to the
+// estimates in `result`: a later fit on the same tests starts where this one ended.
+void StartNuisanceAt(const UpdateResult& result, std::vector<TestRecord>& tests);
+
 }  // namespace mbid::updating::internal

@@ -20,6 +20,7 @@ namespace {
 using internal::Fit;
 using internal::FormatValue;
 using internal::ResolveUnknowns;
+using internal::StartNuisanceAt;
 using internal::Unknown;
 
 }  // namespace
@@ -147,19 +148,7 @@ UpdateResult FitStages(const model::MechanicalModel& model, const std::vector<Te
     for (ParameterSetting& setting : staged.parameters) {
       setting.initial = std::clamp(part.Find(setting.name).value, setting.lower, setting.upper);
     }
-    for (const ParameterEstimate& estimate : part.parameters) {
-      if (estimate.test.empty()) continue;
-      for (TestRecord& test : current) {
-        if (test.name != estimate.test) continue;
-        const std::string prefix = test.name + ":deflection_";
-        if (estimate.name == test.name + ":payload_mass_kg") {
-          test.excitation.get<simulation::LoadDrop>().payload_mass_kg = estimate.value;
-        } else if (estimate.name.compare(0, prefix.size(), prefix) == 0) {
-          test.excitation.get<simulation::InitialDeflection>()
-              .deflection_rad[estimate.name.substr(prefix.size())] = estimate.value;
-        }
-      }
-    }
+    StartNuisanceAt(part, current);
   }
   UpdateResult result = Fit(model, current, staged, stage, "update", &original_start);
   history.insert(history.end(), result.history.begin(), result.history.end());

@@ -11,6 +11,7 @@
 #include "mbid/model/mechanical_model.h"
 #include "mbid/simulation/excitation.h"
 #include "mbid/simulation/integrator_options.h"
+#include "mbid/updating/parameter_profile.h"
 
 namespace mbid::updating {
 
@@ -145,6 +146,8 @@ struct ParameterEstimate {
   double interval_lower = -std::numeric_limits<double>::infinity();
   double interval_upper = std::numeric_limits<double>::infinity();
   std::string why_undetermined;  // empty when determined
+  // Profile-likelihood interval of a shared parameter, when asked for (profile.h).
+  ParameterProfile profile;
 };
 
 struct IterationRecord {
