@@ -123,6 +123,8 @@ int Main(int argc, char** argv) {
   run->add_flag("--overwrite", common.overwrite,
                 "Replace the results folder if an earlier mbid run wrote it (never other folders)");
   AddImportFlags(run, &import_flags);
+  run->add_flag("--profile", common.profile,
+                "Profile-likelihood intervals of the tuned parameters (updating.profile)");
 
   std::string campaign_path;
   int campaign_workers = 0;
@@ -185,6 +187,8 @@ int Main(int argc, char** argv) {
   AddImportFlags(update, &import_flags);
   update->add_option("-o,--output", output_path, "Write /measurement, /scenario, /updating (.h5)");
   update->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
+  update->add_flag("--profile", common.profile,
+                   "Profile-likelihood intervals of the tuned parameters (updating.profile)");
 
   std::vector<std::string> plan_data;
   std::string plan_candidates;

@@ -49,6 +49,7 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   validation::CycleOptions options;
   options.import = common.import;
   options.quiet = common.quiet;
+  options.profile = common.profile;
   options.say = say;
   const validation::CycleResult cycle = validation::RunCycle(scenario, options);
   progress.Say(cycle.verdict_line);

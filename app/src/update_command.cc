@@ -16,6 +16,7 @@
 #include "mbid/common/json_io.h"
 #include "mbid/updating/characteristic.h"
 #include "mbid/updating/output_error.h"
+#include "mbid/updating/profile.h"
 #include "mbid/updating/result_io.h"
 #include "mbid/updating/settings.h"
 #include "mbid/validation/loaded_test.h"
@@ -63,6 +64,9 @@ void PrintSummary(const updating::UpdateResult& result,
                              p.determined ? "" : "  (undetermined: " + p.why_undetermined + ")",
                              p.at_bound ? "  (at bound)" : "");
   }
+  for (const std::string& line : updating::DescribeProfiles(result)) {
+    std::cout << line << "\n";
+  }
   for (const std::string& line : updating::DescribeGlobalSearch(search)) {
     std::cout << line << "\n";
   }
@@ -90,6 +94,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   const auto model = scenario.MakeModel();
   updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
   settings.options.quiet = common.quiet;
+  if (common.profile) settings.profile.enabled = true;
   const identification::IdentificationOptions identification_options =
       scenario.ReadIdentification();
 

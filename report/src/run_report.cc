@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "mbid/report/gnuplot.h"
+#include "mbid/updating/profile.h"
 #include "mbid/updating/result_io.h"
 
 namespace mbid::report {
@@ -283,6 +284,11 @@ std::string TunedParametersMarkdown(const updating::UpdateResult& result,
         std::isfinite(true_value)
             ? fmt::format("{:+.3g}%", 100 * (p.value - true_value) / true_value)
             : "");
+  }
+  const std::vector<std::string> profiles = updating::DescribeProfiles(result);
+  if (!profiles.empty()) {
+    out << "\nProfile-likelihood intervals (each parameter held, the others re-fitted):\n\n";
+    for (const std::string& line : profiles) out << "- " << line << "\n";
   }
   if (!result.undetermined.empty()) {
     out << "\n**The record leaves these parameters undetermined:** "

@@ -60,10 +60,12 @@ class Profiler {
 
   double threshold() const { return threshold_; }
 
-  // 2 (cost - best cost) with parameter `k` held at `value`, the rest re-fitted from `start`.
-  // Returns false (and says why) when the fit failed.
+  // 2 (cost - best cost) with parameter `k` held at `value`, the rest re-fitted from `start`
+  // moved by Predict; `start` then holds the fitted values. Returns false (and says why) when
+  // the fit failed.
   bool RiseAt(size_t k, double value, UpdateResult& start, double* rise, std::string* why) const {
     const ParameterEstimate& held = best_.parameters[k];
+    Predict(k, value, start);
     std::unique_ptr<model::MechanicalModel> clone = model_.Clone();
     ApplyEstimates(start, *clone);
     clone->SetParameter(held.name, value);
@@ -99,12 +101,40 @@ class Profiler {
         return false;
       }
       *rise = 2 * (fit.final_cost - best_.final_cost);
-      start = std::move(fit);
+      for (ParameterEstimate& p : start.parameters) {
+        for (const ParameterEstimate& fitted : fit.parameters) {
+          if (fitted.name == p.name && p.name != held.name) p.value = fitted.value;
+        }
+      }
       return true;
     } catch (const std::exception& e) {
       *why = e.what();
       return false;
     }
+  }
+
+  // Moves the other unknowns of `start` (whose k-th holds the previous value) along the
+  // estimate's covariance to where they are best for the k-th at `value`: the exact profile
+  // of a quadratic cost, so the constrained fit starts close to its end.
+  void Predict(size_t k, double value, UpdateResult& start) const {
+    const Eigen::MatrixXd& covariance = best_.covariance;
+    const auto n = static_cast<Eigen::Index>(best_.parameters.size());
+    const auto kk = static_cast<Eigen::Index>(k);
+    if (covariance.rows() != n || covariance.cols() != n ||
+        start.parameters.size() != best_.parameters.size() || !(covariance(kk, kk) > 0) ||
+        !covariance.allFinite()) {
+      return;
+    }
+    ParameterEstimate& held = start.parameters[k];
+    const double step = ToInternal(held, value) - ToInternal(held, held.value);
+    for (Eigen::Index o = 0; o < n; ++o) {
+      if (o == kk) continue;
+      ParameterEstimate& other = start.parameters[static_cast<size_t>(o)];
+      const double x =
+          ToInternal(other, other.value) + covariance(o, kk) / covariance(kk, kk) * step;
+      other.value = std::clamp(ToValue(other, x), other.lower, other.upper);
+    }
+    held.value = value;
   }
 
   void Search(Side& side) const {
@@ -122,7 +152,8 @@ class Profiler {
     // The bracket in sqrt(rise), which is linear in s where the cost is quadratic.
     double below_s = 0, below_root = 0;
     double above_s = -1, above_root = 0;
-    UpdateResult start = best_;
+    UpdateResult start;  // the values only: the held one's last, the others' fitted there
+    start.parameters = best_.parameters;
     side.open = true;
     side.end = side.reach;
     while (side.fits < profile_.max_fits_per_side && s > 0) {
@@ -347,6 +378,30 @@ void ProfileLikelihood(const model::MechanicalModel& model, const std::vector<Te
   int fits = 0;
   for (const Side& side : sides) fits += side.fits;
   if (progress) progress(fmt::format("profile likelihood: {} constrained fits", fits));
+}
+
+std::vector<std::string> DescribeProfiles(const UpdateResult& result) {
+  std::vector<std::string> lines;
+  for (const ParameterEstimate& p : result.parameters) {
+    const ParameterProfile& profile = p.profile;
+    if (!profile.computed) continue;
+    std::string line =
+        fmt::format("{}: profile {}{}, {}{} {} (Fisher [{}, {}]), {} fits", p.name,
+                    profile.lower_open ? "(" : "[", FormatValue(profile.lower),
+                    FormatValue(profile.upper), profile.upper_open ? ")" : "]", p.units,
+                    FormatValue(p.interval_lower), FormatValue(p.interval_upper), profile.fits);
+    if (profile.lower_open && profile.upper_open) {
+      line += "; open on both sides";
+    } else if (profile.lower_open || profile.upper_open) {
+      line += profile.lower_open ? "; open below" : "; open above";
+    }
+    if (profile.better_minimum) {
+      line += fmt::format("; fits better at {}", FormatValue(profile.better_value));
+    }
+    if (!profile.failure.empty()) line += "; a fit failed " + profile.failure;
+    lines.push_back(line);
+  }
+  return lines;
 }
 
 }  // namespace mbid::updating

@@ -119,6 +119,46 @@ nlohmann::json CharacteristicResultToJson(const CharacteristicResult& result) {
   return json;
 }
 
+namespace {
+
+nlohmann::json ProfileToJson(const ParameterProfile& profile) {
+  nlohmann::json points = nlohmann::json::array();
+  for (size_t i = 0; i < profile.values.size(); ++i) {
+    points.push_back({NumberOrNull(profile.values[i]), NumberOrNull(profile.cost_rises[i])});
+  }
+  nlohmann::json json = {{"interval", nlohmann::json::array({NumberOrNull(profile.lower),
+                                                             NumberOrNull(profile.upper)})},
+                         {"open", nlohmann::json::array({profile.lower_open, profile.upper_open})},
+                         {"threshold", NumberOrNull(profile.threshold)},
+                         {"better_minimum", profile.better_minimum},
+                         {"points", points},
+                         {"fits", profile.fits}};
+  if (profile.better_minimum) json["better_value"] = NumberOrNull(profile.better_value);
+  if (!profile.failure.empty()) json["failure"] = profile.failure;
+  return json;
+}
+
+void WriteProfileGroup(H5Writer& file, const std::string& group, const ParameterProfile& profile,
+                       const std::string& units) {
+  file.WriteScalar(group, "lower", profile.lower, units);
+  file.WriteScalar(group, "upper", profile.upper, units);
+  file.WriteScalar(group, "threshold", profile.threshold, "1");
+  file.WriteStringAttribute(group, "lower_open", profile.lower_open ? "1" : "0");
+  file.WriteStringAttribute(group, "upper_open", profile.upper_open ? "1" : "0");
+  file.WriteStringAttribute(group, "better_minimum", profile.better_minimum ? "1" : "0");
+  file.WriteVector(group, "values",
+                   Eigen::Map<const Eigen::VectorXd>(
+                       profile.values.data(), static_cast<Eigen::Index>(profile.values.size())),
+                   units);
+  file.WriteVector(
+      group, "cost_rises",
+      Eigen::Map<const Eigen::VectorXd>(profile.cost_rises.data(),
+                                        static_cast<Eigen::Index>(profile.cost_rises.size())),
+      "1");
+}
+
+}  // namespace
+
 nlohmann::json UpdateResultToJson(const UpdateResult& result,
                                   const CharacteristicResult* algebraic) {
   nlohmann::json json;
@@ -139,6 +179,7 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
                                                                 NumberOrNull(p.interval_upper)})}};
     if (!p.test.empty()) entry["test"] = p.test;
     if (!p.why_undetermined.empty()) entry["why_undetermined"] = p.why_undetermined;
+    if (p.profile.computed) entry["profile"] = ProfileToJson(p.profile);
     parameters[p.name] = entry;
   }
   json["parameters"] = parameters;
@@ -287,6 +328,7 @@ void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,
     file.WriteScalar(group, "interval_lower", p.interval_lower, p.units);
     file.WriteScalar(group, "interval_upper", p.interval_upper, p.units);
     file.WriteStringAttribute(group, "determined", p.determined ? "1" : "0");
+    if (p.profile.computed) WriteProfileGroup(file, group + "/profile", p.profile, p.units);
   }
   file.WriteStringAttribute(root, "credible", result.credible ? "1" : "0");
   file.WriteScalar(root, "chi_square_per_dof", result.chi_square_per_dof, "1");

@@ -106,6 +106,18 @@ GlobalSearchOptions ReadGlobalSearch(const YamlReader& node, GlobalSearchOptions
   return o;
 }
 
+ProfileOptions ReadProfile(const YamlReader& node, ProfileOptions o) {
+  node.ExpectMap({"enabled", "sigmas", "max_fits_per_side", "max_iterations", "tolerance"});
+  o.enabled = node.Bool("enabled", o.enabled);
+  o.sigmas = node.PositiveDouble("sigmas", o.sigmas);
+  o.max_fits_per_side = node.Int("max_fits_per_side", o.max_fits_per_side);
+  o.max_iterations = node.Int("max_iterations", o.max_iterations);
+  o.tolerance = node.PositiveDouble("tolerance", o.tolerance);
+  std::string why;
+  if (!o.IsValid(&why)) node.Fail(why, "valid profile options (docs/scenarios.md)");
+  return o;
+}
+
 }  // namespace
 
 UpdatingSettings MakeDefaultUpdatingSettings(const model::MechanicalModel& model,
@@ -119,6 +131,7 @@ UpdatingSettings MakeDefaultUpdatingSettings(const model::MechanicalModel& model
   settings.options.integrator = integrator;
   settings.options.integrator.interpolate_outputs = true;
   settings.global_search.threads = DefaultSearchThreads();
+  settings.profile.threads = settings.global_search.threads;
   return settings;
 }
 
@@ -150,6 +163,7 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
                                 "integrator",
                                 "sensitivity",
                                 "global_search",
+                                "profile",
                                 "algebraic"};
   // Residual weights in each channel's unit: noise_std_rad, noise_std_mps2, ...
   for (const std::string& key : simulation::UnitKeys("noise_std")) keys.push_back(key);
@@ -274,6 +288,9 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
   if (node.Has("global_search")) {
     settings.global_search = ReadGlobalSearch(node.Child("global_search"), settings.global_search);
   }
+  if (node.Has("profile")) settings.profile = ReadProfile(node.Child("profile"), settings.profile);
+  // The profile's sides run on the search's workers (its bits do not depend on their count).
+  settings.profile.threads = settings.global_search.threads;
   if (node.Has("algebraic")) {
     settings.algebraic = ReadAlgebraic(node.Child("algebraic"), settings.algebraic);
   }

@@ -100,6 +100,10 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
   updating::GlobalSearchResult search = updating::SearchGlobally(
       model, records, settings.options, *start, starts, settings.global_search, say);
   if (algebraic != nullptr) updating::MarkAlgebraicAmbiguity(*algebraic, search.best);
+  if (settings.profile.enabled) {
+    updating::ProfileLikelihood(model, records, settings.options, settings.profile, search.best,
+                                say);
+  }
   return search;
 }
 

@@ -14,6 +14,7 @@ struct CommonOptions {
   std::string json_path;   // "" = none, "-" = standard output
   bool overwrite = false;  // replace an output folder an earlier run of the command wrote
   validation::ImportOverrides import;  // --channel, --unit, --fill-gaps for measured files
+  bool profile = false;  // --profile: profile-likelihood intervals (updating.profile.enabled)
 };
 
 // `mbid modes SCENARIO [--json FILE]`: the linearized model and its exact modes.

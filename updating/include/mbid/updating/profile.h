@@ -42,4 +42,8 @@ void ProfileLikelihood(const model::MechanicalModel& model, const std::vector<Te
                        UpdateResult& best,
                        const std::function<void(const std::string&)>& progress = {});
 
+// One line per profiled parameter: "c_alpha: profile [4.1e+07, 5.6e+07] N*m/rad (Fisher [...]),
+// 4 fits", with "open below/above" or a better minimum said; empty when none was profiled.
+std::vector<std::string> DescribeProfiles(const UpdateResult& result);
+
 }  // namespace mbid::updating

@@ -9,6 +9,7 @@
 #include "mbid/updating/characteristic.h"
 #include "mbid/updating/global_search.h"
 #include "mbid/updating/output_error.h"
+#include "mbid/updating/profile.h"
 
 namespace mbid::updating {
 
@@ -72,6 +73,12 @@ namespace mbid::updating {
 //       significance: 0.05                 # F-test level of an alternative minimum
 //       threads: 0                         # parallel local fits; 0: one per hardware thread
 //       pole_equivalent_starts: true       # also fit the other sets with the best's poles
+//     profile:                             # profile-likelihood intervals (profile.h)
+//       enabled: false                     # a few constrained fits per parameter and side
+//       sigmas: 2                          # the interval's level, in Fisher standard deviations
+//       max_fits_per_side: 6
+//       max_iterations: 20                 # of each constrained fit
+//       tolerance: 0.05                    # relative, on sqrt(2 x cost rise) at the ends
 //     algebraic:                           # Route 1 (eq. 7)
 //       starts: 100                        # multi-start points
 //       seed: 1
@@ -85,6 +92,7 @@ struct UpdatingSettings {
   UpdateOptions options;  // parameters carry NaN where the section gives no start or bounds
   CharacteristicOptions algebraic;
   GlobalSearchOptions global_search;  // threads resolved (0 in the file: hardware threads)
+  ProfileOptions profile;             // threads: the global search's
   bool algebraic_start = true;
   std::map<std::string, double> noise_std;  // per channel; empty: not given
   bool fit_payload_mass = false;

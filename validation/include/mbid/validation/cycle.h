@@ -19,6 +19,9 @@ struct CycleOptions {
   // --channel, --unit, --fill-gaps, --release for the scenario's measured files.
   ImportOverrides import;
   bool quiet = true;  // no progress of the fits on standard error
+  // Profile-likelihood intervals of the tuned parameters even where the scenario's
+  // updating.profile.enabled does not ask for them (updating/profile.h).
+  bool profile = false;
   // Progress lines ("simulated the test: ...", "Route 2: ..."); empty: none.
   std::function<void(const std::string&)> say;
 };
