@@ -100,6 +100,34 @@ TEST_F(UpdateCliTest, TunesTheReferenceCraneAndWritesJsonAndUpdatingGroup) {
   EXPECT_TRUE(file.Exists("/updating/algebraic"));
 }
 
+// --profile: every tuned joint parameter gets its profile-likelihood interval. On this record
+// the cost is quadratic over the Fisher interval (relative stds of 1e-4 to 1e-2), so both
+// intervals must agree to the profile's 5% tolerance on their half-width, closed on both sides.
+TEST_F(UpdateCliTest, ProfileGivesEveryJointParameterAnInterval) {
+  const fs::path scenario =
+      WriteScenario("reference-crane.yaml", "reference", "duration_s: 8", "duration_s: 4");
+  const fs::path record = Simulate(scenario);
+  const CommandResult result =
+      Run("-q update " + scenario.string() + " " + record.string() + " --profile --json -");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json json = nlohmann::json::parse(result.out);
+  for (const auto& [name, truth] : kTruth) {
+    SCOPED_TRACE(name);
+    const nlohmann::json& p = json["parameters"][name];
+    ASSERT_TRUE(p.contains("profile"));
+    const nlohmann::json& profile = p["profile"];
+    EXPECT_EQ(profile["open"], nlohmann::json::array({false, false}));
+    EXPECT_FALSE(profile["better_minimum"].get<bool>());
+    const double value = p["value"].get<double>();
+    const double lower = profile["interval"][0].get<double>();
+    const double upper = profile["interval"][1].get<double>();
+    const double fisher_half = std::log(p["interval"][1].get<double>() / value);
+    EXPECT_NEAR(std::log(upper / value), fisher_half, 0.06 * fisher_half);
+    EXPECT_NEAR(std::log(value / lower), fisher_half, 0.06 * fisher_half);
+    EXPECT_GE(profile["fits"].get<int>(), 2);
+  }
+}
+
 // The paper's load drop barely excites two of the four modes (reference-crane.md): the fit
 // must say which parameters the record leaves open instead of returning confident numbers.
 TEST_F(UpdateCliTest, LoadDropReportsUndeterminedParameters) {

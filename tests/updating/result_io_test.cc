@@ -39,6 +39,14 @@ UpdateResult MakeResult() {
                       kInf,
                       "",
                       {}};
+  c.profile.computed = true;
+  c.profile.lower = 9.3e6;
+  c.profile.upper = 9.6e6;
+  c.profile.upper_open = true;
+  c.profile.threshold = 4;
+  c.profile.values = {9.3e6, 9.4e6, 9.6e6};
+  c.profile.cost_rises = {4.1, 0, 2.5};
+  c.profile.fits = 5;
   result.parameters = {c, d, m};
   result.correlation = Eigen::Matrix3d::Identity();
   result.correlation(1, 1) = kNaN;
@@ -116,6 +124,12 @@ TEST(ResultIoTest, JsonFollowsTheContract) {
   EXPECT_EQ(c.at("upper"), 8e8);
   EXPECT_EQ(c.at("std"), 2e4);
   EXPECT_EQ(c.at("units"), "N*m/rad");
+  // Profiled: the interval, which side is open, the points [value, rise]; absent otherwise.
+  EXPECT_EQ(c.at("profile").at("interval"), nlohmann::json::array({9.3e6, 9.6e6}));
+  EXPECT_EQ(c.at("profile").at("open"), nlohmann::json::array({false, true}));
+  EXPECT_EQ(c.at("profile").at("points").at(2), nlohmann::json::array({9.6e6, 2.5}));
+  EXPECT_EQ(c.at("profile").at("fits"), 5);
+  EXPECT_FALSE(json.at("parameters").at("d_eta").contains("profile"));
   EXPECT_TRUE(json.at("parameters").at("d_eta").at("std").is_null());  // undetermined: null
   EXPECT_FALSE(json.at("parameters").at("d_eta").at("determined"));
   EXPECT_EQ(json.at("parameters").at("drop/1:payload_mass_kg").at("test"), "drop/1");
@@ -182,6 +196,9 @@ TEST(ResultIoTest, Hdf5GroupRoundTrips) {
   EXPECT_EQ(reader.ReadScalar("/updating/parameters/c_theta", "value"), 9.4e6);
   EXPECT_EQ(reader.ReadUnits("/updating/parameters/c_theta", "value"), "N*m/rad");
   EXPECT_TRUE(std::isnan(reader.ReadScalar("/updating/parameters/d_eta", "std")));
+  EXPECT_EQ(reader.ReadScalar("/updating/parameters/c_theta/profile", "upper"), 9.6e6);
+  EXPECT_EQ(reader.ReadStringAttribute("/updating/parameters/c_theta/profile", "upper_open"), "1");
+  EXPECT_EQ(reader.ReadVector("/updating/parameters/c_theta/profile", "cost_rises")[0], 4.1);
   // '/' cannot be part of an HDF5 name: it becomes '_'.
   EXPECT_EQ(reader.ReadScalar("/updating/parameters/drop_1:payload_mass_kg", "value"), 650);
   EXPECT_EQ(reader.ReadScalar("/updating/cost", "final"), 812.5);
