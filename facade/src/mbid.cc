@@ -40,6 +40,12 @@ UpdateResult Summarise(const updating::GlobalSearchResult& search, const std::st
     value.relative_std = p.relative_std;
     value.interval_lower = p.interval_lower;
     value.interval_upper = p.interval_upper;
+    if (p.profile.computed) {
+      value.profile_lower = p.profile.lower;
+      value.profile_upper = p.profile.upper;
+      value.profile_lower_open = p.profile.lower_open;
+      value.profile_upper_open = p.profile.upper_open;
+    }
     value.determined = p.determined;
     value.why_undetermined = p.why_undetermined;
     value.units = p.units;

@@ -90,6 +90,31 @@ TEST(FacadeTest, UpdateTunesEachRecordWithItsOwnExcitation) {
   EXPECT_THROW(mbid::Update(scenario, records, {scenario.excitation}), mbid::InputError);
 }
 
+// updating.profile.enabled reaches UpdateResult::parameters: on the reference record (4 s) every
+// joint's profile interval is closed and brackets its estimate; without it, NaN.
+TEST(FacadeTest, UpdateCarriesTheProfileIntervalsTheScenarioAsksFor) {
+  std::ifstream in(kReference);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("duration_s: 8"), 13, "duration_s: 4");
+  const fs::path path = fs::temp_directory_path() / "mbid_facade_profile.yaml";
+  std::ofstream(path) << yaml << "updating: {profile: {enabled: true}}\n";
+  const mbid::Scenario scenario = mbid::LoadScenario(path.string());
+  const std::vector<mbid::Measurement> records{mbid::Simulate(scenario)};
+  const mbid::UpdateResult result = mbid::Update(scenario, records);
+  ASSERT_EQ(result.parameters.size(), 8u);
+  for (const auto& [name, p] : result.parameters) {
+    SCOPED_TRACE(name);
+    EXPECT_LT(p.profile_lower, p.value);
+    EXPECT_GT(p.profile_upper, p.value);
+    EXPECT_FALSE(p.profile_lower_open || p.profile_upper_open);
+  }
+  fs::remove(path);
+  const mbid::UpdateResult plain = mbid::Update(mbid::LoadScenario(kReference), records);
+  EXPECT_TRUE(std::isnan(plain.parameters.at("c_alpha").profile_lower));
+}
+
 TEST(FacadeTest, TheCycleInMemoryPassesTheReferenceAndWritesNothing) {
   const fs::path cwd = fs::temp_directory_path() / "mbid_facade_cycle";
   fs::remove_all(cwd);

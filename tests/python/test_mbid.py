@@ -125,6 +125,9 @@ class UpdateAndRunTest(unittest.TestCase):
             self.assertEqual(tuned.parameters[name].value, entry["value"], name)
             self.assertEqual(tuned.parameters[name].std, entry["std"], name)
         self.assertGreater(tuned.parameters["c_alpha"].std, 0.0)
+        # The scenario does not ask for profile-likelihood intervals: NaN, not a number made up.
+        self.assertTrue(math.isnan(tuned.parameters["c_alpha"].profile_lower))
+        self.assertFalse(tuned.parameters["c_alpha"].profile_upper_open)
 
     def test_run_gives_the_verdict_as_text(self):
         result = mbid.run(mbid.load_scenario(REFERENCE))

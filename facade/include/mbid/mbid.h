@@ -9,6 +9,7 @@
 // input (a file, key path, line or column and what was expected; the command's exit 2) and
 // mbid::NumericalError for a fit or integration that failed (exit 3).
 
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -73,6 +74,12 @@ struct ParameterValue {
   // Approximate 95% interval, widened by the credibility check's inflation.
   double interval_lower = 0;
   double interval_upper = 0;
+  // Profile-likelihood interval (the scenario's updating.profile.enabled); NaN when not computed.
+  // An open side ends at the last value reached (the bound): the records do not bound it there.
+  double profile_lower = std::numeric_limits<double>::quiet_NaN();
+  double profile_upper = std::numeric_limits<double>::quiet_NaN();
+  bool profile_lower_open = false;
+  bool profile_upper_open = false;
   bool determined = true;        // false: the records do not fix it (why_undetermined says why)
   std::string why_undetermined;  // empty when determined
   std::string units;
