@@ -15,6 +15,7 @@
 #include "mbid/updating/fisher.h"
 #include "mbid/updating/output_error.h"
 #include "mbid/updating/plan.h"
+#include "mbid/updating/plan_alternatives.h"
 #include "mbid/validation/plan_candidates.h"
 #include "mbid/validation/recorded_tests.h"
 #include "mbid/validation/scenario.h"
@@ -73,6 +74,23 @@ void PrintPlan(const updating::TestPlan& plan, const std::string& estimate_sourc
                "tests; inf = undetermined)\n";
 }
 
+void PrintAlternatives(const updating::AlternativesPlan& plan,
+                       const std::vector<updating::AlternativeMinimumValues>& alternatives) {
+  for (size_t a = 0; a < alternatives.size(); ++a) {
+    std::vector<std::string> can, cannot;
+    for (const updating::CandidateAtAlternatives& entry : plan.candidates) {
+      (entry.cannot_separate[a] ? cannot : can)
+          .push_back(fmt::format("{} ({:.3g})", entry.name, entry.separation[a]));
+    }
+    std::cout << fmt::format(
+        "alternative minimum from {} (2 x cost excess {:.3g}, F-test threshold {:.3g}): may be "
+        "told apart by {}; cannot by {} (chi-square separation of the noise-free outputs)\n",
+        alternatives[a].label, alternatives[a].cost_excess, plan.thresholds[a],
+        can.empty() ? "none" : fmt::format("{}", fmt::join(can, ", ")),
+        cannot.empty() ? "none" : fmt::format("{}", fmt::join(cannot, ", ")));
+  }
+}
+
 }  // namespace
 
 int RunPlanCommand(const std::string& scenario_path, const std::vector<std::string>& data_paths,
@@ -101,6 +119,9 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   std::string estimate_source = "scenario";
   std::vector<std::string> recorded_undetermined;
   bool non_unique = false;
+  std::vector<updating::AlternativeMinimumValues> alternatives;
+  long residual_count = 0;
+  double significance = settings.global_search.significance;
   if (!tests.empty()) {
     const RecordedUpdate update =
         UpdateFromTests(*model, tests, settings, [&common](const std::string& line) {
@@ -116,6 +137,17 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
     // (the global search): the plan's F is local to this estimate and does not see the latter.
     recorded_undetermined = result.undetermined;
     non_unique = update.search.non_unique;
+    residual_count = update.search.residual_count;
+    for (const updating::SearchMinimum& minimum : update.search.minima) {
+      if (!minimum.alternative) continue;
+      updating::AlternativeMinimumValues alternative;
+      alternative.label = fmt::format("{}", fmt::join(minimum.starts, ", "));
+      for (const updating::ParameterEstimate& p : minimum.fit.parameters) {
+        if (p.test.empty()) alternative.values[p.name] = p.value;
+      }
+      alternative.cost_excess = 2 * (minimum.cost - update.search.minima.front().cost);
+      alternatives.push_back(alternative);
+    }
     estimate_source = "estimated";
     // The noise of each channel: the weights of the fit (the identification's residual noise
     // unless the updating section gives one), averaged over the tests that have the channel.
@@ -137,6 +169,16 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   FillCandidateNoise(file, recorded_noise, scenario.sensors.noise_std);
   const updating::TestPlan plan =
       updating::PlanNextTest(*model, recorded, file.candidates, options);
+  updating::AlternativesPlan at_alternatives;
+  if (!alternatives.empty()) {
+    if (!common.quiet) {
+      std::cerr << fmt::format("mbid: plan: the candidates at {} alternative minimum(s) too\n",
+                               alternatives.size());
+    }
+    at_alternatives =
+        updating::PlanAtAlternatives(*model, recorded, file.candidates, plan, alternatives, options,
+                                     residual_count, significance);
+  }
 
   nlohmann::json summary;
   summary["candidates"] = nlohmann::json::array();
@@ -161,6 +203,18 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
       }
       item["noise_std"] = noise;
     }
+    for (const updating::CandidateAtAlternatives& entry : at_alternatives.candidates) {
+      if (entry.name != candidate.name) continue;
+      item["worst_score"] = NumberOrNull(entry.worst_score);
+      nlohmann::json list = nlohmann::json::array();
+      for (size_t a = 0; a < alternatives.size(); ++a) {
+        list.push_back({{"alternative", alternatives[a].label},
+                        {"score", NumberOrNull(entry.scores[a])},
+                        {"separation_chi_square", NumberOrNull(entry.separation[a])},
+                        {"cannot_separate", static_cast<bool>(entry.cannot_separate[a])}});
+      }
+      item["at_alternatives"] = list;
+    }
     summary["candidates"].push_back(item);
   }
   summary["parameters"] = plan.parameters;
@@ -170,6 +224,18 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   summary["recorded_score"] = NumberOrNull(plan.recorded_score);
   summary["recorded_undetermined"] = recorded_undetermined;
   summary["recorded_non_unique"] = non_unique;
+  if (!alternatives.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    for (size_t a = 0; a < alternatives.size(); ++a) {
+      nlohmann::json values = nlohmann::json::object();
+      for (const auto& [name, value] : alternatives[a].values) values[name] = value;
+      list.push_back({{"label", alternatives[a].label},
+                      {"values", values},
+                      {"cost_excess", NumberOrNull(alternatives[a].cost_excess)},
+                      {"threshold", NumberOrNull(at_alternatives.thresholds[a])}});
+    }
+    summary["alternatives"] = list;
+  }
   summary["current_relative_std"] = PerParameter(plan.parameters, plan.current_relative_std);
   summary["undetermined_relative_std"] = options.undetermined_relative_std;
   summary["score"] =
@@ -185,6 +251,7 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
                                             "best one)"
                                           : "");
     }
+    PrintAlternatives(at_alternatives, alternatives);
   }
   return 0;
 }

@@ -1,0 +1,115 @@
+// Next-test planning at the alternative minima (plan_alternatives.h): scores at each minimum
+// and the candidates' noise-free separation of the best from each alternative.
+#include "mbid/updating/plan_alternatives.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "mbid/common/error.h"
+#include "mbid/simulation/simulate.h"
+#include "mbid/updating/global_search.h"
+
+namespace mbid::updating {
+namespace {
+
+// The candidate's model (its own, or the plan's) with the tuned parameters at `values`.
+std::unique_ptr<model::MechanicalModel> ModelAt(const model::MechanicalModel& model,
+                                                const PlanCandidate& candidate,
+                                                const std::map<std::string, double>& values) {
+  std::unique_ptr<model::MechanicalModel> copy =
+      candidate.model ? candidate.model->Clone() : model.Clone();
+  for (const auto& [name, value] : values) {
+    try {
+      copy->SetParameter(name, value);
+    } catch (const InputError& e) {
+      throw InputError(candidate.name, "model", e.what(),
+                       "a model with the tuned parameters of the scenario's");
+    }
+  }
+  return copy;
+}
+
+// The candidate's noise-free outputs at `values`, each channel divided by its noise.
+Eigen::MatrixXd WeightedOutputs(const model::MechanicalModel& model, const PlanCandidate& candidate,
+                                const std::map<std::string, double>& values) {
+  const std::unique_ptr<model::MechanicalModel> at = ModelAt(model, candidate, values);
+  const TestDesign& test = candidate.test;
+  const simulation::SimulationResult run =
+      simulation::Simulate(*at, test.excitation, test.simulation, test.sensors);
+  Eigen::MatrixXd weighted = run.exact.values;
+  for (Eigen::Index c = 0; c < weighted.cols(); ++c) {
+    const std::string& channel = run.exact.channels[static_cast<size_t>(c)];
+    const auto noise = test.sensors.noise_std.find(channel);
+    if (noise == test.sensors.noise_std.end() || !(noise->second > 0)) {
+      throw InputError(candidate.name, "sensors.noise_std", "no noise level for '" + channel + "'",
+                       "a positive noise level for every channel");
+    }
+    weighted.col(c) /= noise->second;
+  }
+  return weighted;
+}
+
+}  // namespace
+
+AlternativesPlan PlanAtAlternatives(const model::MechanicalModel& model,
+                                    const std::vector<TestDesign>& recorded,
+                                    const std::vector<PlanCandidate>& candidates,
+                                    const TestPlan& at_best,
+                                    const std::vector<AlternativeMinimumValues>& alternatives,
+                                    const PlanOptions& options, long residual_count,
+                                    double significance) {
+  AlternativesPlan result;
+  std::map<std::string, double> best;
+  for (size_t k = 0; k < at_best.parameters.size(); ++k) {
+    best[at_best.parameters[k]] = at_best.values[static_cast<Eigen::Index>(k)];
+  }
+  for (const PlanCandidate& candidate : candidates) {
+    CandidateAtAlternatives entry;
+    entry.name = candidate.name;
+    entry.worst_score = std::numeric_limits<double>::quiet_NaN();
+    for (const CandidateScore& score : at_best.candidates) {
+      if (score.name == candidate.name) entry.worst_score = score.score;
+    }
+    result.candidates.push_back(entry);
+  }
+  const double k = static_cast<double>(at_best.parameters.size());
+  std::vector<Eigen::MatrixXd> best_outputs;
+  for (const PlanCandidate& candidate : candidates) {
+    best_outputs.push_back(WeightedOutputs(model, candidate, best));
+  }
+  for (const AlternativeMinimumValues& alternative : alternatives) {
+    std::unique_ptr<model::MechanicalModel> at = model.Clone();
+    std::map<std::string, double> values = best;
+    for (const auto& [name, value] : alternative.values) {
+      if (values.count(name) > 0) values[name] = value;
+    }
+    for (const auto& [name, value] : values) at->SetParameter(name, value);
+    const TestPlan plan = PlanNextTest(*at, recorded, candidates, options);
+    long candidate_residuals = 0;
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      CandidateAtAlternatives& entry = result.candidates[i];
+      double score = std::numeric_limits<double>::quiet_NaN();
+      for (const CandidateScore& s : plan.candidates) {
+        if (s.name == entry.name) score = s.score;
+      }
+      entry.scores.push_back(score);
+      entry.worst_score = std::min(entry.worst_score, score);
+      const Eigen::MatrixXd outputs = WeightedOutputs(model, candidates[i], values);
+      entry.separation.push_back((outputs - best_outputs[i]).squaredNorm());
+      candidate_residuals = std::max<long>(candidate_residuals, outputs.size());
+    }
+    // The threshold with the recorded residuals and the largest candidate's: the F quantile
+    // barely moves with the degrees of freedom past a few hundred.
+    const double dof = std::max(1.0, static_cast<double>(residual_count + candidate_residuals) - k);
+    const double threshold = k * FQuantile(significance, k, dof);
+    result.thresholds.push_back(threshold);
+    for (CandidateAtAlternatives& entry : result.candidates) {
+      entry.cannot_separate.push_back(alternative.cost_excess + entry.separation.back() <
+                                      threshold);
+    }
+  }
+  return result;
+}
+
+}  // namespace mbid::updating
