@@ -115,6 +115,34 @@ TEST(FacadeTest, UpdateCarriesTheProfileIntervalsTheScenarioAsksFor) {
   EXPECT_TRUE(std::isnan(plain.parameters.at("c_alpha").profile_lower));
 }
 
+// A profile open on both sides makes the verdict inconclusive, naming the parameter: bounds on
+// d_eta of +-0.45% around the truth lie inside its 1-sigma range on the 4 s record (relative
+// std ~1-2%), so the cost cannot rise to the 2-sigma threshold before either bound.
+TEST(FacadeTest, AnOpenProfileMakesTheVerdictInconclusive) {
+  std::ifstream in(kReference);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("duration_s: 8"), 13, "duration_s: 4");
+  const fs::path path = fs::temp_directory_path() / "mbid_facade_open_profile.yaml";
+  std::ofstream(path) << yaml
+                      << "updating: {profile: {enabled: true}, bounds: {d_eta: [43800, 44200]}}\n";
+  const mbid::ValidationResult result = mbid::RunValidationCycle(mbid::LoadScenario(path.string()));
+  fs::remove(path);
+  EXPECT_EQ(result.verdict, mbid::Verdict::kInconclusive);
+  const mbid::ParameterValue& d_eta = result.updated.parameters.at("d_eta");
+  EXPECT_TRUE(d_eta.profile_lower_open && d_eta.profile_upper_open);
+  EXPECT_FALSE(d_eta.determined);
+  bool named = false;
+  for (const std::string& reason : result.reasons) {
+    named = named || (reason.find("d_eta") != std::string::npos &&
+                      reason.find("profile") != std::string::npos);
+  }
+  EXPECT_TRUE(named) << ::testing::PrintToString(result.reasons);
+  // The other parameters' profiles close well inside their bounds: still determined.
+  EXPECT_TRUE(result.updated.parameters.at("c_alpha").determined);
+}
+
 TEST(FacadeTest, TheCycleInMemoryPassesTheReferenceAndWritesNothing) {
   const fs::path cwd = fs::temp_directory_path() / "mbid_facade_cycle";
   fs::remove_all(cwd);
