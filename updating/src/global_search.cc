@@ -5,22 +5,23 @@
 
 #include <algorithm>
 #include <atomic>
-#include <boost/math/distributions/fisher_f.hpp>
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <memory>
-#include <optional>
-#include <random>
 #include <set>
 #include <thread>
 
+#include "global_search_internal.h"
 #include "mbid/common/error.h"
-#include "mbid/model/linear_model.h"
-#include "mbid/updating/characteristic.h"
 #include "output_error_fit.h"
 
 namespace mbid::updating {
+using internal::Differences;
+using internal::PoleEquivalentStarts;
+using internal::SpaceFillingDesign;
+using internal::StartOptions;
+using internal::Window;
+
 namespace {
 
 // A start (or screened end) is worth a whole-record fit when its cost is within this factor of
@@ -41,155 +42,11 @@ void RunParallel(int count, int threads, const std::function<void(int)>& job) {
   for (std::thread& thread : pool) thread.join();
 }
 
-// Radical inverse of i in `base` with the digits permuted by `permutation` (a scrambled Halton
-// sequence: the plain one has correlated projections in the higher bases).
-double ScrambledRadicalInverse(unsigned i, unsigned base,
-                               const std::vector<unsigned>& permutation) {
-  double value = 0, weight = 1.0 / base;
-  for (; i > 0; i /= base, weight /= base) value += weight * permutation[i % base];
-  return value;
-}
-
-// `count` points of the unit cube in `dimension` dimensions, seeded.
-std::vector<std::vector<double>> SpaceFillingDesign(int count, int dimension, std::uint64_t seed) {
-  static const unsigned kPrimes[] = {2,  3,  5,  7,  11, 13, 17, 19, 23, 29, 31, 37,  41, 43,
-                                     47, 53, 59, 61, 67, 71, 73, 79, 83, 89, 97, 101, 103};
-  const int available = static_cast<int>(sizeof(kPrimes) / sizeof(kPrimes[0]));
-  std::mt19937_64 random(seed);
-  std::vector<std::vector<unsigned>> permutations;
-  std::vector<double> shift;
-  for (int d = 0; d < dimension; ++d) {
-    const unsigned base = kPrimes[d % available];
-    std::vector<unsigned> permutation(base);
-    for (unsigned k = 0; k < base; ++k) permutation[k] = k;
-    // Zero stays zero: the sequence keeps its low-discrepancy structure.
-    std::shuffle(permutation.begin() + 1, permutation.end(), random);
-    permutations.push_back(permutation);
-    // Beyond the primes, a random shift per dimension keeps repeated bases apart.
-    shift.push_back(d < available ? 0.0 : std::uniform_real_distribution<double>(0, 1)(random));
-  }
-  std::vector<std::vector<double>> points;
-  for (int i = 0; i < count; ++i) {
-    std::vector<double> point;
-    for (int d = 0; d < dimension; ++d) {
-      const unsigned base = kPrimes[d % available];
-      // Index from 1: point 0 of every Halton sequence is the corner.
-      double u = ScrambledRadicalInverse(static_cast<unsigned>(i + 1), base, permutations[d]);
-      u = std::fmod(u + shift[d], 1.0);
-      point.push_back(u);
-    }
-    points.push_back(point);
-  }
-  return points;
-}
-
-// Ceres' coordinate of a parameter and the relative size of a difference in it.
-double Internal(const ParameterEstimate& p, double value) {
-  return p.log_scale ? std::log(value) : value / std::max(std::abs(p.value), 1e-6);
-}
-
-// Parameters (shared, tuned) in which two end points differ beyond the clustering tolerance
-// and 3 standard deviations: both ends' combined (one minimum reached twice), or only `a`'s
-// (`a` the best: is the other end inside its confidence interval?).
-std::vector<std::string> Differences(const UpdateResult& a, const UpdateResult& b, double tolerance,
-                                     bool combined_std = true) {
-  std::vector<std::string> differ;
-  for (const ParameterEstimate& p : a.parameters) {
-    if (!p.test.empty()) continue;
-    const ParameterEstimate& q = b.Find(p.name);
-    const double distance = std::abs(Internal(p, p.value) - Internal(p, q.value));
-    double allowed = tolerance;
-    const double std = combined_std ? std::hypot(p.relative_std, q.relative_std) : p.relative_std;
-    if (std::isfinite(std)) allowed = std::max(allowed, 3 * std);
-    if (distance > allowed) differ.push_back(p.name);
-  }
-  return differ;
-}
-
-std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double fraction) {
-  std::vector<TestRecord> window = tests;
-  for (TestRecord& test : window) {
-    const int samples = test.record.samples();
-    const int kept = std::min(samples, std::max(std::max(50, test.fit_drift ? 3 : 2),
-                                                static_cast<int>(std::ceil(fraction * samples))));
-    test.record.values = test.record.values.topRows(kept).eval();
-  }
-  return window;
-}
-
-UpdateOptions StartOptions(const UpdateOptions& options,
-                           const std::vector<ParameterSetting>& settings,
-                           const std::map<std::string, double>& values) {
-  UpdateOptions start = options;
-  start.parameters = settings;
-  for (ParameterSetting& setting : start.parameters) {
-    const auto found = values.find(setting.name);
-    if (found != values.end() && std::isfinite(found->second)) {
-      setting.initial = std::clamp(found->second, setting.lower, setting.upper);
-    }
-  }
-  return start;
-}
-
 bool Converged(const UpdateResult& result) {
   return result.termination == UpdateResult::Termination::kConverged;
 }
 
-// Every other admissible solution of eq. 7 for the exact poles of `model` carrying `fit`'s
-// values, as starts; none unless every coordinate has a tuned spring and damper and all its
-// modes oscillate.
-std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& model,
-                                              const UpdateResult& fit, std::uint64_t seed) {
-  std::vector<SearchStart> starts;
-  if (!FindFreeCoordinate(model).empty()) return starts;
-  std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
-  ApplyEstimates(fit, *tuned);
-  const model::LinearModel linear = tuned->Linearize();
-  for (const std::string& coordinate : linear.coordinates) {
-    for (const std::string& name : {"c_" + coordinate, "d_" + coordinate}) {
-      bool found = false;
-      for (const ParameterEstimate& p : fit.parameters) found = found || p.name == name;
-      if (!found) return starts;
-    }
-  }
-  std::vector<std::complex<double>> lambda;
-  for (const model::Mode& mode : model::CalcModes(linear)) {
-    if (mode.lambda.imag() > 0) lambda.push_back(mode.lambda);
-  }
-  if (static_cast<int>(lambda.size()) != tuned->coordinate_count()) return starts;
-  CharacteristicOptions options;
-  options.seed = seed;
-  const CharacteristicResult sets = SolveCharacteristicEquation(
-      MakeCharacteristicProblem(*tuned, lambda, std::nullopt, std::nullopt), options);
-  for (size_t s = 0; s < sets.solutions.size(); ++s) {
-    const CharacteristicSolution& set = sets.solutions[s];
-    if (!set.admissible) continue;
-    SearchStart start;
-    start.label = fmt::format("pole-equivalent set {}", s);
-    bool same = true;  // the tuned set itself (to eq. 7's convergence)
-    for (size_t i = 0; i < sets.coordinates.size(); ++i) {
-      const Eigen::Index k = static_cast<Eigen::Index>(i);
-      const std::string c = "c_" + sets.coordinates[i], d = "d_" + sets.coordinates[i];
-      start.values[c] = set.c[k];
-      start.values[d] = set.d[k];
-      same = same && std::abs(set.c[k] / fit.Find(c).value - 1) < 1e-3 &&
-             std::abs(set.d[k] / fit.Find(d).value - 1) < 1e-3;
-    }
-    if (!same) starts.push_back(start);
-  }
-  return starts;
-}
-
 }  // namespace
-
-double FQuantile(double alpha, double d1, double d2) {
-  return boost::math::quantile(boost::math::complement(boost::math::fisher_f(d1, d2), alpha));
-}
-
-double FSurvival(double f, double d1, double d2) {
-  if (!(f > 0)) return 1.0;
-  return boost::math::cdf(boost::math::complement(boost::math::fisher_f(d1, d2), f));
-}
 
 bool GlobalSearchOptions::IsValid(std::string* why) const {
   auto fail = [why](const std::string& reason) {

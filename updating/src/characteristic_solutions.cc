@@ -1,0 +1,139 @@
+// Judging eq. 7's solution sets: admissibility, shapes (eq. 6), amplitudes (eq. 8), mismatch.
+#include <Eigen/Dense>
+#include <cmath>
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "characteristic_internal.h"
+#include "mbid/updating/characteristic.h"
+#include "statistics.h"
+
+namespace mbid::updating::internal {
+std::string InadmissibleReason(const CharacteristicProblem& problem,
+                               const CharacteristicSolution& solution) {
+  std::string reason;
+  for (Eigen::Index i = 0; i < solution.c.size(); ++i) {
+    if (!(solution.c[i] > 0)) {
+      reason += (reason.empty() ? "" : ", ") + ("c_" + problem.coordinates[i]) + " = " +
+                Format(solution.c[i]) + " <= 0";
+    }
+  }
+  for (Eigen::Index i = 0; i < solution.d.size(); ++i) {
+    if (!(solution.d[i] >= 0)) {
+      reason += (reason.empty() ? "" : ", ") + ("d_" + problem.coordinates[i]) + " = " +
+                Format(solution.d[i]) + " < 0";
+    }
+  }
+  return reason;
+}
+
+// w_k of eq. 6: the null vector of A(lambda_k), unit largest magnitude.
+Eigen::VectorXcd CalcShape(const CharacteristicProblem& problem, Complex lambda,
+                           const Eigen::VectorXd& c, const Eigen::VectorXd& d) {
+  const Eigen::MatrixXcd A = CalcCharacteristicMatrix(problem, lambda, c, d);
+  const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(A, Eigen::ComputeFullV);
+  Eigen::VectorXcd w = svd.matrixV().col(A.cols() - 1);
+  Eigen::Index largest = 0;
+  w.cwiseAbs().maxCoeff(&largest);
+  return w / w[largest];
+}
+
+// eq. 8: y_j = sum_k 2 Re(a_k H w_k exp(lambda_k t_j)) (+ offset) by linear least squares in
+// Re a_k, Im a_k (minimum norm where a mode is invisible in the outputs).
+void FitAmplitudes(const CharacteristicProblem& problem, const CharacteristicOptions& options,
+                   CharacteristicSolution& solution) {
+  const Measurement& record = *problem.record;
+  const Eigen::Index n = problem.M.rows();
+  std::vector<Eigen::Index> rows, columns;  // H rows and record columns of the used outputs
+  for (size_t i = 0; i < problem.outputs.size(); ++i) {
+    const int column = record.FindChannel(problem.outputs[i]);
+    if (column >= 0) {
+      rows.push_back(static_cast<Eigen::Index>(i));
+      columns.push_back(column);
+    }
+  }
+  const Eigen::Index m = static_cast<Eigen::Index>(rows.size());
+  const Eigen::Index samples = record.samples();
+  const Eigen::Index unknowns = 2 * n + (options.fit_offset ? m : 0);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(samples * m, unknowns);
+  Eigen::VectorXd b(samples * m);
+  std::vector<Eigen::VectorXcd> output_shapes;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    Eigen::VectorXcd shape = problem.H * solution.shapes[static_cast<size_t>(k)];
+    // Rate outputs see the mode differentiated: lambda or lambda^2 times the shape.
+    for (size_t i = 0; i < problem.output_orders.size(); ++i) {
+      shape[static_cast<Eigen::Index>(i)] *=
+          std::pow(problem.lambda[static_cast<size_t>(k)], problem.output_orders[i]);
+    }
+    output_shapes.push_back(shape);
+  }
+  for (Eigen::Index j = 0; j < samples; ++j) {
+    const double t = record.start_time_s + static_cast<double>(j) * record.sample_interval_s;
+    for (Eigen::Index r = 0; r < m; ++r) {
+      const Eigen::Index row = j * m + r;
+      b[row] = record.values(j, columns[static_cast<size_t>(r)]);
+      for (Eigen::Index k = 0; k < n; ++k) {
+        const Complex h = output_shapes[static_cast<size_t>(k)][rows[static_cast<size_t>(r)]] *
+                          std::exp(problem.lambda[static_cast<size_t>(k)] * t);
+        A(row, 2 * k) = 2 * h.real();
+        A(row, 2 * k + 1) = -2 * h.imag();
+      }
+      if (options.fit_offset) A(row, 2 * n + r) = 1.0;
+    }
+  }
+  const Eigen::VectorXd x = A.completeOrthogonalDecomposition().solve(b);
+  solution.amplitudes.resize(n);
+  solution.initial_q = Eigen::VectorXd::Zero(n);
+  solution.initial_u = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Complex a(x[2 * k], x[2 * k + 1]);
+    solution.amplitudes[k] = a;
+    const Eigen::VectorXcd& w = solution.shapes[static_cast<size_t>(k)];
+    solution.initial_q += 2 * (a * w).real();
+    solution.initial_u += 2 * (a * problem.lambda[static_cast<size_t>(k)] * w).real();
+  }
+  solution.offset = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(problem.outputs.size()));
+  if (options.fit_offset) {
+    for (Eigen::Index r = 0; r < m; ++r)
+      solution.offset[rows[static_cast<size_t>(r)]] = x[2 * n + r];
+  }
+  const Eigen::VectorXd fit = A * x;
+  solution.correlation =
+      Eigen::VectorXd::Constant(static_cast<Eigen::Index>(problem.outputs.size()), kNaN);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    Eigen::VectorXd measured(samples), reconstructed(samples);
+    for (Eigen::Index j = 0; j < samples; ++j) {
+      measured[j] = b[j * m + r];
+      reconstructed[j] = fit[j * m + r];
+    }
+    solution.correlation[rows[static_cast<size_t>(r)]] = CalcPearson(measured, reconstructed);
+  }
+}
+
+void CalcMismatch(const CharacteristicProblem& problem, CharacteristicSolution& solution) {
+  double omega = 0;
+  for (const Complex& lambda : problem.lambda) omega += std::abs(lambda);
+  omega /= static_cast<double>(problem.lambda.size());
+  if (problem.expected_initial_q) {
+    solution.expected_initial_q = problem.expected_initial_q(solution.c, solution.d);
+    const double size = solution.expected_initial_q.norm();
+    solution.displacement_mismatch =
+        (solution.initial_q - solution.expected_initial_q).norm() / size;
+    solution.velocity_mismatch = solution.initial_u.norm() / (omega * size);
+  } else {
+    solution.displacement_mismatch = kNaN;
+    solution.velocity_mismatch = solution.initial_u.norm() / (omega * solution.initial_q.norm());
+  }
+  solution.mismatch =
+      std::hypot(std::isnan(solution.displacement_mismatch) ? 0.0 : solution.displacement_mismatch,
+                 solution.velocity_mismatch);
+}
+
+double DistanceToReference(const CharacteristicProblem& problem,
+                           const CharacteristicSolution& solution) {
+  return std::sqrt(solution.c.cwiseQuotient(problem.c_reference).array().log().square().sum() +
+                   solution.d.cwiseQuotient(problem.d_reference).array().log().square().sum());
+}
+
+}  // namespace mbid::updating::internal

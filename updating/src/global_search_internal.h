@@ -1,0 +1,40 @@
+#pragma once
+
+// What the global search (global_search.cc) takes from its starts and minima files.
+// Private to updating/. global_search_starts.cc: where fits start; global_search_minima.cc:
+// telling end points apart.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mbid/model/mechanical_model.h"
+#include "mbid/updating/global_search.h"
+
+namespace mbid::updating::internal {
+
+// `count` points of the unit cube in `dimension` dimensions, seeded.
+std::vector<std::vector<double>> SpaceFillingDesign(int count, int dimension, std::uint64_t seed);
+
+// The tests cut to the first `fraction` of each record (the screening window).
+std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double fraction);
+
+// `options` with `settings` whose initial values are `values` where given (clamped to bounds).
+UpdateOptions StartOptions(const UpdateOptions& options,
+                           const std::vector<ParameterSetting>& settings,
+                           const std::map<std::string, double>& values);
+
+// Every other admissible solution of eq. 7 for the exact poles of `model` carrying `fit`'s
+// values, as starts; none unless every coordinate has a tuned spring and damper and all its
+// modes oscillate.
+std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& model,
+                                              const UpdateResult& fit, std::uint64_t seed);
+
+// Parameters (shared, tuned) in which two end points differ beyond the clustering tolerance
+// and 3 standard deviations: both ends' combined (one minimum reached twice), or only `a`'s
+// (`a` the best: is the other end inside its confidence interval?).
+std::vector<std::string> Differences(const UpdateResult& a, const UpdateResult& b, double tolerance,
+                                     bool combined_std = true);
+
+}  // namespace mbid::updating::internal

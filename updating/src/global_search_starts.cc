@@ -1,0 +1,132 @@
+// Where the global search's fits start: space-filling design, start options, windows, eq. 7 sets.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "global_search_internal.h"
+#include "mbid/model/linear_model.h"
+#include "mbid/updating/characteristic.h"
+
+namespace mbid::updating::internal {
+namespace {
+
+// Radical inverse of i in `base` with the digits permuted by `permutation` (a scrambled Halton
+// sequence: the plain one has correlated projections in the higher bases).
+double ScrambledRadicalInverse(unsigned i, unsigned base,
+                               const std::vector<unsigned>& permutation) {
+  double value = 0, weight = 1.0 / base;
+  for (; i > 0; i /= base, weight /= base) value += weight * permutation[i % base];
+  return value;
+}
+
+}  // namespace
+
+std::vector<std::vector<double>> SpaceFillingDesign(int count, int dimension, std::uint64_t seed) {
+  static const unsigned kPrimes[] = {2,  3,  5,  7,  11, 13, 17, 19, 23, 29, 31, 37,  41, 43,
+                                     47, 53, 59, 61, 67, 71, 73, 79, 83, 89, 97, 101, 103};
+  const int available = static_cast<int>(sizeof(kPrimes) / sizeof(kPrimes[0]));
+  std::mt19937_64 random(seed);
+  std::vector<std::vector<unsigned>> permutations;
+  std::vector<double> shift;
+  for (int d = 0; d < dimension; ++d) {
+    const unsigned base = kPrimes[d % available];
+    std::vector<unsigned> permutation(base);
+    for (unsigned k = 0; k < base; ++k) permutation[k] = k;
+    // Zero stays zero: the sequence keeps its low-discrepancy structure.
+    std::shuffle(permutation.begin() + 1, permutation.end(), random);
+    permutations.push_back(permutation);
+    // Beyond the primes, a random shift per dimension keeps repeated bases apart.
+    shift.push_back(d < available ? 0.0 : std::uniform_real_distribution<double>(0, 1)(random));
+  }
+  std::vector<std::vector<double>> points;
+  for (int i = 0; i < count; ++i) {
+    std::vector<double> point;
+    for (int d = 0; d < dimension; ++d) {
+      const unsigned base = kPrimes[d % available];
+      // Index from 1: point 0 of every Halton sequence is the corner.
+      double u = ScrambledRadicalInverse(static_cast<unsigned>(i + 1), base, permutations[d]);
+      u = std::fmod(u + shift[d], 1.0);
+      point.push_back(u);
+    }
+    points.push_back(point);
+  }
+  return points;
+}
+
+std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double fraction) {
+  std::vector<TestRecord> window = tests;
+  for (TestRecord& test : window) {
+    const int samples = test.record.samples();
+    const int kept = std::min(samples, std::max(std::max(50, test.fit_drift ? 3 : 2),
+                                                static_cast<int>(std::ceil(fraction * samples))));
+    test.record.values = test.record.values.topRows(kept).eval();
+  }
+  return window;
+}
+
+UpdateOptions StartOptions(const UpdateOptions& options,
+                           const std::vector<ParameterSetting>& settings,
+                           const std::map<std::string, double>& values) {
+  UpdateOptions start = options;
+  start.parameters = settings;
+  for (ParameterSetting& setting : start.parameters) {
+    const auto found = values.find(setting.name);
+    if (found != values.end() && std::isfinite(found->second)) {
+      setting.initial = std::clamp(found->second, setting.lower, setting.upper);
+    }
+  }
+  return start;
+}
+
+std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& model,
+                                              const UpdateResult& fit, std::uint64_t seed) {
+  std::vector<SearchStart> starts;
+  if (!FindFreeCoordinate(model).empty()) return starts;
+  std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
+  ApplyEstimates(fit, *tuned);
+  const model::LinearModel linear = tuned->Linearize();
+  for (const std::string& coordinate : linear.coordinates) {
+    for (const std::string& name : {"c_" + coordinate, "d_" + coordinate}) {
+      bool found = false;
+      for (const ParameterEstimate& p : fit.parameters) found = found || p.name == name;
+      if (!found) return starts;
+    }
+  }
+  std::vector<std::complex<double>> lambda;
+  for (const model::Mode& mode : model::CalcModes(linear)) {
+    if (mode.lambda.imag() > 0) lambda.push_back(mode.lambda);
+  }
+  if (static_cast<int>(lambda.size()) != tuned->coordinate_count()) return starts;
+  CharacteristicOptions options;
+  options.seed = seed;
+  const CharacteristicResult sets = SolveCharacteristicEquation(
+      MakeCharacteristicProblem(*tuned, lambda, std::nullopt, std::nullopt), options);
+  for (size_t s = 0; s < sets.solutions.size(); ++s) {
+    const CharacteristicSolution& set = sets.solutions[s];
+    if (!set.admissible) continue;
+    SearchStart start;
+    start.label = fmt::format("pole-equivalent set {}", s);
+    bool same = true;  // the tuned set itself (to eq. 7's convergence)
+    for (size_t i = 0; i < sets.coordinates.size(); ++i) {
+      const Eigen::Index k = static_cast<Eigen::Index>(i);
+      const std::string c = "c_" + sets.coordinates[i], d = "d_" + sets.coordinates[i];
+      start.values[c] = set.c[k];
+      start.values[d] = set.d[k];
+      same = same && std::abs(set.c[k] / fit.Find(c).value - 1) < 1e-3 &&
+             std::abs(set.d[k] / fit.Find(d).value - 1) < 1e-3;
+    }
+    if (!same) starts.push_back(start);
+  }
+  return starts;
+}
+
+}  // namespace mbid::updating::internal
