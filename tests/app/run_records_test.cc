@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -178,6 +179,13 @@ TEST_F(RunRecordsTest, FieldRecordIsCutAtTheReleaseAndItsOffsetsFitted) {
   EXPECT_EQ(summary["validation"]["verdict"], "passed") << summary["validation"].dump();
   const mbid::H5Reader run((out / "run.h5").string());
   EXPECT_TRUE(run.Exists("/tests/field/release/release_time_s"));
+  // The report says where the record was cut; its record figure (the whole record) marks it.
+  char release[64];
+  std::snprintf(release, sizeof release, "%.6g", test["release"]["release_time_s"].get<double>());
+  EXPECT_NE(
+      ReadText(out / "report.md")
+          .find(std::string("The free decay starts at ") + release + " s of the record (detected)"),
+      std::string::npos);
 }
 
 struct BadRecord {
