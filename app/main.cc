@@ -182,6 +182,8 @@ int Main(int argc, char** argv) {
                    "Backbones (frequency and damping against amplitude): clusters (default: "
                    "modes drifting with amplitude), always (every mode) or never")
       ->check(CLI::IsMember({"clusters", "always", "never"}));
+  identify->add_flag("--remove-drift", identify_options.remove_drift,
+                     "Fit and subtract a linear drift per channel with the modes");
 
   std::vector<std::string> update_data;
   CLI::App* update = app.add_subcommand(

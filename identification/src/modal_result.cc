@@ -92,6 +92,9 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
   json["reliable"] = result.reliable;
   json["reasons"] = result.reasons;
   json["min_correlation"] = result.min_correlation;
+  if (result.drift_per_s.size() > 0) {
+    json["drift_per_s"] = PerChannel(result.channels, result.drift_per_s);
+  }
   json["release_time_s"] = result.release_time_s;
   json["release"] = result.release;
   json["start_time_s"] = result.start_time_s;
@@ -214,6 +217,10 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result, const std::st
     writer.WriteScalar(sub("correlation"), channel, result.correlation(c), "1");
     writer.WriteScalar(sub("offset"), channel, result.offset(c), UnitOf(result, c));
     writer.WriteScalar(sub("noise_std"), channel, result.noise_std(c), UnitOf(result, c));
+    if (result.drift_per_s.size() > 0) {
+      writer.WriteScalar(sub("drift_per_s"), channel, result.drift_per_s(c),
+                         UnitOf(result, c) + "/s");
+    }
     writer.WriteVector(sub("reconstruction"), channel, result.reconstruction.col(c),
                        UnitOf(result, c));
   }

@@ -31,6 +31,7 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
                      "extra_orders",
                      "min_correlation",
                      "backbone",
+                     "remove_drift",
                      "prony"});
   const std::string method = section.Choice("method", identification::MethodNames(),
                                             identification::Method::kHankelNls.name());
@@ -60,6 +61,7 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
   options.compute_stabilization =
       section.Bool("compute_stabilization", options.compute_stabilization);
   options.compute_uncertainty = section.Bool("compute_uncertainty", options.compute_uncertainty);
+  options.remove_drift = section.Bool("remove_drift", options.remove_drift);
   identification::ParseBackboneMode(
       section.Choice("backbone", {"clusters", "always", "never"},
                      identification::BackboneModeName(options.backbone)),

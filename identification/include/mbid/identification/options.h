@@ -191,6 +191,10 @@ struct IdentificationOptions {
   // Which modes get a backbone: sliding-window fits and the Hilbert transform's instantaneous
   // frequency and damping against amplitude (backbone.h, hilbert_backbone.h).
   BackboneMode backbone = BackboneMode::kClusters;
+  // Fit and subtract a linear drift per channel with the modes (drift_removal.h): for records
+  // whose sensors drift (a thermal drift, an integrating amplifier). The constant part stays with
+  // `offset`.
+  bool remove_drift = false;
 
   SpectrumOptions spectrum;
   PronySvdOptions prony;
