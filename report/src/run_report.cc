@@ -223,16 +223,18 @@ std::string BackboneMarkdown(const identification::ModalResult& result) {
         std::minmax_element(b.damping_ratio.begin(), b.damping_ratio.end());
     const auto [a_low, a_high] = std::minmax_element(b.amplitude.begin(), b.amplitude.end());
     out << fmt::format(
-        "{} windows from amplitude {:.3g} to {:.3g}: frequency {:.4g} to {:.4g} Hz, damping ratio "
-        "{:.3g} to {:.3g}; {} (chi-square per degree of freedom {:.3g})",
-        b.frequency_hz.size(), *a_high, *a_low, *f_low, *f_high, *z_low, *z_high,
+        "{} window{} from amplitude {:.3g} to {:.3g}: frequency {:.4g} to {:.4g} Hz, damping "
+        "ratio {:.3g} to {:.3g}; {} (chi-square per degree of freedom {:.3g})",
+        b.frequency_hz.size(), b.frequency_hz.size() == 1 ? "" : "s", *a_high, *a_low, *f_low,
+        *f_high, *z_low, *z_high,
         b.amplitude_dependent ? "**depends on amplitude**" : "no drift beyond the noise",
         b.spread_chi_square_per_dof);
     if (b.hilbert) {
       const auto [h_low, h_high] =
           std::minmax_element(b.hilbert->frequency_hz.begin(), b.hilbert->frequency_hz.end());
-      out << fmt::format("; Hilbert transform: {} windows, frequency {:.4g} to {:.4g} Hz",
-                         b.hilbert->frequency_hz.size(), *h_low, *h_high);
+      out << fmt::format("; Hilbert transform: {} window{}, frequency {:.4g} to {:.4g} Hz",
+                         b.hilbert->frequency_hz.size(),
+                         b.hilbert->frequency_hz.size() == 1 ? "" : "s", *h_low, *h_high);
     }
     out << ".\n";
   }
