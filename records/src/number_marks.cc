@@ -108,6 +108,20 @@ std::optional<double> NumberReadings::With(DecimalMark mark, bool* grouped) cons
 
 NumberReadings ReadNumber(std::string_view cell) {
   NumberReadings readings;
+  if (cell.find_first_of(", \xC2\xE2") == std::string_view::npos) {
+    // The common case (mbid's own files, most loggers): no comma and no space, so the decimal
+    // point reading is the plain number, and without a '.' the comma reading is the same.
+    double value = 0;
+    if (mbid::internal::ParseDouble(cell, &value) == mbid::internal::ParseStatus::kOk) {
+      readings.point = value;
+    }
+    if (cell.find('.') == std::string_view::npos) {
+      readings.comma = readings.point;
+    } else {
+      readings.comma = ReadWith(cell, ',', '.', &readings.comma_grouped);
+    }
+    return readings;
+  }
   readings.point = ReadWith(cell, '.', ',', &readings.point_grouped);
   readings.comma = ReadWith(cell, ',', '.', &readings.comma_grouped);
   return readings;
