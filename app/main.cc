@@ -178,6 +178,15 @@ int Main(int argc, char** argv) {
                    "(low-SNR records)")
       ->capture_default_str();
 
+  std::string identify_backbone = "clusters";
+  identify
+      ->add_option("--backbone", identify_backbone,
+                   "Backbones (frequency and damping against amplitude): clusters (default: "
+                   "modes drifting with amplitude), always (every mode) or never")
+      ->check(CLI::IsMember({"clusters", "always", "never"}));
+  identify->add_flag("--remove-drift", identify_options.remove_drift,
+                     "Fit and subtract a linear drift per channel with the modes");
+
   std::vector<std::string> update_data;
   CLI::App* update = app.add_subcommand(
       "update", "Tune the joints' stiffness and damping to measurements (Route 1, then Ceres)");
@@ -242,6 +251,7 @@ int Main(int argc, char** argv) {
   }
   if (identify->parsed()) {
     mbid::identification::ParseMethod(identify_method, &identify_options.method);
+    mbid::identification::ParseBackboneMode(identify_backbone, &identify_options.backbone);
     if (common.import.release_none) {
       identify_options.release = mbid::identification::ReleaseMode::kNone;
     } else if (common.import.release_time_s) {

@@ -73,6 +73,10 @@ int RunIdentifyCommand(const std::string& data_path,
                                mode.std_decay_rate_per_s, mode.damping_ratio,
                                mode.significant ? "" : "  (not significant)");
     }
+    for (size_t c = 0; c < static_cast<size_t>(result.drift_per_s.size()); ++c) {
+      std::cout << fmt::format("linear drift removed from {}: {:.4g} {}/s\n", result.channels[c],
+                               result.drift_per_s[static_cast<Eigen::Index>(c)], result.units[c]);
+    }
     for (size_t c = 0; c < result.channels.size(); ++c) {
       std::cout << fmt::format("correlation K({}) in the analysed band = {:.4f}\n",
                                result.channels[c],

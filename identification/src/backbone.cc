@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mbid/identification/hilbert_backbone.h"
 #include "mbid/identification/modal_fit.h"
 #include "mbid/identification/refinement.h"
 
@@ -21,6 +22,7 @@ Backbone CalcBackbone(const Eigen::MatrixXd& mode_alone, double sample_interval_
   Eigen::Index reference = 0;
   mode_alone.colwise().squaredNorm().maxCoeff(&reference);
   std::complex<double> start = lambda;
+  std::vector<double> residual_stds;  // of the windows, in the reference channel: the noise
   for (int first = 0; first + window <= samples; first += window / 2) {
     const Eigen::MatrixXd part = mode_alone.middleRows(first, window);
     ModalModel initial;
@@ -40,10 +42,17 @@ Backbone CalcBackbone(const Eigen::MatrixXd& mode_alone, double sample_interval_
     const double centre = 0.5 * (window - 1) * tau;
     const Eigen::Vector2d cs = summary.model.coefficients.block(0, reference, 2, 1);
     const double decay = -pole.real();
+    // Where the mode's amplitude falls below twice the noise (the window's residual), a window
+    // fits the noise, whose chance frequencies would read as a drift: the backbone ends there.
+    const double amplitude = cs.norm() * std::exp(-decay * centre);
+    const double residual_std = std::sqrt(
+        FitAmplitudes(part, tau, summary.model.lambda, false).residual_variance(reference));
+    if (!(amplitude > 2 * residual_std)) break;
+    residual_stds.push_back(residual_std);
     // d zeta / d decay = 1 / |lambda| (omega fixed) up to the small omega term; the decay's std
     // dominates the damping ratio's.
     backbone.time_s.push_back(start_time_s + first * tau + centre);
-    backbone.amplitude.push_back(cs.norm() * std::exp(-decay * centre));
+    backbone.amplitude.push_back(amplitude);
     backbone.frequency_hz.push_back(frequency_hz);
     backbone.damping_ratio.push_back(decay / std::abs(pole));
     backbone.std_frequency_hz.push_back(std_frequency_hz);
@@ -68,6 +77,17 @@ Backbone CalcBackbone(const Eigen::MatrixXd& mode_alone, double sample_interval_
     backbone.spread_chi_square_per_dof = chi_square / static_cast<double>(n - 1);
     backbone.amplitude_dependent = backbone.spread_chi_square_per_dof > 4;
   }
+  // The noise of the reference channel: the median of the windows' residuals.
+  double noise_std = 0;
+  if (!residual_stds.empty()) {
+    std::nth_element(residual_stds.begin(),
+                     residual_stds.begin() + static_cast<long>(residual_stds.size() / 2),
+                     residual_stds.end());
+    noise_std = residual_stds[residual_stds.size() / 2];
+  }
+  BackboneCurve hilbert = CalcHilbertBackbone(mode_alone.col(reference), tau, start_time_s,
+                                              lambda.imag() / (2 * M_PI), noise_std);
+  if (!hilbert.frequency_hz.empty()) backbone.hilbert = std::move(hilbert);
   return backbone;
 }
 

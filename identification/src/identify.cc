@@ -7,6 +7,7 @@
 #include "free_decay.h"
 #include "internal.h"
 #include "mbid/common/error.h"
+#include "mbid/identification/drift_removal.h"
 #include "mbid/identification/release.h"
 #include "mbid/identification/spectrum.h"
 #include "methods/method.h"
@@ -19,6 +20,7 @@ namespace mbid::identification {
 
 ModalResult Identify(const Measurement& measurement, const IdentificationOptions& options,
                      const std::string& origin) {
+  if (options.remove_drift) return IdentifyRemovingDrift(measurement, options, origin);
   ModalResult result;
   options.Validate("identification options");
   bool from_rest = false;

@@ -74,6 +74,15 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
                        {"std_damping_ratio", b.std_damping_ratio},
                        {"amplitude_dependent", b.amplitude_dependent},
                        {"spread_chi_square_per_dof", b.spread_chi_square_per_dof}};
+      if (b.hilbert) {
+        const BackboneCurve& h = *b.hilbert;
+        m["backbone"]["hilbert"] = {{"time_s", h.time_s},
+                                    {"amplitude", h.amplitude},
+                                    {"frequency_hz", h.frequency_hz},
+                                    {"damping_ratio", h.damping_ratio},
+                                    {"std_frequency_hz", h.std_frequency_hz},
+                                    {"std_damping_ratio", h.std_damping_ratio}};
+      }
     }
     modes.push_back(m);
   }
@@ -83,6 +92,9 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
   json["reliable"] = result.reliable;
   json["reasons"] = result.reasons;
   json["min_correlation"] = result.min_correlation;
+  if (result.drift_per_s.size() > 0) {
+    json["drift_per_s"] = PerChannel(result.channels, result.drift_per_s);
+  }
   json["release_time_s"] = result.release_time_s;
   json["release"] = result.release;
   json["start_time_s"] = result.start_time_s;
@@ -165,13 +177,17 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result, const std::st
       return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()))
           .eval();
     };
-    writer.WriteVector(backbone_group, "time_s", vector(b.time_s), "s");
-    writer.WriteVector(backbone_group, "amplitude", vector(b.amplitude),
-                       "units of the mode's largest channel");
-    writer.WriteVector(backbone_group, "frequency_hz", vector(b.frequency_hz), "Hz");
-    writer.WriteVector(backbone_group, "damping_ratio", vector(b.damping_ratio), "1");
-    writer.WriteVector(backbone_group, "std_frequency_hz", vector(b.std_frequency_hz), "Hz");
-    writer.WriteVector(backbone_group, "std_damping_ratio", vector(b.std_damping_ratio), "1");
+    const auto write_curve = [&](const std::string& curve_group, const BackboneCurve& curve) {
+      writer.WriteVector(curve_group, "time_s", vector(curve.time_s), "s");
+      writer.WriteVector(curve_group, "amplitude", vector(curve.amplitude),
+                         "units of the mode's largest channel");
+      writer.WriteVector(curve_group, "frequency_hz", vector(curve.frequency_hz), "Hz");
+      writer.WriteVector(curve_group, "damping_ratio", vector(curve.damping_ratio), "1");
+      writer.WriteVector(curve_group, "std_frequency_hz", vector(curve.std_frequency_hz), "Hz");
+      writer.WriteVector(curve_group, "std_damping_ratio", vector(curve.std_damping_ratio), "1");
+    };
+    write_curve(backbone_group, b);
+    if (b.hilbert) write_curve(backbone_group + "/hilbert", *b.hilbert);
     writer.WriteStringAttribute(backbone_group, "amplitude_dependent",
                                 b.amplitude_dependent ? "true" : "false");
   }
@@ -201,6 +217,10 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result, const std::st
     writer.WriteScalar(sub("correlation"), channel, result.correlation(c), "1");
     writer.WriteScalar(sub("offset"), channel, result.offset(c), UnitOf(result, c));
     writer.WriteScalar(sub("noise_std"), channel, result.noise_std(c), UnitOf(result, c));
+    if (result.drift_per_s.size() > 0) {
+      writer.WriteScalar(sub("drift_per_s"), channel, result.drift_per_s(c),
+                         UnitOf(result, c) + "/s");
+    }
     writer.WriteVector(sub("reconstruction"), channel, result.reconstruction.col(c),
                        UnitOf(result, c));
   }

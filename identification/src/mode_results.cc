@@ -15,14 +15,33 @@
 namespace mbid::identification {
 namespace {
 
+// The decimated record with every mode outside `members` (and the offset) taken away.
+Eigen::MatrixXd KeepModes(const AnalysisRecord& record, const Estimate& estimate,
+                          const std::vector<size_t>& members) {
+  std::vector<std::complex<double>> poles;
+  Eigen::MatrixXd coefficients(2 * static_cast<Eigen::Index>(members.size()),
+                               record.decimated.cols());
+  for (size_t m = 0; m < members.size(); ++m) {
+    poles.push_back(estimate.lambda[members[m]]);
+    coefficients.middleRows(2 * static_cast<Eigen::Index>(m), 2) =
+        estimate.fit.coefficients.middleRows(2 * static_cast<Eigen::Index>(members[m]), 2);
+  }
+  return record.decimated - estimate.fit.reconstruction +
+         CalcDampedSinusoidBasis(poles, record.decimated_interval_s,
+                                 static_cast<int>(record.decimated.rows()), false) *
+             coefficients;
+}
+
 // Poles within 3 % of each other are, in a free decay, one mode whose frequency drifts with
 // amplitude far more often than two modes the record resolves. Each such cluster is measured in
 // sliding windows (backbone.h) with the other modes subtracted; when the windows confirm a drift,
-// the cluster is reported as its largest member with the backbone attached. `result->modes` and
-// `shapes` are in `estimate.lambda`'s order.
+// the cluster is reported as its largest member with the backbone attached. With
+// `backbone: always` every other mode gets its backbone too; with `never` nothing is measured or
+// merged. `result->modes` and `shapes` are in `estimate.lambda`'s order.
 void MergeDriftingModes(const AnalysisRecord& record, const Estimate& estimate,
                         const IdentificationOptions& options, ModalResult* result,
                         std::vector<Eigen::VectorXcd>* shapes) {
+  if (options.backbone == BackboneMode::kNever) return;
   const size_t n = result->modes.size();
   std::vector<size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
@@ -47,19 +66,7 @@ void MergeDriftingModes(const AnalysisRecord& record, const Estimate& estimate,
         }
       }
       // The record with every mode outside the cluster (and the offset) taken away.
-      std::vector<std::complex<double>> members;
-      Eigen::MatrixXd coefficients(2 * static_cast<Eigen::Index>(cluster.size()),
-                                   record.decimated.cols());
-      for (size_t m = 0; m < cluster.size(); ++m) {
-        members.push_back(estimate.lambda[cluster[m]]);
-        coefficients.middleRows(2 * static_cast<Eigen::Index>(m), 2) =
-            estimate.fit.coefficients.middleRows(2 * static_cast<Eigen::Index>(cluster[m]), 2);
-      }
-      const Eigen::MatrixXd alone =
-          record.decimated - estimate.fit.reconstruction +
-          CalcDampedSinusoidBasis(members, record.decimated_interval_s,
-                                  static_cast<int>(record.decimated.rows()), false) *
-              coefficients;
+      const Eigen::MatrixXd alone = KeepModes(record, estimate, cluster);
       Backbone backbone =
           CalcBackbone(alone, record.decimated_interval_s, record.decimated_start_time_s,
                        estimate.lambda[dominant], estimate.weights, options.refinement);
@@ -81,6 +88,15 @@ void MergeDriftingModes(const AnalysisRecord& record, const Estimate& estimate,
       }
     }
     i = j;
+  }
+  if (options.backbone == BackboneMode::kAlways) {
+    // Every other mode's backbone, measured alone (the rest of the record subtracted).
+    for (size_t k = 0; k < n; ++k) {
+      if (drop[k] || result->modes[k].backbone) continue;
+      result->modes[k].backbone = CalcBackbone(
+          KeepModes(record, estimate, {k}), record.decimated_interval_s,
+          record.decimated_start_time_s, estimate.lambda[k], estimate.weights, options.refinement);
+    }
   }
   std::vector<IdentifiedMode> kept;
   std::vector<Eigen::VectorXcd> kept_shapes;

@@ -99,6 +99,29 @@ std::optional<OptionProblem> FindOptionProblem(const IdentificationOptions& o) {
   return c.problem();
 }
 
+std::string BackboneModeName(BackboneMode mode) {
+  switch (mode) {
+    case BackboneMode::kAlways:
+      return "always";
+    case BackboneMode::kNever:
+      return "never";
+    case BackboneMode::kClusters:
+      break;
+  }
+  return "clusters";
+}
+
+bool ParseBackboneMode(const std::string& name, BackboneMode* mode) {
+  for (const BackboneMode candidate :
+       {BackboneMode::kClusters, BackboneMode::kAlways, BackboneMode::kNever}) {
+    if (name == BackboneModeName(candidate)) {
+      *mode = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
 bool IdentificationOptions::IsValid(std::string* error) const {
   const std::optional<OptionProblem> problem = FindOptionProblem(*this);
   if (problem && error != nullptr) {

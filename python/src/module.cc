@@ -181,6 +181,19 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readwrite("compute_spectrum", &IdentificationOptions::compute_spectrum)
       .def_readwrite("compute_stabilization", &IdentificationOptions::compute_stabilization)
       .def_readwrite("compute_uncertainty", &IdentificationOptions::compute_uncertainty)
+      .def_readwrite("remove_drift", &IdentificationOptions::remove_drift)
+      .def_property(
+          "backbone",
+          [](const IdentificationOptions& o) {
+            return mbid::identification::BackboneModeName(o.backbone);
+          },
+          [](IdentificationOptions& o, const std::string& mode) {
+            if (!mbid::identification::ParseBackboneMode(mode, &o.backbone)) {
+              throw mbid::InputError("IdentificationOptions", "backbone",
+                                     "unknown backbone mode '" + mode + "'",
+                                     "clusters, always or never");
+            }
+          })
       .def("__repr__", [](const IdentificationOptions& o) {
         return "<mbid.IdentificationOptions method='" + mbid::identification::MethodName(o.method) +
                "'>";

@@ -8,6 +8,7 @@
 #include "header_cells.h"
 #include "internal.h"
 #include "iso_time.h"
+#include "number_marks.h"
 #include "units.h"
 
 namespace mbid::records::internal {
@@ -82,11 +83,13 @@ std::vector<std::string> SplitFields(const std::string& line, char separator) {
 CellKind ClassifyCell(const std::string& cell, char separator, double* value) {
   if (value != nullptr) *value = std::numeric_limits<double>::quiet_NaN();
   if (cell.empty() || cell == "NaN" || cell == "nan" || cell == "NAN") return CellKind::kGap;
-  std::string number = cell;
-  if (separator != ',') std::replace(number.begin(), number.end(), ',', '.');
-  double parsed = 0;
-  if (mbid::internal::ParseDouble(number, &parsed) == mbid::internal::ParseStatus::kOk) {
-    if (value != nullptr) *value = parsed;
+  // A ','-separated file has a decimal point (an unquoted comma would split the cell).
+  const NumberReadings readings = ReadNumber(cell);
+  const std::optional<double> number = separator == ',' ? readings.point
+                                       : readings.comma ? readings.comma
+                                                        : readings.point;
+  if (number) {
+    if (value != nullptr) *value = *number;
     return CellKind::kNumber;
   }
   Timestamp timestamp;
@@ -133,9 +136,10 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
   return found;
 }
 
-std::string CsvDialect::Describe(bool decimal_comma) const {
+std::string CsvDialect::Describe(bool decimal_comma, bool thousands) const {
   std::string text = separator == '\t' ? "tab-separated" : fmt::format("'{}'-separated", separator);
   if (decimal_comma) text += ", decimal comma";
+  if (thousands) text += ", thousands separators";
   if (crlf) text += ", CRLF";
   if (bom) text += ", BOM";
   if (preamble_lines > 0) {

@@ -22,8 +22,10 @@ std::vector<std::string> SplitFields(const std::string& line, char separator);
 
 enum class CellKind { kNumber, kGap, kTimestamp, kText };
 
-// A data cell: a decimal number (with a decimal comma where the separator is not ','), a gap
-// (empty, NaN, nan), an ISO 8601 timestamp, or text. `value` is set for numbers (NaN for gaps).
+// A data cell: a decimal number (with a decimal comma where the separator is not ',', and
+// thousands separators: number_marks.h), a gap (empty, NaN, nan), an ISO 8601 timestamp, or
+// text. `value` is set for numbers (NaN for gaps): with a decimal comma when the cell reads so
+// (the reader decides a cell that reads both ways by the file's decimal mark).
 CellKind ClassifyCell(const std::string& cell, char separator, double* value = nullptr);
 
 struct CsvDialect {
@@ -34,8 +36,8 @@ struct CsvDialect {
   int units_row = -1;  // index into the lines, or -1
   int field_count = 0;
   int preamble_lines = 0;  // lines before the header other than comments and blank lines
-  // "';'-separated, decimal comma, CRLF, BOM, 3 preamble lines, units row"
-  std::string Describe(bool decimal_comma) const;
+  // "';'-separated, decimal comma, thousands separators, CRLF, BOM, 3 preamble lines, units row"
+  std::string Describe(bool decimal_comma, bool thousands = false) const;
 };
 
 // The header is the first line followed (after an optional units row: every cell empty or a

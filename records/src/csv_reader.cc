@@ -16,6 +16,7 @@
 #include "iso_time.h"
 #include "mbid/common/error.h"
 #include "mbid/common/utf8.h"
+#include "number_marks.h"
 #include "readers.h"
 
 namespace mbid::records::internal {
@@ -26,10 +27,10 @@ constexpr char kExpected[] =
 
 // The decimal place of a number's last printed digit, as a power of ten: "0.0123" -> -4,
 // "1.5e-3" -> -4, "12" -> 0 (as mbid's CSV reader counts it).
-int PrintedPlace(const std::string& text) {
+int PrintedPlace(const std::string& text, char decimal) {
   const size_t exponent_at = std::min(text.find_first_of("eE"), text.size());
   const int exponent = exponent_at < text.size() ? std::atoi(text.c_str() + exponent_at + 1) : 0;
-  const size_t point = text.find_first_of(".,");
+  const size_t point = text.find(decimal);
   const int decimals = point < exponent_at ? static_cast<int>(exponent_at - point - 1) : 0;
   return exponent - decimals;
 }
@@ -63,6 +64,66 @@ void ReadComment(const std::string& line, int number, char separator, Metadata* 
     metadata->units = SplitFields(*units, split);
     metadata->units_line = number;
   }
+}
+
+// Where a cell showed the file's decimal mark (a reading only that mark gives).
+struct MarkEvidence {
+  DecimalMark mark = DecimalMark::kUnknown;
+  std::string cell, where;
+};
+
+// The decimal mark of a file's data rows: a point in ','-separated files; otherwise the mark of
+// the first number that reads with only one of them ("0,5", "1,234.5", "1.234.567"). kUnknown
+// when no number shows it (then "1,234" is ambiguous and refused where it occurs).
+MarkEvidence FindDecimalMark(const std::vector<TextLine>& lines, int first_row, char separator) {
+  MarkEvidence evidence;
+  if (separator == ',') {
+    evidence.mark = DecimalMark::kPoint;
+    return evidence;
+  }
+  for (size_t i = static_cast<size_t>(first_row); i < lines.size(); ++i) {
+    if (IsCommentOrBlank(lines[i].text)) continue;
+    const std::vector<std::string> fields = SplitFields(lines[i].text, separator);
+    for (size_t c = 0; c < fields.size(); ++c) {
+      if (fields[c].find_first_of(".,") == std::string::npos) continue;
+      const DecimalMark mark = ReadNumber(fields[c]).Evidence();
+      if (mark == DecimalMark::kUnknown) continue;
+      evidence.mark = mark;
+      evidence.cell = fields[c];
+      evidence.where = fmt::format("line {}, column {}", lines[i].number, c + 1);
+      return evidence;
+    }
+  }
+  return evidence;
+}
+
+// A number cell's value with the file's decimal mark: refused (exit 2, naming the cell) when it
+// reads only with the other mark than a cell before showed, or both ways and no cell shows which.
+double ReadWithFileMark(const std::string& path, const std::string& where, const std::string& cell,
+                        const MarkEvidence& decimal, bool* thousands) {
+  const NumberReadings readings = ReadNumber(cell);
+  bool grouped = false;
+  const std::optional<double> value = readings.With(decimal.mark, &grouped);
+  if (value) {
+    *thousands = *thousands || grouped;
+    return *value;
+  }
+  if (decimal.mark == DecimalMark::kUnknown) {
+    throw InputError(
+        path, where,
+        fmt::format("'{}' reads as {} with a decimal comma and as {} with a thousands separator, "
+                    "and no number in the file shows which decimal mark it uses",
+                    cell, *readings.comma, *readings.point),
+        "numbers whose decimal mark is evident (a decimal part of other than 3 digits, as in "
+        "0,5 or 1.25, or both marks, as in 1.234,5), or no thousands separators");
+  }
+  const bool comma = decimal.mark == DecimalMark::kComma;
+  throw InputError(path, where,
+                   fmt::format("'{}' does not read with a decimal {}, which {} ('{}') shows", cell,
+                               comma ? "comma" : "point", decimal.where, decimal.cell),
+                   fmt::format("one decimal mark in the file: a decimal {} with '{}' or spaces "
+                               "as thousands separators",
+                               comma ? "comma" : "point", comma ? '.' : ','));
 }
 
 }  // namespace
@@ -125,12 +186,13 @@ RawTable ReadCsv(const std::string& path) {
   Metadata metadata;
   RawTable table;
   table.columns.resize(columns.size());
-  bool decimal_comma = false;
   bool timestamps = false;
   Timestamp first_timestamp;
   int time_place = std::numeric_limits<int>::max();
   int timestamp_decimals = 0;
   const int first_row = (dialect.units_row >= 0 ? dialect.units_row : dialect.header) + 1;
+  const MarkEvidence decimal = FindDecimalMark(lines, first_row, separator);
+  bool thousands = false;
   for (size_t i = 0; i < lines.size(); ++i) {
     const TextLine& line = lines[i];
     if (IsCommentOrBlank(line.text)) {
@@ -161,13 +223,14 @@ RawTable ReadCsv(const std::string& path) {
         timestamp_decimals = std::max(timestamp_decimals, timestamp.decimals);
         value = SecondsBetween(first_timestamp, timestamp);
       } else if (kind == CellKind::kNumber) {
+        value = ReadWithFileMark(path, where, fields[c], decimal, &thousands);
         if (!std::isfinite(value)) {
           throw InputError(path, where, "'" + fields[c] + "' is not finite",
                            "a finite number, or an empty cell or NaN for a gap");
         }
-        if (separator != ',' && fields[c].find(',') != std::string::npos) decimal_comma = true;
         if (static_cast<int>(c) == time_column) {
-          time_place = std::min(time_place, PrintedPlace(fields[c]));
+          time_place = std::min(
+              time_place, PrintedPlace(fields[c], decimal.mark == DecimalMark::kComma ? ',' : '.'));
         }
       } else if (kind != CellKind::kGap) {
         throw InputError(path, where, "'" + fields[c] + "' is not a number",
@@ -183,7 +246,7 @@ RawTable ReadCsv(const std::string& path) {
   table.si_by_contract = separator == ',' && dialect.units_row < 0 && !header_cells.empty() &&
                          header_cells.front() == "time";
   table.format = table.si_by_contract ? "mbid-csv" : "csv";
-  table.dialect = dialect.Describe(decimal_comma);
+  table.dialect = dialect.Describe(decimal.mark == DecimalMark::kComma, thousands);
   table.source = metadata.source;
   if (metadata.units_line > 0) {
     // "# units: s,rad,rad" may include the time column; "rad,rad" lists the channels.

@@ -111,41 +111,9 @@ namespace {
 thread_local FigureBatch* active_batch = nullptr;
 
 void WriteData(const Figure& figure, const std::string& path) {
-  // One data block per series, separated by two blank lines (gnuplot's "index").
   std::ofstream out(path);
-  for (const PlotSeries& series : figure.series) {
-    for (Eigen::Index i = 0; i < series.x.size(); ++i) {
-      out << fmt::format("{:.10g} {:.10g}\n", series.x[i], series.y[i]);
-    }
-    out << "\n\n";
-  }
+  out << GnuplotData(figure);
   CheckWritten(out, path);
-}
-
-// The commands of one figure; `reset` first, so that nothing of the figure before carries over.
-void WriteCommands(const Figure& figure, const std::string& data_path, const std::string& png_path,
-                   std::ostream& script) {
-  script << "reset\n";
-  script << fmt::format("set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n",
-                        figure.width_px, figure.height_px);
-  script << "set output " << Quote(png_path) << "\n";
-  script << "set title " << Quote(figure.title) << "\n";
-  script << "set xlabel " << Quote(figure.x_label) << "\n";
-  script << "set ylabel " << Quote(figure.y_label) << "\n";
-  script << "set grid\nset key " << figure.key << "\nset offsets 0, 0, graph 0.05, graph 0.05\n";
-  if (figure.log_y) script << "set logscale y\nset format y '%.0e'\n";
-  if (figure.log_x) script << "set logscale x\nset format x '%g'\n";
-  if (!figure.x_range.empty()) script << "set xrange " << figure.x_range << "\n";
-  if (!figure.y_range.empty()) script << "set yrange " << figure.y_range << "\n";
-  if (figure.pad_x) script << "set offsets graph 0.03, graph 0.03, graph 0.05, graph 0.05\n";
-  script << "plot ";
-  for (size_t k = 0; k < figure.series.size(); ++k) {
-    if (k > 0) script << ", \\\n     ";
-    script << Quote(data_path) << " index " << k << " using 1:2 with " << figure.series[k].style
-           << " title " << Quote(figure.series[k].title);
-  }
-  // Closing the output completes the file before the next figure opens its own.
-  script << "\nunset output\n";
 }
 
 std::string ReadLog(const std::string& path) {
@@ -172,7 +140,7 @@ void DrawAll(const std::vector<std::pair<Figure, std::string>>& figures) {
   {
     std::ofstream script(script_file.path());
     for (size_t i = 0; i < figures.size(); ++i) {
-      WriteCommands(figures[i].first, scratch[i]->path(), pngs[i]->temp_path(), script);
+      script << GnuplotCommands(figures[i].first, scratch[i]->path(), pngs[i]->temp_path());
     }
     CheckWritten(script, script_file.path());
   }
@@ -199,6 +167,62 @@ void DrawAll(const std::vector<std::pair<Figure, std::string>>& figures) {
 }
 
 }  // namespace
+
+std::string GnuplotData(const Figure& figure) {
+  // One data block per series, separated by two blank lines (gnuplot's "index").
+  std::string data;
+  for (const PlotSeries& series : figure.series) {
+    const bool with_error = series.y_error.size() == series.x.size() && series.x.size() > 0;
+    for (Eigen::Index i = 0; i < series.x.size(); ++i) {
+      data += with_error ? fmt::format("{:.10g} {:.10g} {:.10g}\n", series.x[i], series.y[i],
+                                       series.y_error[i])
+                         : fmt::format("{:.10g} {:.10g}\n", series.x[i], series.y[i]);
+    }
+    data += "\n\n";
+  }
+  return data;
+}
+
+// The commands of one figure; `reset` first, so that nothing of the figure before carries over.
+std::string GnuplotCommands(const Figure& figure, const std::string& data_path,
+                            const std::string& png_path) {
+  std::ostringstream script;
+  script << "reset\n";
+  script << fmt::format("set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n",
+                        figure.width_px, figure.height_px);
+  script << "set output " << Quote(png_path) << "\n";
+  script << "set title " << Quote(figure.title) << "\n";
+  script << "set xlabel " << Quote(figure.x_label) << "\n";
+  script << "set ylabel " << Quote(figure.y_label) << "\n";
+  script << "set grid\nset key " << figure.key << "\nset offsets 0, 0, graph 0.05, graph 0.05\n";
+  if (figure.log_y) script << "set logscale y\nset format y '%.0e'\n";
+  if (figure.log_x) script << "set logscale x\nset format x '%g'\n";
+  if (!figure.x_range.empty()) script << "set xrange " << figure.x_range << "\n";
+  if (!figure.y_range.empty()) script << "set yrange " << figure.y_range << "\n";
+  if (figure.pad_x) script << "set offsets graph 0.03, graph 0.03, graph 0.05, graph 0.05\n";
+  // A mark spans the plot whatever its y range: x in data coordinates, y in the graph's.
+  for (const VerticalMark& mark : figure.marks) {
+    script << fmt::format(
+        "set arrow from first {0:.10g}, graph 0 to first {0:.10g}, graph 1 nohead dt 2 lw 1.5 "
+        "lc rgb {1} front\n",
+        mark.x, Quote(mark.color));
+    script << fmt::format(
+        "set label {} at first {:.10g}, graph 0.96 left offset 0.6, 0 tc rgb {} "
+        "front\n",
+        Quote(mark.label), mark.x, Quote(mark.color));
+  }
+  script << "plot ";
+  for (size_t k = 0; k < figure.series.size(); ++k) {
+    const PlotSeries& series = figure.series[k];
+    const bool with_error = series.y_error.size() == series.x.size() && series.x.size() > 0;
+    if (k > 0) script << ", \\\n     ";
+    script << Quote(data_path) << " index " << k << (with_error ? " using 1:2:3" : " using 1:2")
+           << " with " << series.style << " title " << Quote(series.title);
+  }
+  // Closing the output completes the file before the next figure opens its own.
+  script << "\nunset output\n";
+  return script.str();
+}
 
 void DrawFigure(const Figure& figure, const std::string& png_path) {
   if (active_batch != nullptr) {

@@ -19,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct TestFigures {
-  std::vector<std::string> record, identification, updating;
+  std::vector<std::string> record, identification, backbone, updating;
 };
 
 TestFigures DrawTestFigures(const std::string& folder, const std::string& prefix,
@@ -29,12 +29,19 @@ TestFigures DrawTestFigures(const std::string& folder, const std::string& prefix
     if (!file.empty()) list.push_back(prefix + file);
   };
   const Measurement* exact = test.exact ? &*test.exact : nullptr;
-  for (int c = 0; c < test.measured.channel_count(); ++c) {
-    add(figures.record,
-        DrawRecordFigure(folder, test.measured, exact,
-                         test.simulation ? "exact model output (no sensor errors)"
-                                         : "noise-free record (before the noise was added)",
-                         c));
+  const std::string exact_label = test.simulation
+                                      ? "exact model output (no sensor errors)"
+                                      : "noise-free record (before the noise was added)";
+  if (test.recorded && test.release) {
+    // The whole record as read, the release where the test was cut marked on it.
+    const ReleaseMark release{test.release->release_time_s, test.release->how};
+    for (int c = 0; c < test.recorded->channel_count(); ++c) {
+      add(figures.record, DrawRecordFigure(folder, *test.recorded, nullptr, "", c, &release));
+    }
+  } else {
+    for (int c = 0; c < test.measured.channel_count(); ++c) {
+      add(figures.record, DrawRecordFigure(folder, test.measured, exact, exact_label, c));
+    }
   }
   add(figures.identification, DrawSpectrumFigure(folder, test.identified));
   for (int c = 0; c < static_cast<int>(test.identified.channels.size()); ++c) {
@@ -42,6 +49,9 @@ TestFigures DrawTestFigures(const std::string& folder, const std::string& prefix
         DrawReconstructionFigure(folder, test.measured, test.identified, c));
   }
   add(figures.identification, DrawStabilizationFigure(folder, test.identified));
+  for (const std::string& file : DrawBackboneFigures(folder, test.identified)) {
+    add(figures.backbone, file);
+  }
   const updating::TestFit& fit = test.tuned.tests.front();
   for (int c = 0; c < static_cast<int>(fit.channels.size()); ++c) {
     add(figures.updating, DrawResimulationFigure(folder, test.measured, fit, c));
@@ -103,13 +113,20 @@ int WriteRunReport(const std::string& folder, const Scenario& scenario,
       fs::create_directories(test_folder);
       figures = DrawTestFigures((test_folder / "").string(), prefix, test);
       figure_count += static_cast<int>(figures.record.size() + figures.identification.size() +
-                                       figures.updating.size());
+                                       figures.backbone.size() + figures.updating.size());
     }
     if (several) report << "## Test " << test.name << "\n\n";
     report << heading << " The test record\n\n";
     report << fmt::format("{}: {} samples at {} Hz on channels {}.\n\n", test.origin,
                           test.measured.samples(), 1.0 / test.measured.sample_interval_s,
                           fmt::join(test.measured.channels, ", "));
+    if (test.recorded && test.release) {
+      report << fmt::format(
+          "The free decay starts at {:.6g} s of the record ({}): the record is cut there and that "
+          "instant is t = 0 of the test{}.\n\n",
+          test.release->release_time_s, test.release->how,
+          draw ? " (the dashed line on the record figure)" : "");
+    }
     Embed(report, figures.record);
     std::string label;
     const std::vector<ReferenceMode> known = KnownModes(scenario, test, exact_modes, &label);
@@ -118,6 +135,12 @@ int WriteRunReport(const std::string& folder, const Scenario& scenario,
     report << ModalTableMarkdown(test.identified, known.empty() ? nullptr : &known, label) << "\n";
     for (const std::string& warning : test.identified.warnings) report << "> " << warning << "\n\n";
     Embed(report, figures.identification);
+    const std::string backbones = BackboneMarkdown(test.identified);
+    if (!backbones.empty()) {
+      report << heading << " Backbones: frequency and damping ratio against amplitude\n\n"
+             << backbones << "\n";
+      Embed(report, figures.backbone);
+    }
     report << heading << " Tuned joint parameters (the paper's Table 2)\n\n";
     report << "Start: " << test.start_note << ". "
            << TunedParametersMarkdown(test.tuned, model,

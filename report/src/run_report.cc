@@ -23,9 +23,8 @@ const char* kRecordStyle = "points pt 7 ps 0.35 lc rgb '#1f77b4'";
 
 }  // namespace
 
-std::string DrawRecordFigure(const std::string& folder, const Measurement& measured,
-                             const Measurement* exact, const std::string& exact_label,
-                             int channel) {
+Figure MakeRecordFigure(const Measurement& measured, const Measurement* exact,
+                        const std::string& exact_label, int channel, const ReleaseMark* release) {
   Figure figure;
   const std::string& name = measured.channels[channel];
   figure.title = fmt::format("Test record: {}", name);
@@ -37,8 +36,20 @@ std::string DrawRecordFigure(const std::string& folder, const Measurement& measu
     figure.series.push_back(
         {exact_label, t, exact->values.col(channel), "lines lw 1.5 lc rgb '#d62728'"});
   }
-  const std::string file = fmt::format("record_{}.png", name);
-  DrawFigure(figure, Path(folder, file));
+  if (release != nullptr) {
+    figure.marks.push_back(
+        {release->time_s,
+         fmt::format("release ({}) at {:.6g} s: t = 0 of the test", release->how, release->time_s),
+         "#2ca02c"});
+  }
+  return figure;
+}
+
+std::string DrawRecordFigure(const std::string& folder, const Measurement& measured,
+                             const Measurement* exact, const std::string& exact_label, int channel,
+                             const ReleaseMark* release) {
+  const std::string file = fmt::format("record_{}.png", measured.channels[channel]);
+  DrawFigure(MakeRecordFigure(measured, exact, exact_label, channel, release), Path(folder, file));
   return file;
 }
 
@@ -145,6 +156,90 @@ std::string DrawStabilizationFigure(const std::string& folder,
   if (figure.series.empty()) return "";
   DrawFigure(figure, Path(folder, "stabilization.png"));
   return "stabilization.png";
+}
+
+Figure MakeBackboneFigure(const identification::ModalResult& result, int k, bool damping) {
+  const identification::IdentifiedMode& mode = result.modes.at(static_cast<size_t>(k));
+  const identification::Backbone& backbone = mode.backbone.value();
+  // The amplitude is in the unit of the mode's largest channel (backbone.h).
+  Eigen::Index largest = 0;
+  if (mode.amplitude.size() > 0) mode.amplitude.maxCoeff(&largest);
+  const std::string unit = static_cast<size_t>(largest) < result.units.size()
+                               ? result.units[static_cast<size_t>(largest)]
+                               : std::string("rad");
+  Figure figure;
+  figure.title = fmt::format("Mode {} ({:.4g} Hz): {} against amplitude (backbone)", k + 1,
+                             mode.frequency_hz, damping ? "damping ratio" : "frequency");
+  figure.x_label = fmt::format("amplitude, {}", unit);
+  figure.y_label = damping ? "damping ratio, 1" : "frequency, Hz";
+  figure.pad_x = true;
+  figure.key = "top left box opaque";
+  const auto add = [&figure, damping](const identification::BackboneCurve& curve,
+                                      const std::string& title, const std::string& style) {
+    const auto vector = [](const std::vector<double>& v) {
+      return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()))
+          .eval();
+    };
+    PlotSeries series{title, vector(curve.amplitude),
+                      vector(damping ? curve.damping_ratio : curve.frequency_hz), style};
+    series.y_error = vector(damping ? curve.std_damping_ratio : curve.std_frequency_hz);
+    figure.series.push_back(series);
+  };
+  add(backbone, "sliding-window fits (8 periods), +- 1 std",
+      "yerrorbars pt 7 ps 0.7 lc rgb '#1f77b4'");
+  if (backbone.hilbert) {
+    add(*backbone.hilbert, "Hilbert transform (4 periods), +- 1 std",
+        "yerrorbars pt 6 ps 0.7 lc rgb '#d62728'");
+  }
+  return figure;
+}
+
+std::vector<std::string> DrawBackboneFigures(const std::string& folder,
+                                             const identification::ModalResult& result) {
+  std::vector<std::string> files;
+  for (size_t k = 0; k < result.modes.size(); ++k) {
+    if (!result.modes[k].backbone || result.modes[k].backbone->frequency_hz.empty()) continue;
+    for (const bool damping : {false, true}) {
+      const std::string file =
+          fmt::format("backbone_{}_{}.png", damping ? "damping" : "frequency", k + 1);
+      DrawFigure(MakeBackboneFigure(result, static_cast<int>(k), damping), Path(folder, file));
+      files.push_back(file);
+    }
+  }
+  return files;
+}
+
+std::string BackboneMarkdown(const identification::ModalResult& result) {
+  std::ostringstream out;
+  for (size_t k = 0; k < result.modes.size(); ++k) {
+    if (!result.modes[k].backbone) continue;
+    const identification::Backbone& b = *result.modes[k].backbone;
+    out << fmt::format("- Mode {} ({:.4g} Hz): ", k + 1, result.modes[k].frequency_hz);
+    if (b.frequency_hz.empty()) {
+      out << "too short for a backbone window.\n";
+      continue;
+    }
+    const auto [f_low, f_high] = std::minmax_element(b.frequency_hz.begin(), b.frequency_hz.end());
+    const auto [z_low, z_high] =
+        std::minmax_element(b.damping_ratio.begin(), b.damping_ratio.end());
+    const auto [a_low, a_high] = std::minmax_element(b.amplitude.begin(), b.amplitude.end());
+    out << fmt::format(
+        "{} window{} from amplitude {:.3g} to {:.3g}: frequency {:.4g} to {:.4g} Hz, damping "
+        "ratio {:.3g} to {:.3g}; {} (chi-square per degree of freedom {:.3g})",
+        b.frequency_hz.size(), b.frequency_hz.size() == 1 ? "" : "s", *a_high, *a_low, *f_low,
+        *f_high, *z_low, *z_high,
+        b.amplitude_dependent ? "**depends on amplitude**" : "no drift beyond the noise",
+        b.spread_chi_square_per_dof);
+    if (b.hilbert) {
+      const auto [h_low, h_high] =
+          std::minmax_element(b.hilbert->frequency_hz.begin(), b.hilbert->frequency_hz.end());
+      out << fmt::format("; Hilbert transform: {} window{}, frequency {:.4g} to {:.4g} Hz",
+                         b.hilbert->frequency_hz.size(),
+                         b.hilbert->frequency_hz.size() == 1 ? "" : "s", *h_low, *h_high);
+    }
+    out << ".\n";
+  }
+  return out.str();
 }
 
 std::string ModalTableMarkdown(const identification::ModalResult& result,

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -178,6 +179,42 @@ TEST_F(RunRecordsTest, FieldRecordIsCutAtTheReleaseAndItsOffsetsFitted) {
   EXPECT_EQ(summary["validation"]["verdict"], "passed") << summary["validation"].dump();
   const mbid::H5Reader run((out / "run.h5").string());
   EXPECT_TRUE(run.Exists("/tests/field/release/release_time_s"));
+  // The report says where the record was cut; its record figure (the whole record) marks it.
+  char release[64];
+  std::snprintf(release, sizeof release, "%.6g", test["release"]["release_time_s"].get<double>());
+  EXPECT_NE(
+      ReadText(out / "report.md")
+          .find(std::string("The free decay starts at ") + release + " s of the record (detected)"),
+      std::string::npos);
+}
+
+// identification.backbone: always in a run: every identified mode gets its backbone, and the
+// report lists them with their two figures (frequency and damping ratio against amplitude).
+TEST_F(RunRecordsTest, BackbonesOnRequestAreInTheReport) {
+  const fs::path base = WriteVariant(kScenarios + "reference-crane.yaml", "base.yaml",
+                                     "  duration_s: 8", "  duration_s: 5");
+  std::ofstream(base, std::ios::app) << "identification:\n  backbone: always\n";
+  const fs::path out = dir_ / "run";
+  const CommandResult result = Run("run " + base.string() + " -o " + out.string() + " --quiet");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));
+  const nlohmann::json& modes = summary["identification"]["modes"];
+  ASSERT_GE(modes.size(), 1u);
+  const std::string report = ReadText(out / "report.md");
+  EXPECT_NE(report.find("Backbones: frequency and damping ratio against amplitude"),
+            std::string::npos);
+  for (size_t k = 0; k < modes.size(); ++k) {
+    ASSERT_TRUE(modes[k].contains("backbone")) << k;
+    // A mode with windows has its line and its two figures, embedded in the report.
+    if (modes[k]["backbone"]["frequency_hz"].empty()) continue;
+    EXPECT_NE(report.find("- Mode " + std::to_string(k + 1) + " ("), std::string::npos) << k;
+    for (const char* kind : {"frequency", "damping"}) {
+      const std::string png =
+          "backbone_" + std::string(kind) + "_" + std::to_string(k + 1) + ".png";
+      EXPECT_TRUE(fs::exists(out / png)) << png;
+      EXPECT_NE(report.find("](" + png + ")"), std::string::npos) << png;
+    }
+  }
 }
 
 struct BadRecord {

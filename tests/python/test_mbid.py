@@ -92,6 +92,15 @@ class IdentifyTest(unittest.TestCase):
             prony.method = "fft"
         with self.assertRaises(mbid.InputError):
             prony.release = "later"
+        # The options of issue 13: backbones on request, drift removal (names round-trip).
+        self.assertEqual(options.backbone, "clusters")
+        options.backbone = "always"
+        self.assertEqual(options.backbone, "always")
+        with self.assertRaises(mbid.InputError):
+            options.backbone = "sometimes"
+        self.assertFalse(options.remove_drift)
+        options.remove_drift = True
+        self.assertTrue(options.remove_drift)
 
     def test_identify_of_a_record_equals_identify_of_its_arrays(self):
         record = mbid.simulate(mbid.load_scenario(REFERENCE))

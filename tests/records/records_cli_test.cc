@@ -64,6 +64,40 @@ TEST_F(RecordsCliTest, IdentifyRefusesAGapNamingLineAndColumnAndWritesNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "s.json"));
 }
 
+// --backbone always gives the logger's one linear mode its backbone (both estimators) and
+// --remove-drift reports the drift it removed; without them neither field is there.
+TEST_F(RecordsCliTest, BackboneAndDriftFlags) {
+  const fs::path data = WriteLogger("logger.csv");
+  const CommandResult plain = Run("identify " + data.string() + " --json -");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const nlohmann::json without = nlohmann::json::parse(plain.out);
+  ASSERT_GE(without["modes"].size(), 1u);
+  EXPECT_FALSE(without["modes"][0].contains("backbone"));
+  EXPECT_FALSE(without.contains("drift_per_s"));
+  const CommandResult flagged =
+      Run("identify " + data.string() + " --json - --backbone always --remove-drift");
+  ASSERT_EQ(flagged.exit_code, 0) << flagged.err;
+  const nlohmann::json with = nlohmann::json::parse(flagged.out);
+  ASSERT_GE(with["modes"].size(), 1u);
+  const nlohmann::json& backbone = with["modes"][0]["backbone"];
+  ASSERT_TRUE(backbone.contains("hilbert")) << backbone.dump();
+  // 8 s of a 1.5 Hz decay: sliding windows of 8 periods (5.3 s), at least one; the Hilbert
+  // transform's windows of 4 periods (2.7 s) every 2 periods between the 3 periods (2 s) left
+  // out at each end: 2.
+  EXPECT_GE(backbone["frequency_hz"].size(), 1u);
+  EXPECT_EQ(backbone["hilbert"]["frequency_hz"].size(), 2u);
+  for (const auto& f : backbone["hilbert"]["frequency_hz"]) {
+    // The damped frequency 1.5 sqrt(1 - 0.02^2) Hz; a linear mode, printed to 9 digits: 1e-3.
+    EXPECT_NEAR(f.get<double>(), 1.5 * std::sqrt(1 - 0.02 * 0.02), 1e-3);
+  }
+  // The logger has no drift: what is removed is within the noise of 9 printed digits.
+  ASSERT_TRUE(with.contains("drift_per_s"));
+  for (const auto& [channel, drift] : with["drift_per_s"].items()) {
+    EXPECT_LT(std::abs(drift.get<double>()), 1e-6) << channel;
+  }
+  ExpectOneErrorLine(Run("identify " + data.string() + " --backbone sometimes"), "--backbone");
+}
+
 TEST_F(RecordsCliTest, IdentifyFillsGapsAndReportsTheImport) {
   const fs::path data = WriteLogger("logger.csv", 100);
   const CommandResult result = Run("identify " + data.string() +

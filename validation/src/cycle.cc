@@ -54,9 +54,13 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
                       loaded.excitation_origin));
     }
     if (!source.synthetic) {
+      Measurement recorded = test.measured;
       test.release = CutRecordAtRelease(&test.measured, test.origin,
                                         OverrideRelease(source.release, overrides),
                                         test.excitation ? *test.excitation : excitation);
+      if (test.release->how == "detected" || test.release->how == "given") {
+        test.recorded = std::move(recorded);
+      }
       say(
           fmt::format("test {}: free decay from {:.6g} s of the record ({}); that is "
                       "t = 0 of the test",

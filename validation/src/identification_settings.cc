@@ -30,6 +30,8 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
                      "compute_uncertainty",
                      "extra_orders",
                      "min_correlation",
+                     "backbone",
+                     "remove_drift",
                      "prony"});
   const std::string method = section.Choice("method", identification::MethodNames(),
                                             identification::Method::kHankelNls.name());
@@ -59,6 +61,11 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
   options.compute_stabilization =
       section.Bool("compute_stabilization", options.compute_stabilization);
   options.compute_uncertainty = section.Bool("compute_uncertainty", options.compute_uncertainty);
+  options.remove_drift = section.Bool("remove_drift", options.remove_drift);
+  identification::ParseBackboneMode(
+      section.Choice("backbone", {"clusters", "always", "never"},
+                     identification::BackboneModeName(options.backbone)),
+      &options.backbone);
   if (section.Has("prony")) {
     const YamlReader prony = section.Child("prony");
     prony.ExpectMap({"order", "rank_tolerance", "noise_floor_factor"});

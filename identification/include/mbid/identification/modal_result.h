@@ -80,7 +80,10 @@ struct ModalResult {
   bool reliable = true;
   std::vector<std::string> reasons;
   double min_correlation = 0.9;
-  Eigen::VectorXd offset;          // per channel constant (0 unless fitted or removed)
+  Eigen::VectorXd offset;  // per channel constant (0 unless fitted or removed)
+  // Per channel: the linear drift removed (remove_drift), channel units per second; the record's
+  // baseline is then offset + drift (t - start_time_s). Empty when not asked.
+  Eigen::VectorXd drift_per_s;
   Eigen::VectorXd noise_std;       // per channel: residual standard deviation
   Eigen::MatrixXd reconstruction;  // samples x channels, offset included
   // eq. 5: [A1 ... Ap] of eq. 2 (m x m p) from the modes' poles and output vectors; empty if

@@ -121,6 +121,18 @@ enum class ReleaseMode {
   kNone,    // the record's start (the record is the free decay)
 };
 
+// Which modes carry a backbone, their frequency and damping ratio against amplitude (backbone.h).
+enum class BackboneMode {
+  kClusters,  // only a cluster of close poles that is one mode drifting with amplitude (default)
+  kAlways,    // every mode; clusters are merged as with kClusters
+  kNever,     // none: close poles stay separate modes (flagged as too close to separate)
+};
+
+// "clusters", "always" or "never", as the option `backbone` and the `--backbone` flag.
+std::string BackboneModeName(BackboneMode mode);
+// Parses a backbone mode's name; false (and `mode` unchanged) for any other word.
+bool ParseBackboneMode(const std::string& name, BackboneMode* mode);
+
 // Everything the identification of a free-decay record can be told. Defaults are meant for
 // records like the paper's (a few modes, damping ratio up to 0.8, 10-40 dB SNR).
 struct IdentificationOptions {
@@ -176,6 +188,13 @@ struct IdentificationOptions {
   // at most what the method can compute).
   int stabilization_max_order = 0;
   bool compute_uncertainty = true;
+  // Which modes get a backbone: sliding-window fits and the Hilbert transform's instantaneous
+  // frequency and damping against amplitude (backbone.h, hilbert_backbone.h).
+  BackboneMode backbone = BackboneMode::kClusters;
+  // Fit and subtract a linear drift per channel with the modes (drift_removal.h): for records
+  // whose sensors drift (a thermal drift, an integrating amplifier). The constant part stays with
+  // `offset`.
+  bool remove_drift = false;
 
   SpectrumOptions spectrum;
   PronySvdOptions prony;

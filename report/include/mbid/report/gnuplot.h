@@ -13,6 +13,16 @@ struct PlotSeries {
   Eigen::VectorXd x;
   Eigen::VectorXd y;
   std::string style = "lines";  // gnuplot "with" clause: "lines", "points pt 7 ps 0.6", ...
+  // Empty, or one standard deviation per point: the data get a third column and the series is
+  // plotted `using 1:2:3` (give a style such as "yerrorbars pt 7").
+  Eigen::VectorXd y_error = Eigen::VectorXd();
+};
+
+// A vertical line across the whole plot at x, labelled beside its top (an instant on a time axis).
+struct VerticalMark {
+  double x = 0;
+  std::string label;
+  std::string color = "#2ca02c";
 };
 
 // A 2-D figure drawn by gnuplot (Debian gnuplot-nox, pngcairo terminal). Axis labels carry the
@@ -22,6 +32,7 @@ struct Figure {
   std::string x_label;
   std::string y_label;
   std::vector<PlotSeries> series;
+  std::vector<VerticalMark> marks;
   bool log_y = false;
   bool log_x = false;
   bool pad_x = false;  // leave a margin at both ends of x (points on the edges stay visible)
@@ -56,6 +67,12 @@ class FigureBatch {
   FigureBatch* outer_;
   std::vector<std::pair<Figure, std::string>> figures_;
 };
+
+// What DrawFigure gives gnuplot: the data file (one block per series, separated by two blank
+// lines) and the commands that draw it from `data_path` into `png_path`.
+std::string GnuplotData(const Figure& figure);
+std::string GnuplotCommands(const Figure& figure, const std::string& data_path,
+                            const std::string& png_path);
 
 // True if a gnuplot with the pngcairo terminal is on PATH.
 bool GnuplotAvailable();

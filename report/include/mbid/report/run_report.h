@@ -9,20 +9,48 @@
 #include "mbid/identification/modal_result.h"
 #include "mbid/model/linear_model.h"
 #include "mbid/model/mechanical_model.h"
+#include "mbid/report/gnuplot.h"
 #include "mbid/updating/characteristic.h"
 #include "mbid/updating/output_error.h"
 
 namespace mbid::report {
 
+// The instant a recorded test's free decay starts, as the record figure marks it: in the
+// record's own time, and how it was found ("detected" or "given").
+struct ReleaseMark {
+  double time_s = 0;
+  std::string how;
+};
+
+// The record figure of one channel: the record (and `exact`, on the same samples, if given) with
+// a vertical line at the release when `release` is given, labelled with its time and how it was
+// found.
+Figure MakeRecordFigure(const Measurement& measured, const Measurement* exact,
+                        const std::string& exact_label, int channel, const ReleaseMark* release);
+
 // The figures of a run (gnuplot PNGs), each returned as its file name in `folder`.
 std::string DrawRecordFigure(const std::string& folder, const Measurement& measured,
-                             const Measurement* exact, const std::string& exact_label, int channel);
+                             const Measurement* exact, const std::string& exact_label, int channel,
+                             const ReleaseMark* release = nullptr);
 std::string DrawSpectrumFigure(const std::string& folder,
                                const identification::ModalResult& result);
 std::string DrawReconstructionFigure(const std::string& folder, const Measurement& measured,
                                      const identification::ModalResult& result, int channel);
 std::string DrawStabilizationFigure(const std::string& folder,
                                     const identification::ModalResult& result);
+
+// The backbone of `result`'s mode `k` (0-based; mode k + 1 of the tables) against its amplitude:
+// the frequency (`damping` false) or the damping ratio (true), each point with its standard
+// deviation as an error bar, the sliding-window fits and the Hilbert estimate as two series.
+// Requires the mode to have a backbone.
+Figure MakeBackboneFigure(const identification::ModalResult& result, int k, bool damping);
+// Both figures of every mode with a backbone: backbone_frequency_<k+1>.png and
+// backbone_damping_<k+1>.png.
+std::vector<std::string> DrawBackboneFigures(const std::string& folder,
+                                             const identification::ModalResult& result);
+// One line per mode with a backbone (windows, the range of frequency and damping ratio over the
+// amplitudes, whether they depend on it); empty when no mode has one.
+std::string BackboneMarkdown(const identification::ModalResult& result);
 
 // A mode the record is known to contain: the model's exact mode of a simulated test, or a mode
 // a synthetic record was made from (then with its amplitudes per channel).

@@ -31,6 +31,9 @@ struct RunTest {
   // The test's own excitation (record_source.h); unset: the scenario's.
   std::optional<simulation::Excitation> excitation;
   std::optional<AppliedRelease> release;  // where a recorded test was cut (release_cut.h)
+  // The record as read, before the cut at a detected or given release (the record figure marks
+  // the release on it); unset when the record was not cut.
+  std::optional<Measurement> recorded;
   std::optional<simulation::SimulationResult> simulation;  // a simulated test's integration
   identification::ModalResult identified;
   std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, if it ran
