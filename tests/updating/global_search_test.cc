@@ -232,6 +232,26 @@ TEST(CredibilityTest, ColouredResidualInflatesTheStandardDeviations) {
   EXPECT_TRUE(result.parameters[0].determined);  // 3% inflated, still below 30%
 }
 
+TEST(CredibilityTest, AnIntervalReachingABoundIsUndetermined) {
+  // 1% std: the interval is 1e7 */ exp(0.02) = [9.80e6, 1.02e7]. A lower bound at 9.9e6 lies
+  // inside it: the records allow the bound itself, so the estimate is the bound's, not theirs.
+  TestRecord test;
+  UpdateResult result = FitWithResidual(Ar1Noise(4000, 0.0, 1.0, 11), &test);
+  result.parameters[0].lower = 9.9e6;
+  result.parameters[0].upper = 1e9;
+  AssessCredibility(result, {test}, UpdateOptions());
+  EXPECT_FALSE(result.parameters[0].determined);
+  EXPECT_NE(result.parameters[0].why_undetermined.find("reaches the lower bound"),
+            std::string::npos)
+      << result.parameters[0].why_undetermined;
+  // The same fit with bounds outside the interval stays determined.
+  result = FitWithResidual(Ar1Noise(4000, 0.0, 1.0, 11), &test);
+  result.parameters[0].lower = 9e6;
+  result.parameters[0].upper = 1.1e7;
+  AssessCredibility(result, {test}, UpdateOptions());
+  EXPECT_TRUE(result.parameters[0].determined);
+}
+
 TEST(CredibilityTest, ResidualFarAboveTheNoiseDeterminesNothing) {
   // A residual 3 times the records' noise (chi^2/dof 9 > 4): a local minimum or a missing
   // piece of the model; even a 1% std means nothing there.

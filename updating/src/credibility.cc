@@ -119,6 +119,15 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
       p.why_undetermined = fmt::format("relative std {:.3g}{} above {}", relative,
                                        result.std_inflation > 1 ? " (inflated)" : "",
                                        options.undetermined_relative_std);
+    } else if (p.lower < p.upper && (p.interval_lower <= p.lower || p.interval_upper >= p.upper)) {
+      // The records allow values up to the bound (and maybe beyond): the bound, not the data,
+      // decides where the estimate ends.
+      const bool low = p.interval_lower <= p.lower;
+      p.determined = false;
+      p.why_undetermined = fmt::format(
+          "its interval [{:.4g}, {:.4g}] reaches the {} bound {:.4g}: the records do not bound "
+          "it within the allowed range",
+          p.interval_lower, p.interval_upper, low ? "lower" : "upper", low ? p.lower : p.upper);
     } else if (!p.determined && p.why_undetermined.empty()) {
       p.why_undetermined = "marked by the caller";
     }

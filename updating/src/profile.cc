@@ -218,10 +218,15 @@ class Profiler {
   double threshold_ = 4;
 };
 
-// An earlier reason stays unless `overrides` (a better minimum explains more than any other).
+// An earlier reason is kept, the profile's added to it, unless `overrides` (a better minimum
+// explains more than any other).
 void MarkUndetermined(ParameterEstimate& p, const std::string& why, UpdateResult& result,
                       bool overrides = false) {
-  if (p.determined || p.why_undetermined.empty() || overrides) p.why_undetermined = why;
+  if (p.determined || p.why_undetermined.empty() || overrides) {
+    p.why_undetermined = why;
+  } else {
+    p.why_undetermined += "; " + why;
+  }
   p.determined = false;
   if (std::find(result.undetermined.begin(), result.undetermined.end(), p.name) ==
       result.undetermined.end()) {
