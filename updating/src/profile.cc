@@ -179,7 +179,7 @@ class Profiler {
         // Through the origin in sqrt(rise), exact for a quadratic cost: takes the end from
         // within the tolerance to the cost's own curvature there.
         side.open = false;
-        side.end = s * target / root;
+        side.end = std::min(s * target / root, side.reach);
         return;
       }
       if (root > target) {
