@@ -390,11 +390,11 @@ std::vector<std::string> DescribeProfiles(const UpdateResult& result) {
   for (const ParameterEstimate& p : result.parameters) {
     const ParameterProfile& profile = p.profile;
     if (!profile.computed) continue;
-    std::string line =
-        fmt::format("{}: profile {}{}, {}{} {} (Fisher [{}, {}]), {} fits", p.name,
-                    profile.lower_open ? "(" : "[", FormatValue(profile.lower),
-                    FormatValue(profile.upper), profile.upper_open ? ")" : "]", p.units,
-                    FormatValue(p.interval_lower), FormatValue(p.interval_upper), profile.fits);
+    // 6 digits: a well-determined parameter's interval is narrower than 4 show.
+    std::string line = fmt::format(
+        "{}: profile {}{:.6g}, {:.6g}{} {} (Fisher [{:.6g}, {:.6g}]), {} fits", p.name,
+        profile.lower_open ? "(" : "[", profile.lower, profile.upper,
+        profile.upper_open ? ")" : "]", p.units, p.interval_lower, p.interval_upper, profile.fits);
     if (profile.lower_open && profile.upper_open) {
       line += "; open on both sides";
     } else if (profile.lower_open || profile.upper_open) {
