@@ -64,6 +64,33 @@ TEST(FacadeTest, BadInputIsAnInputErrorWithOneLine) {
   EXPECT_THROW(mbid::Identify(bad), mbid::InputError);
 }
 
+// The identification: and updating: sections are read and checked when the scenario loads, like
+// every other section: a typo there fails every command, naming the file and the key.
+TEST(FacadeTest, ATypoInTheUpdatingOrIdentificationSectionFailsAtLoad) {
+  std::ifstream in(kReference);
+  std::stringstream text;
+  text << in.rdbuf();
+  for (const auto& [section, key] :
+       {std::pair<std::string, std::string>{"updating: {paramters: [c_alpha]}\n", "paramters"},
+        {"identification: {methd: prony-svd}\n", "methd"}}) {
+    const fs::path path = fs::temp_directory_path() / "mbid_facade_typo.yaml";
+    std::ofstream(path) << text.str() << section;
+    try {
+      mbid::LoadScenario(path.string());
+      ADD_FAILURE() << "no error for " << section;
+    } catch (const mbid::InputError& error) {
+      const std::string message = error.what();
+      EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+      EXPECT_NE(message.find(key), std::string::npos) << message;
+    }
+    fs::remove(path);
+  }
+  // Read at load, the same as reading the section again for the scenario's model.
+  const mbid::Scenario scenario = mbid::LoadScenario(kReference);
+  EXPECT_EQ(scenario.updating.options.parameters.size(),
+            scenario.ReadUpdating(*scenario.MakeModel()).options.parameters.size());
+}
+
 // Two load drops of the reference crane, 650 and 1300 kg, each tuned with its own payload:
 // the fit explains both to the noise (chi^2/dof near 1) and c_alpha stays within 4 of its
 // standard deviations of the truth the records were simulated with. Told the scenario's 650 kg

@@ -33,8 +33,7 @@ std::unique_ptr<model::MechanicalModel> Scenario::MakeAlternativeModel(size_t in
 }
 
 identification::IdentificationOptions Scenario::ReadIdentification() const {
-  return root.Has("identification") ? ReadIdentificationSettings(root.Child("identification"))
-                                    : identification::IdentificationOptions();
+  return identification;
 }
 
 updating::UpdatingSettings Scenario::ReadUpdating(const model::MechanicalModel& model) const {
@@ -61,8 +60,9 @@ constexpr double kMaxSamples = 1e8;
 }  // namespace
 
 Scenario LoadScenarioFromText(const std::string& text, const std::string& source) {
-  Scenario scenario{source, "",   text, YamlReader::FromString(text, source), false, {}, {}, {},
-                    {},     0.95, {}};
+  Scenario scenario{
+      source, "", text, YamlReader::FromString(text, source), false, {}, {}, {}, {}, 0.95,
+      {},     {}, {}};
   if (!scenario.root.IsMap()) scenario.root.Fail("not a mapping", "a YAML mapping of sections");
   scenario.root.ExpectMap({"name", "model", "excitation", "simulation", "sensors", "record",
                            "identification", "updating", "validation", "structure"});
@@ -115,6 +115,11 @@ Scenario LoadScenarioFromText(const std::string& text, const std::string& source
       scenario.MakeAlternativeModel(i);
     }
   }
+  if (scenario.root.Has("identification")) {
+    scenario.identification = ReadIdentificationSettings(scenario.root.Child("identification"));
+  }
+  // After `simulation`: the fits integrate with its integrator unless the section says otherwise.
+  scenario.updating = scenario.ReadUpdating(*model);
   if (scenario.root.Has("record")) {
     const std::filesystem::path folder = std::filesystem::path(source).parent_path();
     scenario.records = ReadRecordSources(scenario.root.Child("record"),

@@ -35,15 +35,21 @@ struct Scenario {
   // `mbid structure` to rank beside the model's own rigid variants; paths resolved against the
   // scenario's folder, each a YAML file with a `model:` section (a scenario file will do).
   std::vector<std::string> structure_alternatives;
+  // `identification:` and `updating:` (for the scenario's own model), read and checked at load
+  // like every other section: a typo there is an error of every command, not only of the one
+  // that needs it.
+  identification::IdentificationOptions identification;
+  updating::UpdatingSettings updating;
 
   // A fresh model instance (one per worker).
   std::unique_ptr<model::MechanicalModel> MakeModel() const;
   // The model of structure_alternatives[index], checked as the scenario's own.
   std::unique_ptr<model::MechanicalModel> MakeAlternativeModel(size_t index) const;
-  // The `identification:` section, or the identifier's defaults.
+  // The `identification:` section, or the identifier's defaults (a copy of `identification`).
   identification::IdentificationOptions ReadIdentification() const;
-  // The `updating:` section for `model`, or the defaults; the fits integrate with the
-  // scenario's integrator unless the section says otherwise.
+  // The `updating:` section for `model` (another description's, or a fresh instance of the
+  // scenario's), or the defaults; the fits integrate with the scenario's integrator unless the
+  // section says otherwise.
   updating::UpdatingSettings ReadUpdating(const model::MechanicalModel& model) const;
   // The excitation; an InputError if the scenario has none.
   const simulation::Excitation& RequireExcitation() const;
