@@ -10,8 +10,29 @@
 #include <thread>
 
 #include "mbid/common/error.h"
+#include "plan_internal.h"
 
 namespace mbid::updating {
+
+namespace internal {
+
+std::unique_ptr<model::MechanicalModel> MakeCandidateModel(
+    const model::MechanicalModel& model, const PlanCandidate& candidate,
+    const std::vector<std::pair<std::string, double>>& values) {
+  std::unique_ptr<model::MechanicalModel> copy =
+      candidate.model ? candidate.model->Clone() : model.Clone();
+  for (const auto& [name, value] : values) {
+    try {
+      copy->SetParameter(name, value);
+    } catch (const InputError& e) {
+      throw InputError(candidate.name, "model", e.what(),
+                       "a model with the tuned parameters of the scenario's");
+    }
+  }
+  return copy;
+}
+
+}  // namespace internal
 
 double CalcLogDetWithRidge(const Eigen::MatrixXd& fisher, double ridge, double* added) {
   const Eigen::Index n = fisher.rows();
@@ -94,16 +115,14 @@ TestPlan PlanNextTest(const model::MechanicalModel& model, const std::vector<Tes
     models.push_back(model.Clone());
     jobs.push_back({models.back().get(), &test, {}, nullptr});
   }
+  std::vector<std::pair<std::string, double>> values;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    values.emplace_back(plan.parameters[static_cast<size_t>(k)], plan.values[k]);
+  }
   for (const PlanCandidate& candidate : candidates) {
-    models.push_back(candidate.model ? candidate.model->Clone() : model.Clone());
-    for (Eigen::Index k = 0; k < n && candidate.model; ++k) {
-      try {
-        models.back()->SetParameter(plan.parameters[static_cast<size_t>(k)], plan.values[k]);
-      } catch (const InputError& e) {
-        throw InputError(candidate.name, "model", e.what(),
-                         "a model with the tuned parameters of the scenario's");
-      }
-    }
+    // The plan's own model already carries the values.
+    models.push_back(candidate.model ? internal::MakeCandidateModel(model, candidate, values)
+                                     : model.Clone());
     jobs.push_back({models.back().get(), &candidate.test, {}, nullptr});
   }
   RunJobs(jobs, plan.parameters, options);

@@ -9,31 +9,16 @@
 #include "mbid/common/error.h"
 #include "mbid/simulation/simulate.h"
 #include "mbid/updating/global_search.h"
+#include "plan_internal.h"
 
 namespace mbid::updating {
 namespace {
 
-// The candidate's model (its own, or the plan's) with the tuned parameters at `values`.
-std::unique_ptr<model::MechanicalModel> ModelAt(const model::MechanicalModel& model,
-                                                const PlanCandidate& candidate,
-                                                const std::map<std::string, double>& values) {
-  std::unique_ptr<model::MechanicalModel> copy =
-      candidate.model ? candidate.model->Clone() : model.Clone();
-  for (const auto& [name, value] : values) {
-    try {
-      copy->SetParameter(name, value);
-    } catch (const InputError& e) {
-      throw InputError(candidate.name, "model", e.what(),
-                       "a model with the tuned parameters of the scenario's");
-    }
-  }
-  return copy;
-}
-
 // The candidate's noise-free outputs at `values`, each channel divided by its noise.
 Eigen::MatrixXd WeightedOutputs(const model::MechanicalModel& model, const PlanCandidate& candidate,
                                 const std::map<std::string, double>& values) {
-  const std::unique_ptr<model::MechanicalModel> at = ModelAt(model, candidate, values);
+  const std::unique_ptr<model::MechanicalModel> at =
+      internal::MakeCandidateModel(model, candidate, {values.begin(), values.end()});
   const TestDesign& test = candidate.test;
   const simulation::SimulationResult run =
       simulation::Simulate(*at, test.excitation, test.simulation, test.sensors);
