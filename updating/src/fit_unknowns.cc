@@ -125,4 +125,13 @@ void StartNuisanceAt(const UpdateResult& result, std::vector<TestRecord>& tests)
   }
 }
 
+void WeighAs(const UpdateResult& result, std::vector<TestRecord>& tests) {
+  for (size_t t = 0; t < tests.size() && t < result.tests.size(); ++t) {
+    const TestFit& fit = result.tests[t];
+    for (size_t c = 0; c < fit.channels.size(); ++c) {
+      tests[t].noise_std.emplace(fit.channels[c], fit.noise_std[static_cast<Eigen::Index>(c)]);
+    }
+  }
+}
+
 }  // namespace mbid::updating::internal

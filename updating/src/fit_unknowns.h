@@ -41,4 +41,8 @@ std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,
 // estimates in `result`: a later fit on the same tests starts where this one ended.
 void StartNuisanceAt(const UpdateResult& result, std::vector<TestRecord>& tests);
 
+// Gives every channel of `tests` without a noise level the weight `result` used for it, so that
+// later fits' costs are in the same units as `result`'s.
+void WeighAs(const UpdateResult& result, std::vector<TestRecord>& tests);
+
 }  // namespace mbid::updating::internal

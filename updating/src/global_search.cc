@@ -11,6 +11,7 @@
 #include <set>
 #include <thread>
 
+#include "fit_unknowns.h"
 #include "global_search_internal.h"
 #include "mbid/common/error.h"
 #include "output_error_fit.h"
@@ -138,13 +139,7 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
                   all_given ? "" : " to estimate the noise"));
   full.push_back(fit_full(primary_label, {}, primary));
   if (!all_given) {
-    const UpdateResult& first = full.front().fit;
-    for (size_t t = 0; t < weighted.size() && t < first.tests.size(); ++t) {
-      const TestFit& fit = first.tests[t];
-      for (size_t c = 0; c < fit.channels.size(); ++c) {
-        weighted[t].noise_std.emplace(fit.channels[c], fit.noise_std[static_cast<Eigen::Index>(c)]);
-      }
-    }
+    internal::WeighAs(full.front().fit, weighted);
     if (full.front().failed) {
       // The search cannot weigh its fits; the primary fit's failure is the answer.
       result.best = full.front().fit;

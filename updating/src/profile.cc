@@ -49,12 +49,7 @@ class Profiler {
       : model_(model), options_(options), profile_(profile), best_(best) {
     settings_ = ResolveParameterSettings(model, options);
     weighted_ = tests;
-    for (size_t t = 0; t < weighted_.size() && t < best.tests.size(); ++t) {
-      const TestFit& fit = best.tests[t];
-      for (size_t c = 0; c < fit.channels.size(); ++c) {
-        weighted_[t].noise_std[fit.channels[c]] = fit.noise_std[static_cast<Eigen::Index>(c)];
-      }
-    }
+    internal::WeighAs(best, weighted_);
     threshold_ = profile.sigmas * profile.sigmas * best.std_inflation * best.std_inflation;
   }
 
@@ -152,6 +147,9 @@ class Profiler {
     // The bracket in sqrt(rise), which is linear in s where the cost is quadratic.
     double below_s = 0, below_root = 0;
     double above_s = -1, above_root = 0;
+    const auto bracketed_end = [&] {
+      return below_s + (above_s - below_s) * (target - below_root) / (above_root - below_root);
+    };
     UpdateResult start;  // the values only: the held one's last, the others' fitted there
     start.parameters = best_.parameters;
     side.open = true;
@@ -197,12 +195,12 @@ class Profiler {
         const double grow = std::clamp(target / std::max(root, 1e-3 * target), 1.25, 4.0);
         s = std::min(side.reach, s * grow);
       } else {
-        s = below_s + (above_s - below_s) * (target - below_root) / (above_root - below_root);
+        s = bracketed_end();
       }
     }
     if (above_s >= 0) {
       side.open = false;
-      side.end = below_s + (above_s - below_s) * (target - below_root) / (above_root - below_root);
+      side.end = bracketed_end();
     } else {
       side.end = below_s;  // the search stopped below the threshold: open as far as it went
     }
