@@ -97,7 +97,7 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
                    const std::string& candidates_path, const CommonOptions& common) {
   const Scenario scenario = LoadScenario(scenario_path);
   const auto model = scenario.MakeModel();
-  updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
+  updating::UpdatingSettings settings = scenario.updating;
   settings.options.quiet = common.quiet;
   // The candidates are checked before any long work starts.
   CandidateFile file = ReadCandidateFile(candidates_path, scenario, *model);

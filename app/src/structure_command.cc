@@ -90,7 +90,7 @@ int RunStructureCommand(const std::string& scenario_path,
     file.emplace(output_path);
   }
 
-  const updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
+  const updating::UpdatingSettings& settings = scenario.updating;
   const identification::IdentificationOptions identification_options =
       scenario.ReadIdentification();
   const std::vector<LoadedTest> tests =
@@ -147,7 +147,7 @@ int RunStructureCommand(const std::string& scenario_path,
 
   updating::StructureOptions options;
   options.threads = threads;
-  options.search = scenario.ReadUpdating(*model).global_search;
+  options.search = scenario.updating.global_search;
   options.quiet = common.quiet;
   const updating::StructureRanking ranking = updating::RankStructures(candidates, records, options);
 

@@ -92,7 +92,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
                      const std::string& output_path, const CommonOptions& common) {
   const Scenario scenario = LoadScenario(scenario_path);
   const auto model = scenario.MakeModel();
-  updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
+  updating::UpdatingSettings settings = scenario.updating;
   settings.options.quiet = common.quiet;
   if (common.profile) settings.profile.enabled = true;
   const identification::IdentificationOptions identification_options =

@@ -23,7 +23,7 @@ using validation::WeighByIdentifiedNoise;
 void RunUpdateStep(const StepInput& input, CaseOutcome& outcome) {
   const Scenario& scenario = *input.scenario;
   const model::MechanicalModel& model = *input.model;
-  updating::UpdatingSettings settings = scenario.ReadUpdating(model);
+  updating::UpdatingSettings settings = scenario.updating;
   settings.options.quiet = true;  // the campaign reports progress, not each fit
 
   std::string start;

@@ -110,7 +110,7 @@ UpdateResult Update(const Scenario& scenario, const std::vector<Measurement>& re
   }
   const std::unique_ptr<model::MechanicalModel> model = scenario.MakeModel();
   const identification::IdentificationOptions identification = scenario.ReadIdentification();
-  updating::UpdatingSettings settings = scenario.ReadUpdating(*model);
+  updating::UpdatingSettings settings = scenario.updating;
   settings.options.quiet = true;
   std::vector<validation::LoadedTest> tests;
   for (size_t i = 0; i < records.size(); ++i) {

@@ -124,7 +124,7 @@ CycleResult RunCycle(const Scenario& scenario, const CycleOptions& options) {
 
   RunSettings settings;
   settings.identification = scenario.ReadIdentification();
-  settings.updating = scenario.ReadUpdating(*model);
+  settings.updating = scenario.updating;
   if (options.profile) settings.updating.profile.enabled = true;
   settings.updating.options.quiet = options.quiet;
   settings.min_correlation = scenario.validation_min_correlation;

@@ -35,9 +35,10 @@ struct Scenario {
   // `mbid structure` to rank beside the model's own rigid variants; paths resolved against the
   // scenario's folder, each a YAML file with a `model:` section (a scenario file will do).
   std::vector<std::string> structure_alternatives;
-  // `identification:` and `updating:` (for the scenario's own model), read and checked at load
+  // `identification:` and `updating:` (for the scenario's own model, the fits integrating with
+  // `simulation`'s integrator as loaded unless the section names one), read and checked at load
   // like every other section: a typo there is an error of every command, not only of the one
-  // that needs it.
+  // that needs it. Commands on the scenario's own model use these.
   identification::IdentificationOptions identification;
   updating::UpdatingSettings updating;
 
