@@ -30,6 +30,17 @@ mbid::Measurement TwoModes() {
   return m;
 }
 
+// scenarios/reference-crane.yaml as text, its 8 s test shortened to `duration_s`, `extra` appended
+// (another section).
+std::string ReferenceText(int duration_s, const std::string& extra = "") {
+  std::ifstream in(kReference);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("duration_s: 8"), 13, "duration_s: " + std::to_string(duration_s));
+  return yaml + extra;
+}
+
 TEST(FacadeTest, IdentifyRecoversClosedFormModes) {
   const mbid::ModalResult result = mbid::Identify(TwoModes());
   ASSERT_EQ(result.modes.size(), 2u);
@@ -67,23 +78,17 @@ TEST(FacadeTest, BadInputIsAnInputErrorWithOneLine) {
 // The identification: and updating: sections are read and checked when the scenario loads, like
 // every other section: a typo there fails every command, naming the file and the key.
 TEST(FacadeTest, ATypoInTheUpdatingOrIdentificationSectionFailsAtLoad) {
-  std::ifstream in(kReference);
-  std::stringstream text;
-  text << in.rdbuf();
   for (const auto& [section, key] :
        {std::pair<std::string, std::string>{"updating: {paramters: [c_alpha]}\n", "paramters"},
         {"identification: {methd: prony-svd}\n", "methd"}}) {
-    const fs::path path = fs::temp_directory_path() / "mbid_facade_typo.yaml";
-    std::ofstream(path) << text.str() << section;
     try {
-      mbid::LoadScenario(path.string());
+      mbid::LoadScenarioFromText(ReferenceText(8, section), "typo.yaml");
       ADD_FAILURE() << "no error for " << section;
     } catch (const mbid::InputError& error) {
       const std::string message = error.what();
-      EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+      EXPECT_NE(message.find("typo.yaml"), std::string::npos) << message;
       EXPECT_NE(message.find(key), std::string::npos) << message;
     }
-    fs::remove(path);
   }
   // Read at load, the same as reading the section again for the scenario's model.
   const mbid::Scenario scenario = mbid::LoadScenario(kReference);
@@ -120,14 +125,8 @@ TEST(FacadeTest, UpdateTunesEachRecordWithItsOwnExcitation) {
 // updating.profile.enabled reaches UpdateResult::parameters: on the reference record (4 s) every
 // joint's profile interval is closed and brackets its estimate; without it, NaN.
 TEST(FacadeTest, UpdateCarriesTheProfileIntervalsTheScenarioAsksFor) {
-  std::ifstream in(kReference);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  yaml.replace(yaml.find("duration_s: 8"), 13, "duration_s: 4");
-  const fs::path path = fs::temp_directory_path() / "mbid_facade_profile.yaml";
-  std::ofstream(path) << yaml << "updating: {profile: {enabled: true}}\n";
-  const mbid::Scenario scenario = mbid::LoadScenario(path.string());
+  const mbid::Scenario scenario = mbid::LoadScenarioFromText(
+      ReferenceText(4, "updating: {profile: {enabled: true}}\n"), "profile.yaml");
   const std::vector<mbid::Measurement> records{mbid::Simulate(scenario)};
   const mbid::UpdateResult result = mbid::Update(scenario, records);
   ASSERT_EQ(result.parameters.size(), 8u);
@@ -137,7 +136,6 @@ TEST(FacadeTest, UpdateCarriesTheProfileIntervalsTheScenarioAsksFor) {
     EXPECT_GT(p.profile_upper, p.value);
     EXPECT_FALSE(p.profile_lower_open || p.profile_upper_open);
   }
-  fs::remove(path);
   const mbid::UpdateResult plain = mbid::Update(mbid::LoadScenario(kReference), records);
   EXPECT_TRUE(std::isnan(plain.parameters.at("c_alpha").profile_lower));
 }
@@ -146,16 +144,9 @@ TEST(FacadeTest, UpdateCarriesTheProfileIntervalsTheScenarioAsksFor) {
 // d_eta of +-0.45% around the truth lie inside its 1-sigma range on the 4 s record (relative
 // std ~1-2%), so the cost cannot rise to the 2-sigma threshold before either bound.
 TEST(FacadeTest, AnOpenProfileMakesTheVerdictInconclusive) {
-  std::ifstream in(kReference);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  yaml.replace(yaml.find("duration_s: 8"), 13, "duration_s: 4");
-  const fs::path path = fs::temp_directory_path() / "mbid_facade_open_profile.yaml";
-  std::ofstream(path) << yaml
-                      << "updating: {profile: {enabled: true}, bounds: {d_eta: [43800, 44200]}}\n";
-  const mbid::ValidationResult result = mbid::RunValidationCycle(mbid::LoadScenario(path.string()));
-  fs::remove(path);
+  const mbid::ValidationResult result = mbid::RunValidationCycle(mbid::LoadScenarioFromText(
+      ReferenceText(4, "updating: {profile: {enabled: true}, bounds: {d_eta: [43800, 44200]}}\n"),
+      "open-profile.yaml"));
   EXPECT_EQ(result.verdict, mbid::Verdict::kInconclusive);
   const mbid::ParameterValue& d_eta = result.updated.parameters.at("d_eta");
   EXPECT_TRUE(d_eta.profile_lower_open && d_eta.profile_upper_open);
