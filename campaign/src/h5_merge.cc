@@ -31,6 +31,9 @@ class Id {
   herr_t (*close_)(hid_t);
 };
 
+// Conversion-buffer bytes per value: at most a 16-byte variable-length descriptor either side.
+constexpr size_t kBytesPerValue = 64;
+
 void Check(herr_t status, const std::string& what) {
   if (status < 0) throw std::runtime_error("HDF5: " + what + " failed");
 }
@@ -106,10 +109,15 @@ void CopyDataset(hid_t source, hid_t target, const std::string& name, const std:
                 H5Dclose, "creating " + where);
   Buffer buffer(type.get(), space.get(), where);
   if (buffer.points() > 0) {
-    Check(H5Dread(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()),
+    // Conversion buffers the size of the data: HDF5's default of 1 MiB is allocated and, for
+    // strings, zeroed at every read and write (most of a merge's instructions).
+    const Id transfer(H5Pcreate(H5P_DATASET_XFER), H5Pclose, "transfer properties");
+    Check(H5Pset_buffer(transfer.get(), (buffer.points() + 1) * kBytesPerValue, nullptr, nullptr),
+          "transfer properties");
+    Check(H5Dread(dataset.get(), type.get(), H5S_ALL, H5S_ALL, transfer.get(), buffer.data()),
           "reading " + where);
     buffer.MarkFilled();
-    Check(H5Dwrite(copy.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()),
+    Check(H5Dwrite(copy.get(), type.get(), H5S_ALL, H5S_ALL, transfer.get(), buffer.data()),
           "writing " + where);
   }
   CopyAttributes(dataset.get(), copy.get(), {}, where);

@@ -19,6 +19,16 @@ void Check(herr_t status, const char* what) {
   if (status < 0) throw H5::Exception(what, "failed");
 }
 
+H5::DSetMemXferPropList SizedTransfer(hsize_t elements) {
+  // 64 bytes per value covers every type read or written here (at most a 16-byte
+  // variable-length descriptor on either side).
+  constexpr size_t kBytesPerValue = 64;
+  H5::DSetMemXferPropList transfer;
+  transfer.setBuffer(static_cast<size_t>(std::max<hsize_t>(elements, 1)) * kBytesPerValue, nullptr,
+                     nullptr);
+  return transfer;
+}
+
 std::string Describe(const H5::Exception& e) {
   std::string innermost;
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, CollectInnermost, &innermost);

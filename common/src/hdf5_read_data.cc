@@ -77,8 +77,9 @@ std::vector<std::string> ReadStringData(hid_t id, bool is_attribute) {
   const hsize_t n = CountElements(space.get(), kMaxStrings, &dims);
   std::vector<std::string> out;
   const auto read = [&](hid_t memory_type, void* buffer) {
-    Check(is_attribute ? H5Aread(id, memory_type, buffer)
-                       : H5Dread(id, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer),
+    Check(is_attribute
+              ? H5Aread(id, memory_type, buffer)
+              : H5Dread(id, memory_type, H5S_ALL, H5S_ALL, SizedTransfer(n).getId(), buffer),
           "H5Xread");
   };
   const htri_t variable = H5Tis_variable_str(file_type.get());
