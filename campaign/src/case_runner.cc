@@ -144,8 +144,8 @@ void WriteCaseFile(const CaseOutcome& outcome, const std::string& path) {
   file.Commit();
 }
 
-nlohmann::ordered_json ReadCaseRow(const std::string& path) {
-  const H5Reader file(path);
+nlohmann::ordered_json ReadCaseRow(const std::string& path, H5Reader::Probe probe) {
+  const H5Reader file(path, probe);
   const std::string text = file.ReadStringAttribute("/", "row");
   try {
     return nlohmann::ordered_json::parse(text);

@@ -146,7 +146,8 @@ ResultsFolder::Scan ResultsFolder::ScanCommitted(const Campaign& campaign) const
     try {
       const uint32_t actual = FileCrc32(path);
       if (actual == expected) {
-        ReadCaseRow(path);
+        // The bytes this program committed (CRC-32 as in the name): no probe in a child.
+        ReadCaseRow(path, H5Reader::Probe::kNone);
         scan.committed[it->second] = true;
         continue;
       }

@@ -49,8 +49,11 @@ CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case);
 void WriteCaseFile(const CaseOutcome& outcome, const std::string& path);
 
 // The summary row of a committed case file. Throws InputError if the file is not a complete
-// case file (unreadable, or without the row).
-nlohmann::ordered_json ReadCaseRow(const std::string& path);
+// case file (unreadable, or without the row). `probe`: H5Reader's guard against files that
+// crash libhdf5 (a child process per file); kNone for a file this program wrote or whose
+// CRC-32 matched the one it was committed with.
+nlohmann::ordered_json ReadCaseRow(const std::string& path,
+                                   H5Reader::Probe probe = H5Reader::Probe::kEverything);
 
 // A summary row value: a number, or NaN for null or absent.
 double RowNumber(const nlohmann::ordered_json& row, const std::string& column);
