@@ -8,7 +8,8 @@ namespace mbid::campaign::internal {
 
 // Builds one HDF5 file out of others so that the same inputs give the same bytes, whatever the
 // order or the time the inputs were written in: objects are created in name order and without
-// modification times (HDF5 stores them by default; H5Writer's files carry them). This is what
+// modification times, and each input's objects are copied by HDF5's object copy (H5Ocopy), whose
+// bytes follow from the input's (H5Writer writes no modification times either). This is what
 // makes a campaign file bit-for-bit identical for 1 or 2 workers, or 2 MPI ranks.
 //
 // It calls the HDF5 C library directly, outside H5Writer's process-wide lock: use it only while

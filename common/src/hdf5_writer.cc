@@ -57,13 +57,34 @@ class ObjectIndex {
   std::set<std::string> datasets_;
 };
 
+// Objects are created without modification times (HDF5 stores them by default): the same
+// content gives the same bytes, and a campaign can copy its case files into one file with
+// H5Ocopy and still get the same bytes for any number of workers (h5_merge.h).
+void Untimed(hid_t properties) {
+  internal::Check(H5Pset_obj_track_times(properties, 0), "H5Pset_obj_track_times");
+}
+
+const H5::DSetCreatPropList& UntimedDataset() {
+  // Never destroyed: a property list closed after HDF5 shut down at exit would be an error.
+  static const H5::DSetCreatPropList* const list = [] {
+    auto* created = new H5::DSetCreatPropList;
+    Untimed(created->getId());
+    return created;
+  }();
+  return *list;
+}
+
 void EnsureGroup(H5::H5File& file, ObjectIndex& index, const std::string& path) {
   for (const std::string& prefix : PathPrefixes(path)) {
     if (index.IsGroup(prefix)) continue;
     if (index.IsDataset(prefix)) {
       throw H5::Exception("EnsureGroup", prefix + " exists and is not a group");
     }
-    file.createGroup(prefix);
+    const internal::Handle properties(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "H5Pcreate");
+    Untimed(properties.get());
+    const internal::Handle group(
+        H5Gcreate2(file.getId(), prefix.c_str(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
+        H5Gclose, "H5Gcreate2");
     index.AddGroup(prefix);
   }
 }
@@ -115,10 +136,11 @@ void WriteDoubleDataset(H5::H5File& file, ObjectIndex& index, const std::string&
   RemoveIfExists(file, index, path);
   hsize_t count = 1;
   for (hsize_t d : dims) count *= d;
-  // Short datasets take the default (contiguous) properties without creating a list of their own.
+  // Short datasets share one (contiguous) property list.
   std::optional<H5::DSetCreatPropList> chunked;
   if (dims.size() == 1 && count >= kChunkThreshold) {
     chunked.emplace();
+    Untimed(chunked->getId());
     const hsize_t chunk = std::min(count, kChunkSize);
     chunked->setChunk(1, &chunk);
     if (H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
@@ -126,7 +148,7 @@ void WriteDoubleDataset(H5::H5File& file, ObjectIndex& index, const std::string&
       chunked->setDeflate(kDeflateLevel);
     }
   }
-  const H5::DSetCreatPropList& properties = chunked ? *chunked : H5::DSetCreatPropList::DEFAULT;
+  const H5::DSetCreatPropList& properties = chunked ? *chunked : UntimedDataset();
   const H5::DataSpace space = dims.empty()
                                   ? H5::DataSpace(H5S_SCALAR)
                                   : H5::DataSpace(static_cast<int>(dims.size()), dims.data());
@@ -174,8 +196,10 @@ H5Writer::H5Writer(const std::string& path, bool sync) {
       // H5close at exit, is a segmentation fault. Commit() writes the image itself.
       H5::FileAccPropList access;
       access.setCore(kCoreIncrement, false);
-      impl_->file = std::make_unique<H5::H5File>(impl_->atomic.temp_path(), H5F_ACC_TRUNC,
-                                                 H5::FileCreatPropList::DEFAULT, access);
+      H5::FileCreatPropList creation;
+      Untimed(creation.getId());  // the root group
+      impl_->file =
+          std::make_unique<H5::H5File>(impl_->atomic.temp_path(), H5F_ACC_TRUNC, creation, access);
     } catch (const H5::Exception& e) {
       throw std::runtime_error(
           fmt::format("cannot create HDF5 file {}: {}", impl_->atomic.temp_path(), Describe(e)));
@@ -256,7 +280,7 @@ void H5Writer::WriteStrings(const std::string& group, const std::string& name,
     const hsize_t n = values.size();
     std::vector<const char*> pointers;
     for (const auto& v : values) pointers.push_back(v.c_str());
-    H5::DataSet dataset = file.createDataSet(path, type, H5::DataSpace(1, &n));
+    H5::DataSet dataset = file.createDataSet(path, type, H5::DataSpace(1, &n), UntimedDataset());
     impl_->index.AddDataset(path);
     if (n > 0) {
       dataset.write(pointers.data(), type, H5::DataSpace::ALL, H5::DataSpace::ALL,
