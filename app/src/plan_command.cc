@@ -101,8 +101,7 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   settings.options.quiet = common.quiet;
   // The candidates are checked before any long work starts.
   CandidateFile file = ReadCandidateFile(candidates_path, scenario, *model);
-  const identification::IdentificationOptions identification_options =
-      scenario.ReadIdentification();
+  const identification::IdentificationOptions identification_options = scenario.identification;
   const std::vector<LoadedTest> tests =
       LoadTests(data_paths, scenario, *model, identification_options, common.import, false);
 

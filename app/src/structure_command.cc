@@ -91,8 +91,7 @@ int RunStructureCommand(const std::string& scenario_path,
   }
 
   const updating::UpdatingSettings& settings = scenario.updating;
-  const identification::IdentificationOptions identification_options =
-      scenario.ReadIdentification();
+  const identification::IdentificationOptions identification_options = scenario.identification;
   const std::vector<LoadedTest> tests =
       LoadTests(data_paths, scenario, *model, identification_options, common.import, !common.quiet);
   const std::vector<updating::TestRecord> records = MakeWeightedRecords(tests, settings);

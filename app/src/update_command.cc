@@ -95,8 +95,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   updating::UpdatingSettings settings = scenario.updating;
   settings.options.quiet = common.quiet;
   if (common.profile) settings.profile.enabled = true;
-  const identification::IdentificationOptions identification_options =
-      scenario.ReadIdentification();
+  const identification::IdentificationOptions identification_options = scenario.identification;
 
   // Every record is read and checked before any long work starts.
   const std::vector<LoadedTest> tests =

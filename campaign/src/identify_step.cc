@@ -15,7 +15,7 @@ std::shared_ptr<const identification::ModalResult> RunIdentifyStep(const StepInp
                                                                    CaseOutcome& outcome) {
   const auto result = std::make_shared<const identification::ModalResult>(identification::Identify(
       input.test->measured,
-      FreeDecayOptions(input.scenario->ReadIdentification(), input.scenario->RequireExcitation()),
+      FreeDecayOptions(input.scenario->identification, input.scenario->RequireExcitation()),
       input.scenario->path));
 
   nlohmann::ordered_json& row = outcome.row;

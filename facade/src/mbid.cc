@@ -109,7 +109,7 @@ UpdateResult Update(const Scenario& scenario, const std::vector<Measurement>& re
         "one excitation per record");
   }
   const std::unique_ptr<model::MechanicalModel> model = scenario.MakeModel();
-  const identification::IdentificationOptions identification = scenario.ReadIdentification();
+  const identification::IdentificationOptions identification = scenario.identification;
   updating::UpdatingSettings settings = scenario.updating;
   settings.options.quiet = true;
   std::vector<validation::LoadedTest> tests;

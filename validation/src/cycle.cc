@@ -123,7 +123,7 @@ CycleResult RunCycle(const Scenario& scenario, const CycleOptions& options) {
                           : scenario.RequireExcitation();
 
   RunSettings settings;
-  settings.identification = scenario.ReadIdentification();
+  settings.identification = scenario.identification;
   settings.updating = scenario.updating;
   if (options.profile) settings.updating.profile.enabled = true;
   settings.updating.options.quiet = options.quiet;

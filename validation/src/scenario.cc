@@ -32,10 +32,6 @@ std::unique_ptr<model::MechanicalModel> Scenario::MakeAlternativeModel(size_t in
   return model::MakeModel(alternative.Child("model"));
 }
 
-identification::IdentificationOptions Scenario::ReadIdentification() const {
-  return identification;
-}
-
 updating::UpdatingSettings Scenario::ReadUpdating(const model::MechanicalModel& model) const {
   return root.Has("updating")
              ? updating::ReadUpdatingSettings(root.Child("updating"), model, simulation.integrator)

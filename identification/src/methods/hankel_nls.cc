@@ -37,13 +37,17 @@ class PolesByOrder {
   std::map<int, Poles> poles_;
 };
 
-// True for the continuous image of a real negative discrete pole, a sequence that changes sign
-// at every sample: no oscillation the samples resolve (its sine column vanishes), but the form
-// white noise often takes above the signal order. Refined as a mode, it is a weakly determined
-// pole whose Gauss-Newton steps converge only linearly (26 of the 28 iterations on the
-// reference crane's record) before the significance test drops it.
-bool AtNyquist(std::complex<double> lambda, double tau) {
-  return lambda.imag() >= (1 - 1e-6) * M_PI / tau;
+// A pole that may start a mode: in the upper half plane, inside the step-5 limits and below the
+// Nyquist frequency. A pole at the Nyquist frequency is the continuous image of a real negative
+// discrete pole, a sequence that changes sign at every sample: no oscillation the samples
+// resolve (its sine column vanishes), but the form white noise often takes above the signal
+// order. Refined as a mode, it is a weakly determined pole whose Gauss-Newton steps converge
+// only linearly (26 of the 28 iterations on the reference crane's record) before the
+// significance test drops it.
+bool IsCandidate(std::complex<double> lambda, const AnalysisRecord& record,
+                 const IdentificationOptions& options) {
+  const bool at_nyquist = lambda.imag() >= (1 - 1e-6) * M_PI / record.decimated_interval_s;
+  return lambda.imag() > 0 && !at_nyquist && PassesFilter(lambda, options, record.max_frequency_hz);
 }
 
 // Candidates: upper-half poles at the signal order inside the step-5 limits, below the Nyquist
@@ -51,13 +55,9 @@ bool AtNyquist(std::complex<double> lambda, double tau) {
 void AddStableCandidates(const AnalysisRecord& record, const IdentificationOptions& options,
                          int order, int columns, PolesByOrder& poles_at, Estimate* estimate) {
   const Poles& poles = poles_at.At(order);
-  const double tau = record.decimated_interval_s;
   int unstable = 0;
   for (const auto& lambda : poles) {
-    if (lambda.imag() <= 0 || AtNyquist(lambda, tau) ||
-        !PassesFilter(lambda, options, record.max_frequency_hz)) {
-      continue;
-    }
+    if (!IsCandidate(lambda, record, options)) continue;
     bool stable = true;
     for (int s = 1; s <= options.hankel.stability_orders; ++s) {
       const int higher = order + 2 * s;
@@ -174,10 +174,7 @@ void AddModesFromHigherOrders(const AnalysisRecord& record, const Identification
     trial.model_order = estimate->model_order;
     trial.effective_rank = estimate->effective_rank;
     for (const auto& lambda : poles_at.At(higher)) {
-      if (lambda.imag() > 0 && !AtNyquist(lambda, record.decimated_interval_s) &&
-          PassesFilter(lambda, options, record.max_frequency_hz)) {
-        trial.lambda.push_back(lambda);
-      }
+      if (IsCandidate(lambda, record, options)) trial.lambda.push_back(lambda);
     }
     if (trial.lambda.size() <= estimate->lambda.size()) continue;
     try {

@@ -46,8 +46,6 @@ struct Scenario {
   std::unique_ptr<model::MechanicalModel> MakeModel() const;
   // The model of structure_alternatives[index], checked as the scenario's own.
   std::unique_ptr<model::MechanicalModel> MakeAlternativeModel(size_t index) const;
-  // The `identification:` section, or the identifier's defaults (a copy of `identification`).
-  identification::IdentificationOptions ReadIdentification() const;
   // The `updating:` section for `model` (another description's, or a fresh instance of the
   // scenario's), or the defaults; the fits integrate with the scenario's integrator unless the
   // section says otherwise.
