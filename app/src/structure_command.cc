@@ -40,21 +40,29 @@ using validation::LoadTests;
 using validation::MakeWeightedRecords;
 using validation::Scenario;
 using validation::SolveAlgebraicRoute;
+using validation::StartFromAlgebraicRoute;
 
 namespace {
 
-// Route 2's options for a model: the given settings, started from Route 1 on the first record
-// when it gives an admissible set (as `mbid update` does).
-updating::UpdateOptions StartedOptions(const model::MechanicalModel& model,
-                                       updating::UpdatingSettings settings, const LoadedTest& first,
-                                       std::string* start) {
+// Route 2's settings and starts for a model as `mbid update` takes them: Route 1 on the first
+// record gives the primary start when admissible and its other sets as the global search's
+// further starts.
+struct StartedSettings {
+  updating::UpdatingSettings settings;
+  std::vector<updating::SearchStart> starts;
+  std::string start;  // "route1" or "scenario"
+};
+
+StartedSettings StartFromRoute1(const model::MechanicalModel& model,
+                                const updating::UpdatingSettings& settings,
+                                const LoadedTest& first) {
+  StartedSettings started{settings, {}, ""};
   std::string note;
   const auto algebraic =
       SolveAlgebraicRoute(model, first.identified, first.record, first.excitation, settings, &note);
-  *start = algebraic && updating::ApplyAlgebraicStart(*algebraic, settings.options, &note)
-               ? "route1"
-               : "scenario";
-  return settings.options;
+  started.starts =
+      StartFromAlgebraicRoute(algebraic.get(), &started.settings, &started.start, &note);
+  return started;
 }
 
 }  // namespace
@@ -99,12 +107,13 @@ int RunStructureCommand(const std::string& scenario_path,
   // The candidates: the full model first (its fit's noise weighs all), then each set of rigid
   // coordinates, then the alternatives.
   std::vector<updating::StructureCandidate> candidates;
-  std::string start;
+  const StartedSettings full = StartFromRoute1(*model, settings, tests.front());
+  const std::string& start = full.start;
   candidates.push_back({"full",
                         {},
                         "",
                         std::shared_ptr<const model::MechanicalModel>(model->Clone()),
-                        StartedOptions(*model, settings, tests.front(), &start),
+                        full.settings.options,
                         false});
   for (const std::vector<std::string>& rigid : updating::EnumerateRigidSets(compliant, max_rigid)) {
     // Starts at the full fit's estimates (settings.options: no Route 1 values in it).
@@ -129,12 +138,12 @@ int RunStructureCommand(const std::string& scenario_path,
             scenario.structure_alternatives[i], error.what());
       }
     }
-    std::string alternative_start;
+    // A local fit from its own Route 1 set (the global search is the reference's).
     candidates.push_back({scenario.structure_alternatives[i],
                           {},
                           scenario.structure_alternatives[i],
                           alternative,
-                          StartedOptions(*alternative, own, tests.front(), &alternative_start),
+                          StartFromRoute1(*alternative, own, tests.front()).settings.options,
                           false});
   }
   if (!common.quiet) {
@@ -146,7 +155,10 @@ int RunStructureCommand(const std::string& scenario_path,
 
   updating::StructureOptions options;
   options.threads = threads;
-  options.search = scenario.updating.global_search;
+  // The reference is fitted as `mbid update` fits it: the same starts, the same search.
+  options.search = full.settings.global_search;
+  options.reference_starts = full.starts;
+  options.reference_start = full.start;
   options.quiet = common.quiet;
   const updating::StructureRanking ranking = updating::RankStructures(candidates, records, options);
 

@@ -85,10 +85,17 @@ nlohmann::json StructureRankingToJson(const updating::StructureRanking& ranking,
   }
   nlohmann::json noise = nlohmann::json::array();
   for (const auto& channels : ranking.noise_std) noise.push_back(channels);
+  const updating::GlobalSearchResult& search = ranking.reference_search;
   return {{"structures", structures},
           {"criterion", "bic"},
           {"records", records},
           {"noise_std", noise},
+          {"reference_search",
+           {{"starts", search.starts},
+            {"screened", search.screened},
+            {"full_fits", search.full_fits},
+            {"non_unique", search.non_unique},
+            {"notes", search.notes}}},
           {"wall_time_s", ranking.wall_time_s}};
 }
 

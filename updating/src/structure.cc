@@ -205,8 +205,11 @@ StructureRanking RankStructures(const std::vector<StructureCandidate>& candidate
     throw InputError(candidates[0].name, "channels", reference_missing,
                      "records of the scenario model's outputs or coordinates");
   }
-  fits[0].fit = FitCandidate(*candidates[0].model, tests, PrepareOptions(candidates[0], nullptr),
-                             &options.search);
+  StructureRanking ranking;
+  ranking.reference_search =
+      SearchGlobally(*candidates[0].model, tests, PrepareOptions(candidates[0], nullptr),
+                     options.reference_start, options.reference_starts, options.search);
+  fits[0].fit = ranking.reference_search.best;
   report(fmt::format("structure {}: {} after {} iterations, cost {:.6g}", fits[0].name,
                      fits[0].fit.termination_name(), fits[0].fit.iterations,
                      fits[0].fit.final_cost));
@@ -217,7 +220,6 @@ StructureRanking RankStructures(const std::vector<StructureCandidate>& candidate
                              " (whose noise weighs every candidate) failed: " + reference.message);
   }
   std::vector<TestRecord> weighed = tests;
-  StructureRanking ranking;
   for (size_t t = 0; t < tests.size(); ++t) {
     const TestFit& fit = reference.tests[t];
     for (size_t c = 0; c < fit.channels.size(); ++c) {

@@ -77,26 +77,33 @@ std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
           settings.algebraic));
 }
 
+std::vector<updating::SearchStart> StartFromAlgebraicRoute(
+    const updating::CharacteristicResult* algebraic, updating::UpdatingSettings* settings,
+    std::string* start, std::string* note) {
+  *start = "scenario";
+  bool from_route1 = false;
+  if (algebraic != nullptr) {
+    std::string why;
+    from_route1 = updating::ApplyAlgebraicStart(*algebraic, settings->options, &why);
+    if (from_route1) *start = "route1";
+    if (!why.empty()) *note = note->empty() ? why : *note + "; " + why;
+  }
+  // Route 1 ran on as many poles as coordinates (SolveAlgebraicRoute) and solved: its sets are
+  // every joint set with these poles.
+  settings->global_search.complete_starts =
+      algebraic != nullptr && algebraic->status == updating::CharacteristicResult::Status::kSolved;
+  if (algebraic == nullptr) return {};
+  return updating::MakeAlgebraicStarts(*algebraic, from_route1);
+}
+
 updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
                                        const std::vector<updating::TestRecord>& records,
                                        updating::UpdatingSettings settings,
                                        const updating::CharacteristicResult* algebraic,
                                        std::string* start, std::string* note,
                                        const std::function<void(const std::string&)>& say) {
-  *start = "scenario";
-  bool from_route1 = false;
-  if (algebraic != nullptr) {
-    std::string why;
-    from_route1 = updating::ApplyAlgebraicStart(*algebraic, settings.options, &why);
-    if (from_route1) *start = "route1";
-    if (!why.empty()) *note = note->empty() ? why : *note + "; " + why;
-  }
-  std::vector<updating::SearchStart> starts;
-  if (algebraic != nullptr) starts = updating::MakeAlgebraicStarts(*algebraic, from_route1);
-  // Route 1 ran on as many poles as coordinates (SolveAlgebraicRoute) and solved: its sets are
-  // every joint set with these poles.
-  settings.global_search.complete_starts =
-      algebraic != nullptr && algebraic->status == updating::CharacteristicResult::Status::kSolved;
+  const std::vector<updating::SearchStart> starts =
+      StartFromAlgebraicRoute(algebraic, &settings, start, note);
   updating::GlobalSearchResult search = updating::SearchGlobally(
       model, records, settings.options, *start, starts, settings.global_search, say);
   if (algebraic != nullptr) updating::MarkAlgebraicAmbiguity(*algebraic, search.best);

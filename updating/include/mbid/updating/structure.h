@@ -61,6 +61,11 @@ struct StructureOptions {
   // would mislead the whole ranking. The variants and the leave-one-out fits start from it and
   // are local fits.
   GlobalSearchOptions search;
+  // The reference's further starts (Route 1's other sets, as `mbid update` gives them; with
+  // search.complete_starts when they hold every set matching the identified poles) and its
+  // primary start's label ("route1", "scenario").
+  std::vector<SearchStart> reference_starts;
+  std::string reference_start = "start";
 };
 
 struct StructureFit {
@@ -90,6 +95,9 @@ struct StructureRanking {
   // The noise standard deviations every candidate was weighed with: the reference fit's, per test
   // and channel.
   std::vector<std::map<std::string, double>> noise_std;
+  // How the reference was searched (starts, screened design points, whole-record fits, notes);
+  // its best is the reference's fit.
+  GlobalSearchResult reference_search;
   double wall_time_s = 0;
 };
 

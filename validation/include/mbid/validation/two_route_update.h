@@ -29,6 +29,14 @@ std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
     const Measurement& record, const simulation::Excitation& excitation,
     const updating::UpdatingSettings& settings, std::string* note);
 
+// Route 2's starts from Route 1 (null: none): Route 1's chosen set becomes the primary start in
+// settings->options when admissible (`start` "route1", else "scenario", the reason added to
+// `note`); returns the other admissible sets as further starts, and marks them complete
+// (settings->global_search.complete_starts) when Route 1 solved.
+std::vector<updating::SearchStart> StartFromAlgebraicRoute(
+    const updating::CharacteristicResult* algebraic, updating::UpdatingSettings* settings,
+    std::string* start, std::string* note);
+
 // Route 2 as every command runs it: from Route 1's chosen set when it applies (else the
 // scenario's values), with the other admissible Route-1 sets and the settings' space-filling
 // design as further starts of the global search (global_search.h); Route 1's ambiguity marks the
