@@ -132,12 +132,75 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     return run;
   };
 
-  // The primary start first, alone. Where the records give no noise level, its fit estimates
-  // one, and every other fit is weighed by it so that all costs are in the same units.
+  // The design: space-filling points in Ceres' coordinates over the bounds, each screened (a
+  // short fit on the first part of each record).
+  const auto make_design = [&](int count) {
+    std::vector<std::map<std::string, double>> design;
+    for (const std::vector<double>& point :
+         SpaceFillingDesign(count, static_cast<int>(settings.size()), search.seed)) {
+      std::map<std::string, double> values;
+      for (size_t k = 0; k < settings.size(); ++k) {
+        const ParameterSetting& s = settings[k];
+        // Uniform in Ceres' coordinates over the bounds.
+        values[s.name] =
+            s.log_scale
+                ? std::exp(std::log(s.lower) + point[k] * (std::log(s.upper) - std::log(s.lower)))
+                : s.lower + point[k] * (s.upper - s.lower);
+      }
+      design.push_back(values);
+    }
+    return design;
+  };
+  // The records' first parts, once the weights are known.
+  std::vector<TestRecord> windows;
+  UpdateOptions screen = local;
+  screen.max_iterations = search.screen_iterations;
+  screen.continuation_fractions.clear();
+  struct Screened {
+    std::vector<std::map<std::string, double>> design;
+    std::vector<Run> batch;
+  };
+  const auto screen_one = [&](const std::map<std::string, double>& values, size_t d) {
+    Run run{fmt::format("design {}", d + 1), {}, false};
+    try {
+      run.fit = UpdateModel(model, windows, StartOptions(screen, settings, values));
+    } catch (const std::exception& e) {
+      run.failed = true;
+    }
+    return run;
+  };
+
+  // The primary start first. Where the records give no noise level, its fit estimates one, and
+  // every other fit is weighed by it so that all costs are in the same units; where the given
+  // starts may settle the search (complete_starts), its fit decides whether the design runs.
+  // Otherwise nothing of the design depends on it: it is fitted in the design's batch, which
+  // keeps every thread busy while it runs (the same fits, hence the same result).
   const auto batch_start = std::chrono::steady_clock::now();
-  say(fmt::format("global search: fit from {}{}", primary_label,
-                  all_given ? "" : " to estimate the noise"));
-  full.push_back(fit_full(primary_label, {}, primary));
+  const bool design_with_primary = all_given && !search.complete_starts && search.design_starts > 0;
+  say(fmt::format("global search: fit from {}{}{}", primary_label,
+                  all_given ? "" : " to estimate the noise",
+                  design_with_primary
+                      ? fmt::format(" beside {} design points on the first {:.0f}% of each record",
+                                    search.design_starts, 100 * search.screen_fraction)
+                      : ""));
+  Screened early;
+  if (design_with_primary) {
+    windows = Window(weighted, search.screen_fraction);
+    early.design = make_design(search.design_starts);
+    early.batch.resize(early.design.size());
+    Run primary_run;
+    RunParallel(static_cast<int>(early.design.size()) + 1, search.threads, [&](int i) {
+      if (i == 0) {
+        primary_run = fit_full(primary_label, {}, primary);
+      } else {
+        const size_t d = static_cast<size_t>(i - 1);
+        early.batch[d] = screen_one(early.design[d], d);
+      }
+    });
+    full.push_back(primary_run);
+  } else {
+    full.push_back(fit_full(primary_label, {}, primary));
+  }
   if (!all_given) {
     internal::WeighAs(full.front().fit, weighted);
     if (full.front().failed) {
@@ -220,42 +283,23 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
         "no space-filling design: the given starts hold every set that matches the identified "
         "poles, and the best of them fits the records to their noise");
   }
-  std::vector<std::map<std::string, double>> design;
-  for (const std::vector<double>& point :
-       SpaceFillingDesign(design_count, static_cast<int>(settings.size()), search.seed)) {
-    std::map<std::string, double> values;
-    for (size_t k = 0; k < settings.size(); ++k) {
-      const ParameterSetting& s = settings[k];
-      // Uniform in Ceres' coordinates over the bounds.
-      values[s.name] =
-          s.log_scale
-              ? std::exp(std::log(s.lower) + point[k] * (std::log(s.upper) - std::log(s.lower)))
-              : s.lower + point[k] * (s.upper - s.lower);
+  Screened screened = std::move(early);
+  if (!design_with_primary) {
+    windows = Window(weighted, search.screen_fraction);
+    screened.design = make_design(design_count);
+    if (!screened.design.empty()) {
+      say(fmt::format("global search: {} design points on the first {:.0f}% of each record",
+                      screened.design.size(), 100 * search.screen_fraction));
     }
-    design.push_back(values);
+    screened.batch.resize(screened.design.size());
+    RunParallel(static_cast<int>(screened.batch.size()), search.threads, [&](int i) {
+      const size_t d = static_cast<size_t>(i);
+      screened.batch[d] = screen_one(screened.design[d], d);
+    });
   }
+  const std::vector<std::map<std::string, double>>& design = screened.design;
+  const std::vector<Run>& batch = screened.batch;
   result.starts = static_cast<int>(1 + starts.size() + design.size());
-
-  // Design points on the first part of each record, in parallel.
-  if (!design.empty()) {
-    say(fmt::format("global search: {} design points on the first {:.0f}% of each record",
-                    design.size(), 100 * search.screen_fraction));
-  }
-  const std::vector<TestRecord> windows = Window(weighted, search.screen_fraction);
-  UpdateOptions screen = local;
-  screen.max_iterations = search.screen_iterations;
-  screen.continuation_fractions.clear();
-  std::vector<Run> batch(design.size());
-  RunParallel(static_cast<int>(batch.size()), search.threads, [&](int i) {
-    const size_t d = static_cast<size_t>(i);
-    Run run{fmt::format("design {}", d + 1), {}, false};
-    try {
-      run.fit = UpdateModel(model, windows, StartOptions(screen, settings, design[d]));
-    } catch (const std::exception& e) {
-      run.failed = true;
-    }
-    batch[d] = run;
-  });
   result.screen_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - batch_start).count();
   result.screened = static_cast<int>(design.size());
@@ -292,12 +336,12 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   }
   std::vector<Run> refits(chosen.size());
   RunParallel(static_cast<int>(chosen.size()), search.threads, [&](int i) {
-    const Run& screened = batch[chosen[static_cast<size_t>(i)]];
+    const Run& end = batch[chosen[static_cast<size_t>(i)]];
     std::map<std::string, double> values;
-    for (const ParameterEstimate& p : screened.fit.parameters) {
+    for (const ParameterEstimate& p : end.fit.parameters) {
       if (p.test.empty()) values[p.name] = p.value;
     }
-    refits[static_cast<size_t>(i)] = fit_full(screened.label, values, local);
+    refits[static_cast<size_t>(i)] = fit_full(end.label, values, local);
   });
   full.insert(full.end(), refits.begin(), refits.end());
 
