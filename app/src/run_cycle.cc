@@ -51,6 +51,11 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
   options.quiet = common.quiet;
   options.profile = common.profile;
   options.say = say;
+  // The record and identification figures are drawn while the tests are tuned.
+  report::EarlyRunFigures early((folder / "").string());
+  options.identified = [&early](const validation::RunTest& test, size_t test_count) {
+    early.Start(test, test_count);
+  };
   const validation::CycleResult cycle = validation::RunCycle(scenario, options);
   progress.Say(cycle.verdict_line);
   for (const std::string& reason : cycle.reasons) {
@@ -58,7 +63,8 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
     std::cerr << "mbid: " << (cycle.verdict == "failed" ? "failed" : "inconclusive") << ": "
               << reason << "\n";
   }
-  const int figure_count = report::WriteRunFolder(cycle, scenario, (folder / "").string(), say);
+  const int figure_count =
+      report::WriteRunFolder(cycle, scenario, (folder / "").string(), say, &early);
   folder.Commit();
   progress.Say(fmt::format("wrote {}/ (run.h5, summary.json, report.md, {} figures)",
                            final_dir.string(), figure_count));

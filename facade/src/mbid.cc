@@ -4,6 +4,7 @@
 
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "mbid/common/output_folder.h"
 #include "mbid/identification/identify.h"
@@ -146,6 +147,14 @@ ValidationResult RunValidationCycle(const Scenario& scenario, const ValidationOp
   validation::CycleOptions cycle_options;
   cycle_options.quiet = options.quiet;
   cycle_options.say = Progress(options.quiet);
+  // With a folder, the record and identification figures are drawn while the tests are tuned.
+  std::optional<report::EarlyRunFigures> early;
+  if (folder) {
+    early.emplace((*folder / "").string());
+    cycle_options.identified = [&early](const validation::RunTest& test, size_t test_count) {
+      early->Start(test, test_count);
+    };
+  }
   ValidationResult result;
   result.cycle = validation::RunCycle(scenario, cycle_options);
   result.verdict = ParseVerdict(result.cycle.verdict);
@@ -156,7 +165,8 @@ ValidationResult RunValidationCycle(const Scenario& scenario, const ValidationOp
   result.identified = first.identified;
   result.updated = Summarise(first.search, first.start_note);
   if (folder) {
-    report::WriteRunFolder(result.cycle, scenario, (*folder / "").string(), cycle_options.say);
+    report::WriteRunFolder(result.cycle, scenario, (*folder / "").string(), cycle_options.say,
+                           &*early);
     folder->Commit();
   }
   return result;

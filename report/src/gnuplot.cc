@@ -172,10 +172,10 @@ std::vector<std::unique_ptr<AtomicFile>> DrawGroup(
 // Figures are drawn by two gnuplot processes at once when there are enough of them to pay for
 // the second start (measured in docs/performance.md); each PNG is committed only when all were
 // drawn.
-void DrawAll(const std::vector<std::pair<Figure, std::string>>& figures) {
+void DrawAll(const std::vector<std::pair<Figure, std::string>>& figures, int processes = 2) {
   if (figures.empty()) return;
   constexpr size_t kParallelFrom = 4;
-  if (figures.size() < kParallelFrom) {
+  if (figures.size() < kParallelFrom || processes < 2) {
     for (const auto& png : DrawGroup(figures)) png->Commit();
     return;
   }
@@ -278,10 +278,10 @@ void FigureBatch::Add(const Figure& figure, const std::string& png_path) {
   figures_.emplace_back(figure, png_path);
 }
 
-void FigureBatch::Draw() {
+void FigureBatch::Draw(int processes) {
   std::vector<std::pair<Figure, std::string>> figures;
   figures.swap(figures_);
-  DrawAll(figures);
+  DrawAll(figures, processes);
 }
 
 }  // namespace mbid::report

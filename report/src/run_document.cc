@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "mbid/report/gnuplot.h"
 #include "mbid/report/run_report.h"
@@ -18,13 +19,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct TestFigures {
-  std::vector<std::string> record, identification, backbone, updating;
-};
+}  // namespace
 
-TestFigures DrawTestFigures(const std::string& folder, const std::string& prefix,
-                            const RunTest& test) {
-  TestFigures figures;
+TestFigureFiles DrawIdentificationFigures(const std::string& folder, const std::string& prefix,
+                                          const RunTest& test) {
+  TestFigureFiles figures;
   const auto add = [&prefix](std::vector<std::string>& list, const std::string& file) {
     if (!file.empty()) list.push_back(prefix + file);
   };
@@ -52,12 +51,20 @@ TestFigures DrawTestFigures(const std::string& folder, const std::string& prefix
   for (const std::string& file : DrawBackboneFigures(folder, test.identified)) {
     add(figures.backbone, file);
   }
+  return figures;
+}
+
+namespace {
+
+void DrawUpdatingFigures(const std::string& folder, const std::string& prefix, const RunTest& test,
+                         TestFigureFiles& figures) {
   const updating::TestFit& fit = test.tuned.tests.front();
   for (int c = 0; c < static_cast<int>(fit.channels.size()); ++c) {
-    add(figures.updating, DrawResimulationFigure(folder, test.measured, fit, c));
+    const std::string file = DrawResimulationFigure(folder, test.measured, fit, c);
+    if (!file.empty()) figures.updating.push_back(prefix + file);
   }
-  add(figures.updating, DrawConvergenceFigure(folder, test.tuned));
-  return figures;
+  const std::string file = DrawConvergenceFigure(folder, test.tuned);
+  if (!file.empty()) figures.updating.push_back(prefix + file);
 }
 
 void Embed(std::ostream& out, const std::vector<std::string>& figures) {
@@ -91,7 +98,7 @@ std::vector<ReferenceMode> KnownModes(const Scenario& scenario, const RunTest& t
 int WriteRunReport(const std::string& folder, const Scenario& scenario,
                    const model::MechanicalModel& model, const std::vector<model::Mode>& exact_modes,
                    const std::vector<RunTest>& tests, const std::string& verdict,
-                   const std::function<void(const std::string&)>& say) {
+                   const std::function<void(const std::string&)>& say, EarlyRunFigures* early) {
   const bool several = tests.size() > 1;
   const bool draw = GnuplotAvailable();
   if (!draw) say("gnuplot with pngcairo not found: the report has no figures");
@@ -106,12 +113,15 @@ int WriteRunReport(const std::string& folder, const Scenario& scenario,
                                       : fmt::format("{} recorded test(s).\n\n", tests.size()));
   const std::string heading = several ? "###" : "##";
   for (const RunTest& test : tests) {
-    TestFigures figures;
+    TestFigureFiles figures;
     if (draw) {
       const std::string prefix = several ? test.name + "/" : "";
       const fs::path test_folder = fs::path(folder) / prefix;
       fs::create_directories(test_folder);
-      figures = DrawTestFigures((test_folder / "").string(), prefix, test);
+      std::optional<TestFigureFiles> drawn = early ? early->Take(test.name) : std::nullopt;
+      figures =
+          drawn ? *drawn : DrawIdentificationFigures((test_folder / "").string(), prefix, test);
+      DrawUpdatingFigures((test_folder / "").string(), prefix, test, figures);
       figure_count += static_cast<int>(figures.record.size() + figures.identification.size() +
                                        figures.backbone.size() + figures.updating.size());
     }

@@ -128,7 +128,7 @@ bool IsRunFolder(const std::string& folder) {
 
 int WriteRunFolder(const validation::CycleResult& cycle, const validation::Scenario& scenario,
                    const std::string& folder_path,
-                   const std::function<void(const std::string&)>& say) {
+                   const std::function<void(const std::string&)>& say, EarlyRunFigures* early) {
   const fs::path folder(folder_path);
   const std::vector<RunTest>& tests = cycle.tests;
   const double threshold = cycle.min_correlation;
@@ -204,7 +204,7 @@ int WriteRunFolder(const validation::CycleResult& cycle, const validation::Scena
   summary["validation"] = validation;
 
   const int figure_count = WriteRunReport((folder / "").string(), scenario, *cycle.model,
-                                          cycle.exact_modes, tests, cycle.verdict_line, say);
+                                          cycle.exact_modes, tests, cycle.verdict_line, say, early);
   WriteJson(summary, (folder / "summary.json").string());
   run.Commit();
   return figure_count;

@@ -135,8 +135,13 @@ CycleResult RunCycle(const Scenario& scenario, const CycleOptions& options) {
   std::vector<std::string> verdicts;
   for (RunTest& test : result.tests) {
     const std::string prefix = several ? "test " + test.name + ": " : "";
-    AnalyseTest(test, *model, test.excitation ? *test.excitation : result.excitation, settings,
-                [&](const std::string& message) { say(prefix + message); });
+    const size_t test_count = result.tests.size();
+    AnalyseTest(
+        test, *model, test.excitation ? *test.excitation : result.excitation, settings,
+        [&](const std::string& message) { say(prefix + message); },
+        [&](const RunTest& identified) {
+          if (options.identified) options.identified(identified, test_count);
+        });
     verdicts.push_back(test.verdict);
     for (const std::string& reason : test.reasons) {
       result.reasons.push_back(prefix + reason);

@@ -15,11 +15,13 @@ namespace mbid::validation {
 
 void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
                  const simulation::Excitation& excitation, const RunSettings& settings,
-                 const std::function<void(const std::string&)>& say) {
+                 const std::function<void(const std::string&)>& say,
+                 const std::function<void(const RunTest&)>& identified) {
   test.identified = identification::Identify(
       test.measured, FreeDecayOptions(settings.identification, excitation), test.origin);
   say(fmt::format("identified {} modes ({}), K = {:.3f}", test.identified.modes.size(),
                   test.identified.method, test.identified.correlation.minCoeff()));
+  if (identified) identified(test);
 
   // Route 1 (eqs. 6-8) when there are enough identified poles (SolveAlgebraicRoute); Route 2
   // searches from its sets, the scenario's values and a space-filling design (TuneModel).

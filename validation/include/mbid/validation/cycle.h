@@ -24,6 +24,9 @@ struct CycleOptions {
   bool profile = false;
   // Progress lines ("simulated the test: ...", "Route 2: ..."); empty: none.
   std::function<void(const std::string&)> say;
+  // Called with each test as soon as it is identified (its record, release and modes final),
+  // before Routes 1 and 2, and the run's number of tests: e.g. to draw its figures meanwhile.
+  std::function<void(const RunTest&, size_t)> identified;
 };
 
 // The validation cycle of one scenario, in memory: its tests (the scenario's records, or one

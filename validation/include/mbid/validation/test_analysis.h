@@ -62,9 +62,11 @@ struct RunSettings {
 
 // The cycle after the record: identify the modes (the free decay after any forcing), Route 1
 // (eq. 7) on their poles, Route 2 (Ceres) from Route 1's set or the scenario's values, and the
-// verdict on the re-simulation. Throws NumericalError when Route 2 does not converge.
+// verdict on the re-simulation. `identified`, if set, hears the test once its modes are
+// identified. Throws NumericalError when Route 2 does not converge.
 void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
                  const simulation::Excitation& excitation, const RunSettings& settings,
-                 const std::function<void(const std::string&)>& say);
+                 const std::function<void(const std::string&)>& say,
+                 const std::function<void(const RunTest&)>& identified = {});
 
 }  // namespace mbid::validation
