@@ -19,13 +19,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A drawn figure's file into its section's list (nothing when no figure was drawn).
+void Add(std::vector<std::string>& list, const std::string& prefix, const std::string& file) {
+  if (!file.empty()) list.push_back(prefix + file);
+}
+
 }  // namespace
 
 TestFigureFiles DrawIdentificationFigures(const std::string& folder, const std::string& prefix,
                                           const RunTest& test) {
   TestFigureFiles figures;
   const auto add = [&prefix](std::vector<std::string>& list, const std::string& file) {
-    if (!file.empty()) list.push_back(prefix + file);
+    Add(list, prefix, file);
   };
   const Measurement* exact = test.exact ? &*test.exact : nullptr;
   const std::string exact_label = test.simulation
@@ -60,11 +65,9 @@ void DrawUpdatingFigures(const std::string& folder, const std::string& prefix, c
                          TestFigureFiles& figures) {
   const updating::TestFit& fit = test.tuned.tests.front();
   for (int c = 0; c < static_cast<int>(fit.channels.size()); ++c) {
-    const std::string file = DrawResimulationFigure(folder, test.measured, fit, c);
-    if (!file.empty()) figures.updating.push_back(prefix + file);
+    Add(figures.updating, prefix, DrawResimulationFigure(folder, test.measured, fit, c));
   }
-  const std::string file = DrawConvergenceFigure(folder, test.tuned);
-  if (!file.empty()) figures.updating.push_back(prefix + file);
+  Add(figures.updating, prefix, DrawConvergenceFigure(folder, test.tuned));
 }
 
 void Embed(std::ostream& out, const std::vector<std::string>& figures) {
