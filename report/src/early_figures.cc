@@ -17,16 +17,19 @@ EarlyRunFigures::~EarlyRunFigures() {
 }
 
 void EarlyRunFigures::Start(const validation::RunTest& test, size_t test_count) {
-  if (!GnuplotAvailable() || drawing_.count(test.name)) return;
-  const std::string prefix = test_count > 1 ? test.name + "/" : "";
+  if (drawing_.count(test.name)) return;
+  const std::string prefix = TestFolderPrefix(test.name, test_count);
   const std::string test_folder = (std::filesystem::path(folder_) / prefix / "").string();
-  drawing_[test.name] = std::async(std::launch::async, [test, prefix, test_folder] {
-    std::filesystem::create_directories(test_folder);
-    FigureBatch batch;  // this thread's own
-    TestFigureFiles files = DrawIdentificationFigures(test_folder, prefix, test);
-    batch.Draw(1);  // one gnuplot process: the updating runs on the other core
-    return files;
-  });
+  // The gnuplot check starts a process too: on this thread it would delay the updating.
+  drawing_[test.name] = std::async(
+      std::launch::async, [test, prefix, test_folder]() -> std::optional<TestFigureFiles> {
+        if (!GnuplotAvailable()) return std::nullopt;
+        std::filesystem::create_directories(test_folder);
+        FigureBatch batch;  // this thread's own
+        TestFigureFiles files = DrawIdentificationFigures(test_folder, prefix, test);
+        batch.Draw(1);  // one gnuplot process: the updating runs on the other core
+        return files;
+      });
 }
 
 std::optional<TestFigureFiles> EarlyRunFigures::Take(const std::string& test_name) {

@@ -26,12 +26,13 @@ void Add(std::vector<std::string>& list, const std::string& prefix, const std::s
 
 }  // namespace
 
+std::string TestFolderPrefix(const std::string& test_name, size_t test_count) {
+  return test_count > 1 ? test_name + "/" : "";
+}
+
 TestFigureFiles DrawIdentificationFigures(const std::string& folder, const std::string& prefix,
                                           const RunTest& test) {
   TestFigureFiles figures;
-  const auto add = [&prefix](std::vector<std::string>& list, const std::string& file) {
-    Add(list, prefix, file);
-  };
   const Measurement* exact = test.exact ? &*test.exact : nullptr;
   const std::string exact_label = test.simulation
                                       ? "exact model output (no sensor errors)"
@@ -40,21 +41,22 @@ TestFigureFiles DrawIdentificationFigures(const std::string& folder, const std::
     // The whole record as read, the release where the test was cut marked on it.
     const ReleaseMark release{test.release->release_time_s, test.release->how};
     for (int c = 0; c < test.recorded->channel_count(); ++c) {
-      add(figures.record, DrawRecordFigure(folder, *test.recorded, nullptr, "", c, &release));
+      Add(figures.record, prefix,
+          DrawRecordFigure(folder, *test.recorded, nullptr, "", c, &release));
     }
   } else {
     for (int c = 0; c < test.measured.channel_count(); ++c) {
-      add(figures.record, DrawRecordFigure(folder, test.measured, exact, exact_label, c));
+      Add(figures.record, prefix, DrawRecordFigure(folder, test.measured, exact, exact_label, c));
     }
   }
-  add(figures.identification, DrawSpectrumFigure(folder, test.identified));
+  Add(figures.identification, prefix, DrawSpectrumFigure(folder, test.identified));
   for (int c = 0; c < static_cast<int>(test.identified.channels.size()); ++c) {
-    add(figures.identification,
+    Add(figures.identification, prefix,
         DrawReconstructionFigure(folder, test.measured, test.identified, c));
   }
-  add(figures.identification, DrawStabilizationFigure(folder, test.identified));
+  Add(figures.identification, prefix, DrawStabilizationFigure(folder, test.identified));
   for (const std::string& file : DrawBackboneFigures(folder, test.identified)) {
-    add(figures.backbone, file);
+    Add(figures.backbone, prefix, file);
   }
   return figures;
 }
@@ -118,7 +120,7 @@ int WriteRunReport(const std::string& folder, const Scenario& scenario,
   for (const RunTest& test : tests) {
     TestFigureFiles figures;
     if (draw) {
-      const std::string prefix = several ? test.name + "/" : "";
+      const std::string prefix = TestFolderPrefix(test.name, tests.size());
       const fs::path test_folder = fs::path(folder) / prefix;
       fs::create_directories(test_folder);
       std::optional<TestFigureFiles> drawn = early ? early->Take(test.name) : std::nullopt;

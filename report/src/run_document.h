@@ -22,6 +22,10 @@ int WriteRunReport(const std::string& folder, const validation::Scenario& scenar
                    const std::vector<validation::RunTest>& tests, const std::string& verdict,
                    const std::function<void(const std::string&)>& say, EarlyRunFigures* early);
 
+// Where a test's figures go, relative to the run folder: "" for a run of one test, else its
+// own subfolder "<name>/".
+std::string TestFolderPrefix(const std::string& test_name, size_t test_count);
+
 // A test's record and identification figures into `folder` (the test's own: the run folder or
 // its subfolder), file names prefixed with `prefix` in the lists. Through the calling thread's
 // FigureBatch, if one is active.

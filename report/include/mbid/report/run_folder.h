@@ -31,15 +31,15 @@ class EarlyRunFigures {
   EarlyRunFigures& operator=(const EarlyRunFigures&) = delete;
 
   // Starts drawing `test`'s figures (it is copied) into the run folder, in the test's subfolder
-  // when the run has several tests (`test_count`). Does nothing without gnuplot.
+  // when the run has several tests (`test_count`). Draws nothing without gnuplot.
   void Start(const validation::RunTest& test, size_t test_count);
-  // The files of the test's figures once drawn (waits); nullopt if none were started for it.
-  // Rethrows a drawing error.
+  // The files of the test's figures once drawn (waits); nullopt if none were started for it or
+  // gnuplot is missing. Rethrows a drawing error.
   std::optional<TestFigureFiles> Take(const std::string& test_name);
 
  private:
   std::string folder_;
-  std::map<std::string, std::future<TestFigureFiles>> drawing_;
+  std::map<std::string, std::future<std::optional<TestFigureFiles>>> drawing_;
 };
 
 // Writes the results of a validation cycle into `folder` (an existing, empty folder, normally
