@@ -100,12 +100,6 @@ std::string FitFailure(const UpdateResult& fit) {
 
 }  // namespace
 
-UpdateResult FitCandidate(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
-                          const UpdateOptions& options, const GlobalSearchOptions* search) {
-  if (search == nullptr) return UpdateModel(model, tests, options);
-  return SearchGlobally(model, tests, options, "start", {}, *search).best;
-}
-
 std::vector<std::vector<std::string>> EnumerateRigidSets(const std::vector<std::string>& compliant,
                                                          int max_rigid) {
   std::vector<std::vector<std::string>> sets;
@@ -242,7 +236,7 @@ StructureRanking RankStructures(const std::vector<StructureCandidate>& candidate
       return;
     }
     try {
-      fit.fit = FitCandidate(*candidates[i].model, weighed, prepared[i]);
+      fit.fit = UpdateModel(*candidates[i].model, weighed, prepared[i]);
       fit.skipped = FitFailure(fit.fit);
     } catch (const InputError& error) {
       fit.skipped = error.what();
@@ -287,7 +281,7 @@ StructureRanking RankStructures(const std::vector<StructureCandidate>& candidate
         }
       }
       try {
-        const UpdateResult fit = FitCandidate(*candidates[i].model, others, loo);
+        const UpdateResult fit = UpdateModel(*candidates[i].model, others, loo);
         if (fit.termination == UpdateResult::Termination::kFailure) {
           failure[static_cast<size_t>(job)] = fit.message;
           return;

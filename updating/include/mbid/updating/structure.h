@@ -101,11 +101,6 @@ struct StructureRanking {
   double wall_time_s = 0;
 };
 
-// Route 2 on one candidate: the global search when `search` is given, else one local fit.
-UpdateResult FitCandidate(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
-                          const UpdateOptions& options,
-                          const GlobalSearchOptions* search = nullptr);
-
 // The subsets of `compliant` with 1 to `max_rigid` elements, smaller first, each in the order of
 // `compliant` (lexicographic among subsets of one size).
 std::vector<std::vector<std::string>> EnumerateRigidSets(const std::vector<std::string>& compliant,
