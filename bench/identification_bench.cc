@@ -11,9 +11,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
-#include <Eigen/SVD>
 #include <cmath>
 #include <complex>
 #include <cstdio>
@@ -23,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "mbid/common/eigen_decompositions.h"
 #include "mbid/common/error.h"
 #include "mbid/identification/identify.h"
 #include "mbid/identification/spectrum.h"

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -10,6 +9,7 @@
 #include <map>
 
 #include "mbid/campaign/campaign_case.h"
+#include "mbid/common/eigen_decompositions.h"
 #include "units.h"
 
 namespace mbid::campaign {

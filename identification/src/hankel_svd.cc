@@ -1,11 +1,11 @@
 #include "mbid/identification/hankel_svd.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "mbid/common/eigen_decompositions.h"
 #include "symmetric_eigen.h"
 
 namespace mbid::identification {

@@ -1,11 +1,11 @@
 #include "mbid/identification/prony_svd.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "mbid/common/eigen_decompositions.h"
 
 namespace mbid::identification {
 

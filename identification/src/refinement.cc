@@ -2,7 +2,6 @@
 
 #include <ceres/ceres.h>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
 #include <array>
@@ -10,6 +9,7 @@
 #include <memory>
 
 #include "internal.h"
+#include "mbid/common/eigen_decompositions.h"
 #include "mbid/identification/modal_fit.h"
 
 namespace mbid::identification {

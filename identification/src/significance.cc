@@ -1,10 +1,11 @@
 #include "mbid/identification/significance.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "mbid/common/eigen_decompositions.h"
 
 namespace mbid::identification {
 namespace {
@@ -27,8 +28,8 @@ Eigen::VectorXd CalcSignificance(const AmplitudeFit& fit) {
   const Eigen::MatrixXd& gram = fit.gram;
   const Eigen::VectorXd scale =
       gram.diagonal().cwiseMax(std::numeric_limits<double>::min()).cwiseSqrt().cwiseInverse();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scale.asDiagonal() * gram *
-                                                       scale.asDiagonal());
+  const Eigen::MatrixXd scaled = scale.asDiagonal() * gram * scale.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
   const Eigen::VectorXd& d = eigen.eigenvalues();
   const Eigen::VectorXd inverse_d =
       (d.array() > 1e-14 * d.maxCoeff()).select(d.cwiseInverse(), 0.0);

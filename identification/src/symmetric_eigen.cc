@@ -1,11 +1,12 @@
 #include "symmetric_eigen.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <vector>
+
+#include "mbid/common/eigen_decompositions.h"
 
 namespace mbid::identification {
 namespace {

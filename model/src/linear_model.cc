@@ -1,10 +1,11 @@
 #include "mbid/model/linear_model.h"
 
 #include <Eigen/Dense>
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+#include "mbid/common/eigen_decompositions.h"
 
 namespace mbid::model {
 

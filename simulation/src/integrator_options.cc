@@ -1,9 +1,10 @@
 #include "mbid/simulation/integrator_options.h"
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <sstream>
 #include <utility>
+
+#include "mbid/common/eigen_decompositions.h"
 
 namespace mbid::simulation {
 namespace {

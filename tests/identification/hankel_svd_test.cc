@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "mbid/common/eigen_decompositions.h"
 #include "signals.h"
 
 namespace mbid::identification {

@@ -4,9 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include "mbid/common/eigen_decompositions.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/model/simbody.h"

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "characteristic_internal.h"
+#include "mbid/common/eigen_decompositions.h"
 #include "mbid/updating/characteristic.h"
 #include "statistics.h"
 

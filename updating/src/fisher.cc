@@ -1,12 +1,12 @@
 #include "mbid/updating/fisher.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
 #include "baseline.h"
+#include "mbid/common/eigen_decompositions.h"
 #include "mbid/common/error.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/simulation/sensitivity.h"

@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "fit_unknowns.h"
+#include "mbid/common/eigen_decompositions.h"
 #include "mbid/common/error.h"
 #include "prepared_test.h"
 #include "statistics.h"

@@ -1,7 +1,6 @@
 #include "mbid/updating/plan.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -9,6 +8,7 @@
 #include <exception>
 #include <thread>
 
+#include "mbid/common/eigen_decompositions.h"
 #include "mbid/common/error.h"
 #include "plan_internal.h"
 
