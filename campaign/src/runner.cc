@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "cluster.h"
+#include "commit_queue.h"
 #include "h5_merge.h"
 #include "mbid/campaign/campaign_case.h"
 #include "mbid/campaign/campaign_runner.h"
@@ -201,7 +202,7 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
   std::mutex wakeup_mutex;
   internal::WorkQueue queue(wakeup, summary.workers);
   internal::Tally tally;
-  std::atomic<int> running{summary.workers};
+  std::atomic<int> running{summary.workers + 1};
   std::mutex error_mutex;
   std::exception_ptr worker_error;
   // Taking the mutex before notifying makes the main thread's predicate wait race-free.
@@ -209,39 +210,65 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
     std::lock_guard<std::mutex> lock(wakeup_mutex);
     wakeup.notify_all();
   };
-  std::vector<std::thread> workers;
+  // Workers compute cases and hand them to one committer thread, which writes their files.
+  // `running` counts both: the campaign's threads are done when it is 0.
+  internal::CommitQueue commits(summary.workers);
+  std::atomic<int> computing{summary.workers};
+  std::vector<std::thread> threads;
+  const auto fail = [&] {
+    // Not a case's failure (those are results) but the campaign's: its files cannot be
+    // written. Stop taking and committing cases.
+    std::lock_guard<std::mutex> lock(error_mutex);
+    if (!worker_error) worker_error = std::current_exception();
+    queue.Close();
+    commits.Close();
+  };
   const auto work = [&] {
     try {
       while (const std::optional<int> index = queue.Pop()) {
-        const CaseOutcome outcome =
-            ComputeCase(campaign, campaign.cases[static_cast<size_t>(*index)]);
-        folder.CommitCase(outcome.id,
-                          [&outcome](const std::string& path) { WriteCaseFile(outcome, path); });
-        if (!outcome.ok()) ++tally.failed;
+        if (!commits.Push(ComputeCase(campaign, campaign.cases[static_cast<size_t>(*index)]))) {
+          break;
+        }
+      }
+    } catch (...) {
+      fail();
+    }
+    if (--computing == 0) commits.Close();
+    --running;
+    notify_main();
+  };
+  const auto commit = [&] {
+    try {
+      while (const std::optional<CaseOutcome> outcome = commits.Pop()) {
+        folder.CommitCase(outcome->id,
+                          [&outcome](const std::string& path) { WriteCaseFile(*outcome, path); });
+        if (!outcome->ok()) ++tally.failed;
         ++tally.done;
         notify_main();
       }
     } catch (...) {
-      // Not a case's failure (those are results) but the campaign's: its files cannot be
-      // written. Stop taking cases.
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (!worker_error) worker_error = std::current_exception();
-      queue.Close();
+      fail();
     }
     --running;
     notify_main();
   };
   try {
-    for (int w = 0; w < summary.workers; ++w) workers.emplace_back(work);
+    threads.emplace_back(commit);
+    for (int w = 0; w < summary.workers; ++w) threads.emplace_back(work);
   } catch (const std::system_error& error) {
     // Out of threads or memory for their stacks: stop the ones that started, then fail like any
     // other campaign error (a joinable std::thread left behind would call std::terminate).
-    const auto started = workers.size();
-    running -= summary.workers - static_cast<int>(started);
+    const int started = static_cast<int>(threads.size());
+    const int workers_started = std::max(0, started - 1);
+    running -= summary.workers + 1 - started;
+    computing -= summary.workers - workers_started;
     queue.Close();
-    for (std::thread& worker : workers) worker.join();
-    const std::string message = fmt::format("cannot start worker thread {} of {}: {}", started + 1,
-                                            summary.workers, error.what());
+    commits.Close();
+    for (std::thread& thread : threads) thread.join();
+    const std::string message =
+        started == 0 ? fmt::format("cannot start the thread that commits cases: {}", error.what())
+                     : fmt::format("cannot start worker thread {} of {}: {}", workers_started + 1,
+                                   summary.workers, error.what());
     if (cluster.size() > 1) {
       std::fprintf(stderr, "mbid: failure: rank %d: %s\n", cluster.rank(), message.c_str());
       cluster.Abort(1);
@@ -271,7 +298,7 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
     wakeup.wait_for(lock, cluster.poll_interval(),
                     [&] { return running.load() == 0 || tally.done.load() != seen_done; });
   }
-  for (std::thread& worker : workers) worker.join();
+  for (std::thread& thread : threads) thread.join();
   if (worker_error) std::rethrow_exception(worker_error);
   summary.ran = tally.done + cluster.remote_done();
   summary.cases_wall_s =
