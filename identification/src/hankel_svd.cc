@@ -1,5 +1,6 @@
 #include "mbid/identification/hankel_svd.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
@@ -70,12 +71,40 @@ int HankelSvd::CountSignal(double noise_floor_factor, double min_relative, int m
   return count;
 }
 
+void HankelSvd::ExtendShiftProducts(const Eigen::Ref<const Eigen::MatrixXd>& v, int order) const {
+  const int known = static_cast<int>(shift_gram_.cols());
+  if (order <= known) return;
+  const int l = columns() - 1;
+  const int added = order - known;
+  const auto v1 = v.topRows(l);
+  const auto v2 = v.bottomRows(l);
+  shift_gram_.conservativeResize(order, order);
+  shift_cross_.conservativeResize(order, order);
+  shift_gram_.rightCols(added) = v1.transpose() * v1.rightCols(added);
+  shift_gram_.bottomLeftCorner(added, known) = shift_gram_.topRightCorner(known, added).transpose();
+  shift_cross_.rightCols(added) = v1.transpose() * v2.rightCols(added);
+  shift_cross_.bottomLeftCorner(added, known) =
+      v1.rightCols(added).transpose() * v2.leftCols(known);
+}
+
 std::vector<std::complex<double>> HankelSvd::CalcPoles(int order) const {
   const int l = columns() - 1;
   // The right singular vectors are the Gram matrix's eigenvectors, computed as far as needed.
-  const Eigen::MatrixXd v = eigen_->LeadingVectors(order);
-  // V1 Z = V2 in the least-squares sense; eig(Z) are the discrete poles.
-  const Eigen::MatrixXd z = v.topRows(l).colPivHouseholderQr().solve(v.bottomRows(l));
+  const Eigen::Ref<const Eigen::MatrixXd> v = eigen_->LeadingVectors(order);
+  // V1 Z = V2 in the least-squares sense; eig(Z) are the discrete poles. V has orthonormal
+  // columns, so V1^T V1 = I - w w^T (w: V's last row) has its eigenvalues in [1 - |w|^2, 1]:
+  // while |w|^2 <= 1/2 the normal equations are as accurate as a QR of V1, and their matrices
+  // for every order are the leading blocks of one product (a QR per order was a third of an
+  // identification's stabilization data).
+  Eigen::MatrixXd z;
+  if (v.row(l).squaredNorm() <= 0.5) {
+    ExtendShiftProducts(v, order);
+    const Eigen::LLT<Eigen::MatrixXd> cholesky(shift_gram_.topLeftCorner(order, order));
+    if (cholesky.info() == Eigen::Success) {
+      z = cholesky.solve(shift_cross_.topLeftCorner(order, order));
+    }
+  }
+  if (z.size() == 0) z = v.topRows(l).colPivHouseholderQr().solve(v.bottomRows(l));
   Eigen::EigenSolver<Eigen::MatrixXd> eigen(z, /*computeEigenvectors=*/false);
   std::vector<std::complex<double>> mu(eigen.eigenvalues().data(),
                                        eigen.eigenvalues().data() + order);

@@ -56,8 +56,13 @@ class HankelSvd {
   std::vector<std::complex<double>> CalcPoles(int order) const;
 
  private:
+  // V1^T V1 and V1^T V2 of the leading singular vectors, extended to `order` columns.
+  void ExtendShiftProducts(const Eigen::Ref<const Eigen::MatrixXd>& v, int order) const;
+
   Eigen::VectorXd singular_values_;
   std::unique_ptr<SymmetricEigen> eigen_;  // of the Gram matrix
+  // The leading M x M blocks are the normal equations of every order M (ExtendShiftProducts).
+  mutable Eigen::MatrixXd shift_gram_, shift_cross_;
   Eigen::VectorXd channel_noise_std_;
   double noise_floor_ = 0;
   double noise_edge_ = 1;
