@@ -5,7 +5,10 @@
 //                      one committed)
 //   total_cases_per_s  cases over the whole command (folder checks, merge into campaign.h5,
 //                      summary.csv, report figures)
-//   efficiency         cases_per_s / (units * cases_per_s with 1 worker): the parallel efficiency
+//   efficiency         cases_per_s / (units * cases_per_s with 1 worker). Case files are committed
+//                      on a thread of their own, so 1 worker already overlaps writing with
+//                      computing on a second core: this understates what a second worker adds;
+//                      cpu_ratio is the fairer measure
 //   cpu_ms_per_case    CPU time (user + system, all threads or all ranks and mpiexec) of the
 //                      whole command per case: unlike rates, unaffected by other load on a
 //                      shared host
