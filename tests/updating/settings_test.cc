@@ -41,8 +41,11 @@ TEST(SettingsTest, DefaultsTuneEveryParameterFromTheModel) {
   EXPECT_EQ(settings.options.jacobian, UpdateOptions::Jacobian::kSensitivities);
   EXPECT_TRUE(settings.algebraic_start);
   EXPECT_TRUE(settings.noise_std.empty());
-  // An empty section is the defaults.
+  // An empty section is the defaults: cautious first steps from starts of unknown quality,
+  // Ceres-like ones from the sets that have the identified poles.
   EXPECT_EQ(Read("updating:\n", *crane.model).options.parameters.size(), 8u);
+  EXPECT_EQ(settings.options.initial_trust_region_radius, 10);
+  EXPECT_EQ(settings.global_search.matched_trust_region_radius, 1000);
 }
 
 TEST(SettingsTest, ReadsEveryKey) {
@@ -87,6 +90,8 @@ updating:
   EXPECT_EQ(o.undetermined_relative_std, 0.5);
   EXPECT_EQ(o.threads, 2);
   EXPECT_EQ(o.initial_trust_region_radius, 100);
+  // A radius the file gives holds for Route 1's starts too.
+  EXPECT_EQ(settings.global_search.matched_trust_region_radius, 100);
   EXPECT_EQ(o.continuation_fractions, (std::vector<double>{0.25, 0.5}));
   EXPECT_EQ(o.integrator.method, simulation::IntegratorOptions::Method::kAdams);
   EXPECT_EQ(o.integrator.relative_tolerance, 1e-7);

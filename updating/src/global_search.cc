@@ -63,6 +63,9 @@ bool GlobalSearchOptions::IsValid(std::string* why) const {
   }
   if (!(significance > 0 && significance < 1)) return fail("significance in (0, 1)");
   if (threads < 1) return fail("threads must be >= 1");
+  if (!(matched_trust_region_radius >= 0) || !std::isfinite(matched_trust_region_radius)) {
+    return fail("matched_trust_region_radius must be >= 0 and finite");
+  }
   return true;
 }
 
@@ -86,8 +89,16 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   }
   const std::vector<ParameterSetting> settings = ResolveParameterSettings(model, options);
 
+  // Options for a start: the matched radius where it has the identified poles.
+  const auto with_radius = [&search](UpdateOptions base, bool matches_poles) {
+    if (matches_poles && search.matched_trust_region_radius > 0) {
+      base.initial_trust_region_radius = search.matched_trust_region_radius;
+    }
+    return base;
+  };
   // The primary start: the options' own values (or the scenario's), fitted first and alone.
-  UpdateOptions primary = StartOptions(options, settings, {});
+  UpdateOptions primary =
+      with_radius(StartOptions(options, settings, {}), search.primary_matches_poles);
   if (!search.enabled) {
     result.best = UpdateModel(model, tests, primary);
     SearchMinimum only;
@@ -249,7 +260,8 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     std::vector<Run> fitted(promising.size());
     RunParallel(static_cast<int>(promising.size()), search.threads, [&](int i) {
       const SearchStart& start = promising[static_cast<size_t>(i)];
-      fitted[static_cast<size_t>(i)] = fit_full(start.label, start.values, local);
+      fitted[static_cast<size_t>(i)] =
+          fit_full(start.label, start.values, with_radius(local, start.matches_poles));
     });
     full.insert(full.end(), fitted.begin(), fitted.end());
     if (promising.size() < candidates.size()) {

@@ -267,6 +267,10 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
   options.threads = node.Int("threads", options.threads);
   options.initial_trust_region_radius =
       node.PositiveDouble("initial_trust_region_radius", options.initial_trust_region_radius);
+  // A radius the file gives holds for every start, Route 1's too.
+  if (node.Has("initial_trust_region_radius")) {
+    settings.global_search.matched_trust_region_radius = options.initial_trust_region_radius;
+  }
   if (node.Has("continuation_fractions")) {
     const YamlReader list = node.Child("continuation_fractions");
     if (!list.node().IsSequence()) {
@@ -342,6 +346,7 @@ std::vector<SearchStart> MakeAlgebraicStarts(const CharacteristicResult& algebra
     if (!set.admissible || (skip_chosen && static_cast<int>(s) == algebraic.chosen)) continue;
     SearchStart start;
     start.label = "route1 set " + std::to_string(s);
+    start.matches_poles = true;
     for (size_t i = 0; i < algebraic.coordinates.size(); ++i) {
       const Eigen::Index k = static_cast<Eigen::Index>(i);
       start.values["c_" + algebraic.coordinates[i]] = set.c[k];

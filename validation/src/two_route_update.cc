@@ -86,6 +86,7 @@ std::vector<updating::SearchStart> StartFromAlgebraicRoute(
     std::string why;
     from_route1 = updating::ApplyAlgebraicStart(*algebraic, settings->options, &why);
     if (from_route1) *start = "route1";
+    settings->global_search.primary_matches_poles = from_route1;
     if (!why.empty()) *note = note->empty() ? why : *note + "; " + why;
   }
   // Route 1 ran on as many poles as coordinates (SolveAlgebraicRoute) and solved: its sets are

@@ -49,6 +49,15 @@ struct GlobalSearchOptions {
   // Otherwise the sets with the best end's own poles (eq. 7 on its exact modes: joints that
   // trade roles) are fitted too; each is a candidate alternative the design may have missed.
   bool pole_equivalent_starts = true;
+  // Ceres' initial trust region radius for starts that have the identified poles: the given
+  // starts marked `matches_poles` (Route 1's sets) and the primary start when
+  // `primary_matches_poles` (set by the caller). They sit in the records' basin already, where
+  // the cautious first steps of UpdateOptions::initial_trust_region_radius, meant for starts of
+  // unknown quality, slow Gauss-Newton down (the reference crane: 5 -> 3 iterations, the same
+  // cost within 1e-7) or stop it early on a flat valley's slope (tests/updating/
+  // global_search_test.cc). 0: the options' own radius for every start.
+  double matched_trust_region_radius = 1e3;
+  bool primary_matches_poles = false;
 
   bool IsValid(std::string* why) const;
 };
@@ -57,6 +66,7 @@ struct GlobalSearchOptions {
 struct SearchStart {
   std::string label;  // "scenario", "route1 set 2", "design 5", ...
   std::map<std::string, double> values;
+  bool matches_poles = false;  // has the identified poles (GlobalSearchOptions)
 };
 
 // One distinct end point of the local fits.

@@ -46,7 +46,9 @@ namespace mbid::updating {
 //     max_chi_square_per_dof: 4            # above: the fit does not explain the records
 //     whiteness_lags: 20                   # Ljung-Box lags of the residual's whiteness
 //     threads: 1                           # parallel simulations (tests, sensitivity groups)
-//     initial_trust_region_radius: 10      # Ceres LM; small = cautious first steps
+//     initial_trust_region_radius: 10      # Ceres LM; small = cautious first steps; when not
+//                                          #   given, Route 1's sets start at 1000
+//                                          #   (GlobalSearchOptions::matched_trust_region_radius)
 //     continuation_fractions: []           # e.g. [0.25]: fit the first quarter of each record
 //                                          #   first, then the whole (fewer local minima)
 //     integrator:                          # the fit's simulations; default: the scenario's
