@@ -75,7 +75,7 @@ std::string GnuplotData(const Figure& figure);
 std::string GnuplotCommands(const Figure& figure, const std::string& data_path,
                             const std::string& png_path);
 
-// True if a gnuplot with the pngcairo terminal is on PATH.
+// True if a gnuplot with the pngcairo terminal is on PATH; checked once per process.
 bool GnuplotAvailable();
 
 }  // namespace mbid::report
