@@ -21,6 +21,7 @@
 #include "report.h"
 #include "results_folder.h"
 #include "summary_table.h"
+#include "write_in_child.h"
 
 namespace mbid::campaign {
 namespace {
@@ -105,7 +106,8 @@ int FinishCampaign(const Campaign& campaign, const internal::ResultsFolder& fold
       internal::WriteCampaignReport(campaign, rows, folder.Path(""), study);
 
   AtomicFile merged(folder.Path("campaign.h5"));
-  {
+  // In a child process: HDF5 crashes when the file system refuses its writes (write_in_child.h).
+  internal::WriteInChild(merged.path(), [&] {
     internal::DeterministicH5File file(merged.temp_path());
     file.CopyTree(info_path, "/", {});
     file.CreateGroup("/cases");
@@ -115,7 +117,7 @@ int FinishCampaign(const Campaign& campaign, const internal::ResultsFolder& fold
     }
     if (fs::exists(study_path)) file.CopyTree(study_path, "/", {"format", "format_version"});
     file.Close();
-  }
+  });
   CrashPoint("campaign-merge");
   merged.Commit();
   CrashPoint("campaign-merged");

@@ -316,6 +316,46 @@ TEST_F(OutputSafetyTest, AFullDiskIsAFailureAndLeavesNothing) {
   EXPECT_TRUE(Entries(work_).empty());
 }
 
+TEST_F(OutputSafetyTest, ACaseFileThatCannotBeWrittenEndsTheCampaignCleanly) {
+  // Case files are written by one committer thread while the workers compute: when it fails (a
+  // file-size limit, as a full disk), the workers must stop and the command end with the
+  // failure, not hang waiting to hand over their cases. 100 blocks (50 or 100 KiB by the
+  // shell's block size) hold the manifest, not a simulated case's file (about 150 kB).
+  const fs::path campaign =
+      Write("c.yaml", "name: c\nbase: " + kReference + "\nsteps: [simulate, identify]\n" +
+                          "sweep:\n  - grid:\n      simulation.duration_s: [4, 5, 6, 7, 8, 9]\n");
+  const CommandResult result = Run(
+      "campaign " + campaign.string() + " -o " + (work_ / "o").string() + " --workers 2 --quiet",
+      "ulimit -f 100 && ");
+  EXPECT_EQ(result.exit_code, 1) << result.err;  // not 153 (SIGXFSZ)
+  EXPECT_EQ(result.err.rfind("mbid: failure: cannot write ", 0), 0u) << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  EXPECT_TRUE(fs::exists(work_ / "o" / "campaign.json"));  // the folder stays resumable
+  EXPECT_FALSE(fs::exists(work_ / "o" / "campaign.h5"));
+}
+
+TEST_F(OutputSafetyTest, AMergeThatCannotBeWrittenIsAFailureAndResumable) {
+  // The cases' files fit, the merged campaign.h5 does not: HDF5 1.10.8 crashes (SIGSEGV in its
+  // object copy) when the file system refuses a write, so the merge runs in a child process
+  // and its crash is a failure with one line. 200 blocks (100 or 200 KiB) hold a modes-only
+  // case file (about 30 kB), not six of them merged.
+  const fs::path campaign =
+      Write("c.yaml", "name: c\nbase: " + kReference + "\nsweep:\n" +
+                          "  - grid:\n      simulation.duration_s: [4, 5, 6, 7, 8, 9]\n");
+  const std::string arguments =
+      "campaign " + campaign.string() + " -o " + (work_ / "o").string() + " --quiet";
+  const CommandResult full = Run(arguments + " --workers 2", "ulimit -f 200 && ");
+  EXPECT_EQ(full.exit_code, 1) << full.err;  // not 139 (SIGSEGV)
+  EXPECT_EQ(full.err.rfind("mbid: failure: cannot write ", 0), 0u) << full.err;
+  EXPECT_NE(full.err.find("campaign.h5"), std::string::npos) << full.err;
+  EXPECT_EQ(std::count(full.err.begin(), full.err.end(), '\n'), 1) << full.err;
+  EXPECT_FALSE(fs::exists(work_ / "o" / "campaign.h5"));
+  // With room again, --resume merges the committed cases.
+  const CommandResult resumed = Run(arguments + " --resume");
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_TRUE(fs::exists(work_ / "o" / "campaign.h5"));
+}
+
 TEST_F(OutputSafetyTest, AWorkerThreadThatCannotStartEndsTheCampaignCleanly) {
   // New threads get stacks of `ulimit -s` (2 GB here); in 3 GB of address space the second
   // cannot start. std::thread then throws, which once ended in std::terminate (exit 134).
