@@ -104,8 +104,8 @@ void CheckWritten(std::ofstream& out, const std::string& path) {
 }  // namespace
 
 bool GnuplotAvailable() {
-  // Asked once per process: the check starts gnuplot (about 40 ms), and `mbid run` asks on its
-  // early figures' thread and again in the report, after the fit, where users wait.
+  // Asked once per process: the check starts gnuplot (10-40 ms by the host), and `mbid run`
+  // asks on its early figures' thread and again in the report, after the fit, where users wait.
   static const bool available = Spawn({"gnuplot", "-e", "set terminal pngcairo"}, "/dev/null") == 0;
   return available;
 }
@@ -177,7 +177,9 @@ std::vector<std::unique_ptr<AtomicFile>> DrawGroup(
 // drawn.
 void DrawAll(const std::vector<std::pair<Figure, std::string>>& figures, int processes = 2) {
   if (figures.empty()) return;
-  constexpr size_t kParallelFrom = 4;
+  // A gnuplot start costs 10 ms on a quiet host, a figure 15-20 ms: two figures already pay
+  // for the second process (mbid run's last three: 85 -> 65 ms, docs/performance.md).
+  constexpr size_t kParallelFrom = 2;
   if (figures.size() < kParallelFrom || processes < 2) {
     for (const auto& png : DrawGroup(figures)) png->Commit();
     return;

@@ -60,7 +60,7 @@ class FigureBatch {
 
   void Add(const Figure& figure, const std::string& png_path);
   // Draws every figure added so far; each PNG is committed only if all were drawn. Throws as
-  // DrawFigure does. With 4 figures or more and `processes` 2, two gnuplot processes draw
+  // DrawFigure does. With 2 figures or more and `processes` 2, two gnuplot processes draw
   // alternate figures at once; 1 draws them all in one (beside other work).
   void Draw(int processes = 2);
 
