@@ -35,7 +35,6 @@ void WriteModelTruth(H5Writer& file, const model::MechanicalModel& model) {
   const model::LinearModel linear = model.Linearize();
   file.WriteStrings("/truth/linear_model", "coordinates", linear.coordinates);
   file.WriteStrings("/truth/linear_model", "outputs", linear.outputs);
-  file.WriteMatrix("/truth/linear_model", "M", linear.M, "kg*m^2");
   const std::vector<std::string> coordinate_units = model.coordinate_units();
   const bool angles = std::all_of(coordinate_units.begin(), coordinate_units.end(),
                                   [](const std::string& unit) { return unit == "rad"; });
