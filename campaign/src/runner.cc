@@ -17,11 +17,11 @@
 #include "mbid/common/atomic_file.h"
 #include "mbid/common/crash_point.h"
 #include "mbid/common/hdf5_io.h"
+#include "mbid/common/write_in_child.h"
 #include "progress.h"
 #include "report.h"
 #include "results_folder.h"
 #include "summary_table.h"
-#include "write_in_child.h"
 
 namespace mbid::campaign {
 namespace {
@@ -107,7 +107,7 @@ int FinishCampaign(const Campaign& campaign, const internal::ResultsFolder& fold
 
   AtomicFile merged(folder.Path("campaign.h5"));
   // In a child process: HDF5 crashes when the file system refuses its writes (write_in_child.h).
-  internal::WriteInChild(merged.path(), [&] {
+  WriteInChild(merged.path(), [&] {
     internal::DeterministicH5File file(merged.temp_path());
     file.CopyTree(info_path, "/", {});
     file.CreateGroup("/cases");

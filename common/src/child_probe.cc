@@ -20,6 +20,22 @@
 
 namespace mbid::internal {
 
+void PrepareCrashReportingChild() {
+  // A crash ends the child by its signal, whatever handler the parent installed (a sanitizer's,
+  // a host program's around the Python module), so that it is told as a crash.
+  for (int signal_number : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
+    std::signal(signal_number, SIG_DFL);
+  }
+  // The child leaves without exit handlers; its messages and core dumps are of no use.
+  const rlimit no_core{0, 0};
+  setrlimit(RLIMIT_CORE, &no_core);
+  const int null = open("/dev/null", O_WRONLY);
+  if (null >= 0) {
+    dup2(null, STDOUT_FILENO);
+    dup2(null, STDERR_FILENO);
+  }
+}
+
 void SurviveInChild(const std::string& path, const std::string& expected,
                     const std::string& library, const std::function<void()>& body) {
   // Off only to debug a crash in-process (docs/reliability.md).
@@ -43,19 +59,7 @@ void SurviveInChild(const std::string& path, const std::string& expected,
     pthread_mutexattr_init(&recursive);
     pthread_mutexattr_settype(&recursive, PTHREAD_MUTEX_RECURSIVE);
     pthread_mutex_init(H5Mutex().native_handle(), &recursive);
-    // A crash ends the child by its signal, whatever handler the parent installed (a
-    // sanitizer's, a host program's around the Python module), so that it is told as a crash.
-    for (int signal_number : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
-      std::signal(signal_number, SIG_DFL);
-    }
-    // The child leaves without exit handlers; its messages and core dumps are of no use.
-    const rlimit no_core{0, 0};
-    setrlimit(RLIMIT_CORE, &no_core);
-    const int null = open("/dev/null", O_WRONLY);
-    if (null >= 0) {
-      dup2(null, STDOUT_FILENO);
-      dup2(null, STDERR_FILENO);
-    }
+    PrepareCrashReportingChild();
     try {
       body();
     } catch (...) {

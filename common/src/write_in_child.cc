@@ -1,6 +1,5 @@
-#include "write_in_child.h"
+#include "mbid/common/write_in_child.h"
 
-#include <fcntl.h>
 #include <fmt/format.h>
 #include <sys/resource.h>
 #include <sys/statvfs.h>
@@ -8,14 +7,15 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <filesystem>
 #include <stdexcept>
 
-namespace mbid::campaign::internal {
+#include "internal.h"
+
+namespace mbid {
 namespace {
 
 // What the file system has left where `path` goes, and the file-size limit, for the message
@@ -57,17 +57,7 @@ void WriteInChild(const std::string& path, const std::function<void()>& write) {
   }
   if (child == 0) {
     close(message_pipe[0]);
-    // A crash ends the child by its signal, so that the parent can tell it; no core dump.
-    for (int signal_number : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
-      std::signal(signal_number, SIG_DFL);
-    }
-    const rlimit no_core{0, 0};
-    setrlimit(RLIMIT_CORE, &no_core);
-    const int null = open("/dev/null", O_WRONLY);
-    if (null >= 0) {
-      dup2(null, STDOUT_FILENO);
-      dup2(null, STDERR_FILENO);
-    }
+    internal::PrepareCrashReportingChild();
     int status = 0;
     try {
       write();
@@ -109,4 +99,4 @@ void WriteInChild(const std::string& path, const std::function<void()>& write) {
       fmt::format("cannot write {}: {}", path, message.empty() ? "its writer failed" : message));
 }
 
-}  // namespace mbid::campaign::internal
+}  // namespace mbid
