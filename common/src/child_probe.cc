@@ -21,6 +21,12 @@
 namespace mbid::internal {
 
 void PrepareCrashReportingChild() {
+  // The parent's lock came along, owned by a thread the child does not have; the child is
+  // single-threaded, so a fresh lock is safe (HDF5 calls in the child take it).
+  pthread_mutexattr_t recursive;
+  pthread_mutexattr_init(&recursive);
+  pthread_mutexattr_settype(&recursive, PTHREAD_MUTEX_RECURSIVE);
+  pthread_mutex_init(H5Mutex().native_handle(), &recursive);
   // A crash ends the child by its signal, whatever handler the parent installed (a sanitizer's,
   // a host program's around the Python module), so that it is told as a crash.
   for (int signal_number : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
@@ -53,12 +59,6 @@ void SurviveInChild(const std::string& path, const std::string& expected,
   const pid_t child = fork();
   if (child < 0) return;  // no process to spare: read as before rather than refuse the file
   if (child == 0) {
-    // The parent's lock came along, owned by a thread the child does not have; the child is
-    // single-threaded, so a fresh lock is safe (the reads in `body` take it).
-    pthread_mutexattr_t recursive;
-    pthread_mutexattr_init(&recursive);
-    pthread_mutexattr_settype(&recursive, PTHREAD_MUTEX_RECURSIVE);
-    pthread_mutex_init(H5Mutex().native_handle(), &recursive);
     PrepareCrashReportingChild();
     try {
       body();

@@ -88,12 +88,13 @@ inline void CheckReadable(const std::string& path, const std::string& expected) 
     throw InputError(path, "", std::string("cannot read: ") + std::strerror(error), expected);
 }
 
-// libhdf5 1.10 (and matio over it) can crash or loop for ever on a corrupt file, e.g. in its
-// global-heap reads of variable-length strings, and no check before a call can rule that out.
-// In a forked child: crash signals back to their default action (so that the parent sees the
-// crash), no core dump, standard output and error to /dev/null.
+// In a child forked while this thread held the HDF5 lock: a fresh HDF5 lock, crash signals back
+// to their default action (so that the parent sees the crash), no core dump, standard output and
+// error to /dev/null.
 void PrepareCrashReportingChild();
 
+// libhdf5 1.10 (and matio over it) can crash or loop for ever on a corrupt file, e.g. in its
+// global-heap reads of variable-length strings, and no check before a call can rule that out.
 // SurviveInChild runs `body` (the read) in a child process first and throws an InputError
 // ("<library> crashed reading the file", with `expected`) if the child crashes or does not
 // finish in time; a file it survives is then read in this process. Errors `body` throws are

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "hdf5_internal.h"
 #include "internal.h"
 
 namespace mbid {
@@ -43,6 +44,9 @@ void WriteInChild(const std::string& path, const std::function<void()>& write) {
     write();
     return;
   }
+  // Held across the fork, so that no thread of this process is inside HDF5 when the child's copy
+  // of the library is made (the child gets a fresh lock).
+  const internal::H5Lock lock(internal::H5Mutex());
   int message_pipe[2];
   if (pipe(message_pipe) != 0) {
     write();
