@@ -1,9 +1,10 @@
 #pragma once
 // Eigen's dense decompositions on MatrixXd, compiled once in mbid_common instead of in every
-// file that uses them: each costs 4-21 s of -O2 per translation unit (BDCSVD the most), which
-// was a sixth of a cold build. Include this header instead of <Eigen/Eigenvalues> or
-// <Eigen/SVD>; a decomposition of another matrix type (or from an expression, not a MatrixXd)
-// is still compiled where it is used, correctly but without the saving.
+// file that uses them: each costs 4-21 s of -O2 per translation unit (BDCSVD the most); compiled
+// once, a cold build takes 4% less CPU (docs/performance.md). Include this header instead of
+// <Eigen/Eigenvalues> or <Eigen/SVD>; a decomposition of another matrix type (or from an
+// expression, not a MatrixXd) is still compiled where it is used, correctly but without the
+// saving.
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
