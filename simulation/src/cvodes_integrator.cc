@@ -21,6 +21,7 @@
 
 #include "cvodes_integrator_impl.h"
 #include "mbid/common/error.h"
+#include "serial_vector_ops.h"
 
 namespace mbid::simulation {
 namespace {
@@ -196,6 +197,8 @@ void CvodesIntegrator::Impl::CreateSolver(int n) {
 
   y_.reset(N_VNew_Serial(n, context));
   if (!y_) throw NumericalError("CVODES", "N_VNew_Serial returned NULL");
+  // Before CVodeInit: CVODES' own vectors (and the sensitivities) are clones and share the ops.
+  internal::UseOptimizedSerialOps(y_.get());
   const SimTK::Vector& y0 = state_.getY();
   realtype* y = N_VGetArrayPointer(y_.get());
   for (int i = 0; i < n; ++i) y[i] = y0[i];
