@@ -2,6 +2,7 @@
 // equilibrium and the linearization.
 #include <Eigen/Dense>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -80,10 +81,24 @@ void MultibodyModel::Impl::CalcRestMatrices(RestMatrices& result) const {
   }
 }
 
+namespace {
+
+// A Simbody vector's elements as an array (SimTK's element access is an out-of-line call in
+// Debian's build); nullptr when empty.
+template <typename V>
+auto Elements(V& v) -> decltype(&v[0]) {
+  if (v.size() == 0) return nullptr;
+  if (!v.hasContiguousData()) throw std::logic_error("Simbody vector without contiguous data");
+  return &v[0];
+}
+
+}  // namespace
+
 MechanicalModel::StateDerivative MultibodyModel::MakeStateDerivative() const {
   struct Scratch {
     SimTK::Vector mobility_forces, residual, u_dot;
     SimTK::Vector_<SimTK::SpatialVec> body_forces;
+    const SimTK::Vector no_accelerations;  // u' = 0 for the inverse dynamics, made once
   };
   auto scratch = std::make_shared<Scratch>();
   return [&m = *impl_, scratch](const SimTK::State& state, double* y_dot) {
@@ -99,26 +114,28 @@ MechanicalModel::StateDerivative MultibodyModel::MakeStateDerivative() const {
       body[w.body] += SimTK::SpatialVec(r % w.force_G, w.force_G);
     }
     // Force::MobilityLinearSpring and MobilityLinearDamper: -c (q - q_0) - d u on the mobility.
-    const SimTK::Vector& q = state.getQ();
-    const SimTK::Vector& u = state.getU();
+    const double* q = Elements(state.getQ());
+    const double* u = Elements(state.getU());
+    double* f = Elements(mobility);
     for (const Impl::Coordinate& c : m.coordinate_data) {
       if (c.spring < 0) continue;
       const SimTK::Force::MobilityLinearSpring& spring = m.springs[static_cast<size_t>(c.spring)];
-      mobility[c.u] += -spring.getStiffness(state) * (q[c.q] - spring.getQZero(state)) -
-                       m.dampers[static_cast<size_t>(c.spring)].getDamping(state) * u[c.u];
+      f[c.u] += -spring.getStiffness(state) * (q[c.q] - spring.getQZero(state)) -
+                m.dampers[static_cast<size_t>(c.spring)].getDamping(state) * u[c.u];
     }
     AddExternalLoads(m.matter, m.external_load, m.locate_point, state, body, mobility);
     // u' = M^-1 (f_applied - f_inertial): Simbody's forward-dynamics operator needs the Dynamics
     // stage, its inverse dynamics (residual = f_inertial - f_applied at u' = 0) and M^-1 only
-    // Velocity.
-    m.matter.calcResidualForceIgnoringConstraints(state, mobility, body, SimTK::Vector(),
+    // Velocity. u' = -(M^-1 residual): M^-1's arithmetic is odd in its argument, bit for bit.
+    m.matter.calcResidualForceIgnoringConstraints(state, mobility, body, scratch->no_accelerations,
                                                   scratch->residual);
-    scratch->residual *= -1;
     m.matter.multiplyByMInv(state, scratch->residual, scratch->u_dot);
     const SimTK::Vector& q_dot = state.getQDot();
     const int nq = q_dot.size();
-    for (int i = 0; i < nq; ++i) y_dot[i] = q_dot[i];
-    for (int i = 0; i < scratch->u_dot.size(); ++i) y_dot[nq + i] = scratch->u_dot[i];
+    const double* q_dot_data = Elements(q_dot);
+    for (int i = 0; i < nq; ++i) y_dot[i] = q_dot_data[i];
+    const double* u_dot = Elements(scratch->u_dot);
+    for (int i = 0; i < scratch->u_dot.size(); ++i) y_dot[nq + i] = -u_dot[i];
   };
 }
 

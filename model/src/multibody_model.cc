@@ -254,9 +254,11 @@ namespace {
 std::pair<int, bool> ParseSpringParameter(const std::vector<std::string>& coordinates,
                                           const MachineDescription& machine,
                                           const std::string& name, double value) {
-  for (size_t i = 0; i < coordinates.size(); ++i) {
-    const bool stiffness = name == "c_" + coordinates[i];
-    if (!stiffness && name != "d_" + coordinates[i]) continue;
+  // Compared in place: the sensitivities' input hook applies a parameter per quotient.
+  const bool prefixed = name.size() > 2 && name[1] == '_' && (name[0] == 'c' || name[0] == 'd');
+  for (size_t i = 0; prefixed && i < coordinates.size(); ++i) {
+    if (name.compare(2, std::string::npos, coordinates[i]) != 0) continue;
+    const bool stiffness = name[0] == 'c';
     if (machine.FindSpring(coordinates[i]) == nullptr) break;
     if (stiffness && !(std::isfinite(value) && value > 0)) {
       throw InputError("model", name, "stiffness " + std::to_string(value),
