@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "cvodes_integrator_impl.h"
+#include "dense_solve.h"
 #include "mbid/common/error.h"
 #include "serial_vector_ops.h"
 
@@ -223,6 +224,7 @@ void CvodesIntegrator::Impl::CreateSolver(int n) {
     if (!matrix_) throw NumericalError("CVODES", "SUNDenseMatrix returned NULL");
     linear_solver_.reset(SUNLinSol_Dense(y_.get(), matrix_.get(), context));
     if (!linear_solver_) throw NumericalError("CVODES", "SUNLinSol_Dense returned NULL");
+    internal::UseOptimizedDenseSolve(linear_solver_.get());
     const int flag = CVodeSetLinearSolver(cv, linear_solver_.get(), matrix_.get());
     if (flag != CVLS_SUCCESS) {
       throw NumericalError("CVODES", "CVodeSetLinearSolver failed: " + LinearSolverFlagName(flag));
