@@ -244,7 +244,8 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
         try {
           start_costs[static_cast<size_t>(i)] =
               probe.continuation_fractions.empty()
-                  ? internal::CalcStartCost(model, weighted, at_start)
+                  ? internal::CalcStartCostUpTo(model, weighted, at_start,
+                                                kPromisingCostRatio * best_cost)
                   : UpdateModel(model, weighted, at_start).initial_cost;
         } catch (const std::exception&) {
           // A start whose simulation fails is not promising.

@@ -20,6 +20,16 @@ std::vector<std::vector<double>> SpaceFillingDesign(int count, int dimension, st
 // The tests cut to the first `fraction` of each record (the screening window).
 std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double fraction);
 
+// The share of each record a start's cost is first probed on.
+constexpr double kProbePrefix = 0.1;
+
+// The cost of the tests at `options`' start, or, when that exceeds `limit`, possibly only the
+// cost of the records' first kProbePrefix, which then already exceeds it (a lower bound where
+// every channel's noise is given and no baseline is projected out). Far starts (other Route-1
+// sets start thousands of times above the best) are decided on a tenth of a simulation.
+double CalcStartCostUpTo(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
+                         const UpdateOptions& options, double limit);
+
 // `options` with `settings` whose initial values are `values` where given (clamped to bounds).
 UpdateOptions StartOptions(const UpdateOptions& options,
                            const std::vector<ParameterSetting>& settings,

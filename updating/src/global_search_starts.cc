@@ -15,6 +15,7 @@
 #include "global_search_internal.h"
 #include "mbid/model/linear_model.h"
 #include "mbid/updating/characteristic.h"
+#include "output_error_fit.h"
 
 namespace mbid::updating::internal {
 namespace {
@@ -71,6 +72,27 @@ std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double frac
     test.record.values = test.record.values.topRows(kept).eval();
   }
   return window;
+}
+
+// With every channel's noise given and no baseline projected out, the cost is a sum of fixed
+// squares over the samples, so the records' first tenth bounds it from below.
+double CalcStartCostUpTo(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
+                         const UpdateOptions& options, double limit) {
+  bool bounded = true;
+  for (const TestRecord& test : tests) {
+    bounded = bounded && !test.fit_offsets;
+    for (const std::string& channel : test.record.channels) {
+      bounded = bounded && test.noise_std.count(channel) > 0;
+    }
+  }
+  if (!bounded) return CalcStartCost(model, tests, options);
+  const std::vector<TestRecord> prefix = Window(tests, kProbePrefix);
+  bool whole = true;
+  for (size_t i = 0; i < tests.size(); ++i) {
+    whole = whole && prefix[i].record.samples() == tests[i].record.samples();
+  }
+  const double prefix_cost = CalcStartCost(model, prefix, options);
+  return prefix_cost > limit || whole ? prefix_cost : CalcStartCost(model, tests, options);
 }
 
 UpdateOptions StartOptions(const UpdateOptions& options,
