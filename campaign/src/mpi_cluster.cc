@@ -53,9 +53,9 @@ class MpiCluster final : public Cluster {
   int remote_done() const override { return remote_done_; }
   int remote_failed() const override { return remote_failed_; }
   // Cases are fetched one per worker ahead, but a request and its answer each wait for a poll
-  // on their side: at 10 ms the two could outlast a case (about 18 ms on the reference crane)
-  // and 2 ranks ran 91-98 cases/s against 108-111 for 2 threads; at 2 ms they run 103-110, for
-  // no measurable CPU (an MPI_Iprobe or MPI_Test per poll).
+  // on their side: at 10 ms the two could outlast a case (about 18 ms on the reference crane),
+  // and 2 ranks ran 88-96 cases/s where 2 threads ran 103-114; at 2 ms they run 98-108, for no
+  // measurable CPU (an MPI_Iprobe or MPI_Test per poll; docs/performance.md).
   std::chrono::milliseconds poll_interval() const override { return std::chrono::milliseconds(2); }
   [[noreturn]] void Abort(int exit_code) override {
     MPI_Abort(MPI_COMM_WORLD, exit_code);
