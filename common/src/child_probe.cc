@@ -44,10 +44,7 @@ void PrepareCrashReportingChild() {
 
 void SurviveInChild(const std::string& path, const std::string& expected,
                     const std::string& library, const std::function<void()>& body) {
-  // Off only to debug a crash in-process (docs/reliability.md).
-  if (const char* off = std::getenv("MBID_NO_CHILD_PROBE"); off != nullptr && *off != '\0') {
-    return;
-  }
+  if (ChildProcessesOff()) return;
   std::error_code error;
   const auto bytes = std::filesystem::file_size(path, error);
   // 5 s, plus 1 s per 20 MB: far more than an intact file needs.

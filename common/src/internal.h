@@ -88,6 +88,13 @@ inline void CheckReadable(const std::string& path, const std::string& expected) 
     throw InputError(path, "", std::string("cannot read: ") + std::strerror(error), expected);
 }
 
+// MBID_NO_CHILD_PROBE is set (non-empty): HDF5 reads and writes run in this process, to debug a
+// crash in-process (docs/reliability.md).
+inline bool ChildProcessesOff() {
+  const char* off = std::getenv("MBID_NO_CHILD_PROBE");
+  return off != nullptr && *off != '\0';
+}
+
 // In a child forked while this thread held the HDF5 lock: a fresh HDF5 lock, crash signals back
 // to their default action (so that the parent sees the crash), no core dump, standard output and
 // error to /dev/null.

@@ -40,7 +40,7 @@ std::string SpaceLeft(const std::string& path) {
 }  // namespace
 
 void WriteInChild(const std::string& path, const std::function<void()>& write) {
-  if (const char* off = std::getenv("MBID_NO_CHILD_PROBE"); off != nullptr && *off != '\0') {
+  if (internal::ChildProcessesOff()) {
     write();
     return;
   }

@@ -10,6 +10,7 @@
 #include "mbid/model/model_factory.h"
 #include "mbid/simulation/scenario_sections.h"
 #include "mbid/simulation/simulate.h"
+#include "mbid/updating/output_error.h"
 
 namespace mbid::updating::testing {
 
@@ -43,6 +44,16 @@ inline Measurement SimulateExact(const Crane& crane, double duration_s, double r
   sensors.sample_rate_hz = rate_hz;
   sensors.channels = crane.sensors.channels;
   return simulation::Simulate(*crane.model, crane.excitation, options, sensors).exact;
+}
+
+// A test `name` of `duration_s` simulated from the crane and measured by its sensors (their noise
+// and seed), to be weighed with that noise.
+inline TestRecord SimulateTest(const Crane& crane, const std::string& name, double duration_s) {
+  simulation::SimulationOptions options = crane.simulation;
+  options.duration_s = duration_s;
+  const simulation::SimulationResult run =
+      simulation::Simulate(*crane.model, crane.excitation, options, crane.sensors);
+  return {name, run.measured, crane.excitation, crane.sensors.noise_std};
 }
 
 }  // namespace mbid::updating::testing

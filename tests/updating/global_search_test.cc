@@ -9,7 +9,6 @@
 #include <random>
 
 #include "crane_fixture.h"
-#include "mbid/simulation/sensor.h"
 #include "mbid/updating/credibility.h"
 
 namespace mbid::updating {
@@ -40,12 +39,8 @@ struct LoadDrop {
   Crane crane = LoadCrane(testing::kLoadDropScenario);
   TestRecord test;
   LoadDrop(double duration_s) {
-    simulation::SimulationOptions simulation = crane.simulation;
-    simulation.duration_s = duration_s;
     crane.sensors.seed = 3;
-    const simulation::SimulationResult run =
-        simulation::Simulate(*crane.model, crane.excitation, simulation, crane.sensors);
-    test = {"load drop", run.measured, crane.excitation, crane.sensors.noise_std};
+    test = testing::SimulateTest(crane, "load drop", duration_s);
   }
   UpdateOptions Options() const {
     UpdateOptions options = DesignModel(*crane.model);
@@ -164,12 +159,8 @@ struct NearStart {
   NearStart(const std::string& scenario, double duration_s,
             const std::map<std::string, double>& factor)
       : crane(LoadCrane(scenario)) {
-    simulation::SimulationOptions simulation = crane.simulation;
-    simulation.duration_s = duration_s;
     crane.sensors.seed = 3;
-    const simulation::SimulationResult run =
-        simulation::Simulate(*crane.model, crane.excitation, simulation, crane.sensors);
-    test = {"decay", run.measured, crane.excitation, crane.sensors.noise_std};
+    test = testing::SimulateTest(crane, "decay", duration_s);
     options = DesignModel(*crane.model);
     options.integrator = crane.simulation.integrator;
     options.integrator.interpolate_outputs = true;

@@ -20,11 +20,8 @@ struct Probe {
   TestRecord test;
   UpdateOptions options;
   Probe() {
-    simulation::SimulationOptions simulation = crane.simulation;
-    simulation.duration_s = 3.0;  // 301 samples: the first tenth is 50 (Window's least)
-    const simulation::SimulationResult run =
-        simulation::Simulate(*crane.model, crane.excitation, simulation, crane.sensors);
-    test = {"load drop", run.measured, crane.excitation, crane.sensors.noise_std};
+    // 301 samples: the first tenth is 50 (Window's least).
+    test = testing::SimulateTest(crane, "load drop", 3.0);
     options.integrator = crane.simulation.integrator;
     options.integrator.interpolate_outputs = true;
     options.quiet = true;

@@ -118,12 +118,7 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   // tied to the search's would change the bits with it.
   primary.threads = options.threads;
   std::vector<TestRecord> weighted = tests;
-  bool all_given = true;
-  for (const TestRecord& test : tests) {
-    for (const std::string& channel : test.record.channels) {
-      all_given = all_given && test.noise_std.count(channel) > 0;
-    }
-  }
+  const bool all_given = internal::EveryNoiseGiven(tests);
 
   struct Run {
     std::string label;

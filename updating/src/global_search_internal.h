@@ -20,6 +20,9 @@ std::vector<std::vector<double>> SpaceFillingDesign(int count, int dimension, st
 // The tests cut to the first `fraction` of each record (the screening window).
 std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double fraction);
 
+// Whether every channel of every test has its noise level given (else fits estimate it).
+bool EveryNoiseGiven(const std::vector<TestRecord>& tests);
+
 // The share of each record a start's cost is first probed on.
 constexpr double kProbePrefix = 0.1;
 

@@ -74,17 +74,22 @@ std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double frac
   return window;
 }
 
+bool EveryNoiseGiven(const std::vector<TestRecord>& tests) {
+  for (const TestRecord& test : tests) {
+    for (const std::string& channel : test.record.channels) {
+      if (test.noise_std.count(channel) == 0) return false;
+    }
+  }
+  return true;
+}
+
 // With every channel's noise given and no baseline projected out, the cost is a sum of fixed
 // squares over the samples, so the records' first tenth bounds it from below.
 double CalcStartCostUpTo(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
                          const UpdateOptions& options, double limit) {
-  bool bounded = true;
-  for (const TestRecord& test : tests) {
-    bounded = bounded && !test.fit_offsets;
-    for (const std::string& channel : test.record.channels) {
-      bounded = bounded && test.noise_std.count(channel) > 0;
-    }
-  }
+  const bool bounded =
+      EveryNoiseGiven(tests) &&
+      std::none_of(tests.begin(), tests.end(), [](const TestRecord& t) { return t.fit_offsets; });
   if (!bounded) return CalcStartCost(model, tests, options);
   const std::vector<TestRecord> prefix = Window(tests, kProbePrefix);
   bool whole = true;
