@@ -28,6 +28,8 @@ void EarlyRunFigures::Start(const validation::RunTest& test, size_t test_count) 
         FigureBatch batch;  // this thread's own
         TestFigureFiles files = DrawIdentificationFigures(test_folder, prefix, test);
         batch.Draw(1);  // one gnuplot process: the updating runs on the other core
+        // The last figures wait for the updating's end; their two processes start meanwhile.
+        PrepareGnuplot(2);
         return files;
       });
 }

@@ -11,11 +11,13 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
+#include "gnuplot_standby.h"
 #include "mbid/common/atomic_file.h"
 #include "mbid/common/interrupt_cleanup.h"
 
@@ -103,6 +105,10 @@ void CheckWritten(std::ofstream& out, const std::string& path) {
 
 }  // namespace
 
+void PrepareGnuplot(int processes) {
+  if (GnuplotAvailable()) internal::StartStandbyGnuplot(processes);
+}
+
 bool GnuplotAvailable() {
   // Asked once per process: the check starts gnuplot (10-40 ms by the host), and `mbid run`
   // asks on its early figures' thread and again in the report, after the fit, where users wait.
@@ -154,17 +160,25 @@ std::vector<std::unique_ptr<AtomicFile>> DrawGroup(
   const std::string what =
       figures.size() == 1 ? named
                           : fmt::format("{} and {} other figure(s)", named, figures.size() - 1);
-  const int status = Spawn({"gnuplot", AsArgument(script_file.path())}, log.path());
-  if (status < 0) {
-    throw std::runtime_error("cannot start gnuplot for " + what + ": " + std::strerror(errno));
+  std::string messages;
+  int status = -1;
+  if (const std::optional<internal::StandbyGnuplot> standby = internal::TakeStandbyGnuplot()) {
+    status = internal::RunStandby(*standby, "load " + Quote(script_file.path()), &messages);
   }
-  if (status != 0)
-    throw std::runtime_error("gnuplot failed on " + what + ": " + ReadLog(log.path()));
+  if (status < 0) {
+    messages.clear();
+    status = Spawn({"gnuplot", AsArgument(script_file.path())}, log.path());
+    if (status < 0) {
+      throw std::runtime_error("cannot start gnuplot for " + what + ": " + std::strerror(errno));
+    }
+    messages = ReadLog(log.path());
+  }
+  if (status != 0) throw std::runtime_error("gnuplot failed on " + what + ": " + messages);
   for (size_t i = 0; i < figures.size(); ++i) {
     std::error_code ignored;
     if (std::filesystem::file_size(pngs[i]->temp_path(), ignored) == 0 || ignored) {
       // gnuplot reports a failed write of its output on standard error but exits with 0.
-      const std::string text = ReadLog(log.path());
+      const std::string& text = messages;
       throw std::runtime_error("cannot write " + figures[i].second + ": gnuplot wrote no figure (" +
                                (text.empty() ? "no message" : text) + ")");
     }
@@ -172,41 +186,51 @@ std::vector<std::unique_ptr<AtomicFile>> DrawGroup(
   return pngs;
 }
 
-// Figures are drawn by two gnuplot processes at once when there are enough of them to pay for
-// the second start (measured in docs/performance.md); each PNG is committed only when all were
-// drawn.
-void DrawAll(const std::vector<std::pair<Figure, std::string>>& figures, int processes = 2) {
-  if (figures.empty()) return;
-  // A gnuplot start costs 10 ms on a quiet host, a figure 15-20 ms: two figures already pay
-  // for the second process (mbid run's last three: 85 -> 65 ms, docs/performance.md).
-  constexpr size_t kParallelFrom = 2;
-  if (figures.size() < kParallelFrom || processes < 2) {
-    for (const auto& png : DrawGroup(figures)) png->Commit();
-    return;
-  }
-  std::vector<std::pair<Figure, std::string>> halves[2];
-  for (size_t i = 0; i < figures.size(); ++i) halves[i % 2].push_back(figures[i]);
-  std::vector<std::unique_ptr<AtomicFile>> second;
-  std::exception_ptr second_error;
-  std::thread other([&] {
-    try {
-      second = DrawGroup(halves[1]);
-    } catch (...) {
-      second_error = std::current_exception();
+using Drawn = std::vector<std::unique_ptr<AtomicFile>>;
+
+}  // namespace
+
+// Figures drawn by one or two gnuplot processes, each group on a thread of its own, so that the
+// caller can go on meanwhile; each PNG is committed only when all were drawn.
+struct internal::FigureDrawing {
+  std::vector<std::future<Drawn>> groups;
+
+  FigureDrawing(const std::vector<std::pair<Figure, std::string>>& figures, int processes) {
+    if (figures.empty()) return;
+    // A gnuplot start costs 10 ms on a quiet host, a figure 15-20 ms: two figures already pay
+    // for the second process (mbid run's last three: 85 -> 65 ms, docs/performance.md).
+    constexpr size_t kParallelFrom = 2;
+    const size_t count = figures.size() < kParallelFrom || processes < 2 ? 1 : 2;
+    for (size_t g = 0; g < count; ++g) {
+      std::vector<std::pair<Figure, std::string>> group;
+      for (size_t i = g; i < figures.size(); i += count) group.push_back(figures[i]);
+      groups.push_back(std::async(std::launch::async, DrawGroup, std::move(group)));
     }
-  });
-  std::vector<std::unique_ptr<AtomicFile>> first;
-  std::exception_ptr first_error;
-  try {
-    first = DrawGroup(halves[0]);
-  } catch (...) {
-    first_error = std::current_exception();
   }
-  other.join();
-  if (first_error) std::rethrow_exception(first_error);
-  if (second_error) std::rethrow_exception(second_error);
-  for (const auto& png : first) png->Commit();
-  for (const auto& png : second) png->Commit();
+
+  // Waits for every group (their threads must end before anything is thrown) and commits.
+  void Finish() {
+    std::vector<Drawn> drawn;
+    std::exception_ptr error;
+    for (std::future<Drawn>& group : groups) {
+      try {
+        drawn.push_back(group.get());
+      } catch (...) {
+        if (!error) error = std::current_exception();
+      }
+    }
+    groups.clear();
+    if (error) std::rethrow_exception(error);
+    for (const Drawn& pngs : drawn) {
+      for (const auto& png : pngs) png->Commit();
+    }
+  }
+};
+
+namespace {
+
+void DrawAll(const std::vector<std::pair<Figure, std::string>>& figures, int processes = 2) {
+  internal::FigureDrawing(figures, processes).Finish();
 }
 
 }  // namespace
@@ -277,6 +301,7 @@ void DrawFigure(const Figure& figure, const std::string& png_path) {
 
 FigureBatch::FigureBatch() : outer_(active_batch) { active_batch = this; }
 
+// A drawing not finished is waited for here (std::future's destructor) and its PNGs dropped.
 FigureBatch::~FigureBatch() { active_batch = outer_; }
 
 void FigureBatch::Add(const Figure& figure, const std::string& png_path) {
@@ -284,9 +309,21 @@ void FigureBatch::Add(const Figure& figure, const std::string& png_path) {
 }
 
 void FigureBatch::Draw(int processes) {
+  Start(processes);
+  Finish();
+}
+
+void FigureBatch::Start(int processes) {
+  Finish();
   std::vector<std::pair<Figure, std::string>> figures;
   figures.swap(figures_);
-  DrawAll(figures, processes);
+  drawing_ = std::make_unique<internal::FigureDrawing>(figures, processes);
+}
+
+void FigureBatch::Finish() {
+  if (!drawing_) return;
+  const std::unique_ptr<internal::FigureDrawing> drawing = std::move(drawing_);
+  drawing->Finish();
 }
 
 }  // namespace mbid::report

@@ -103,12 +103,12 @@ std::vector<ReferenceMode> KnownModes(const Scenario& scenario, const RunTest& t
 int WriteRunReport(const std::string& folder, const Scenario& scenario,
                    const model::MechanicalModel& model, const std::vector<model::Mode>& exact_modes,
                    const std::vector<RunTest>& tests, const std::string& verdict,
-                   const std::function<void(const std::string&)>& say, EarlyRunFigures* early) {
+                   const std::function<void(const std::string&)>& say, EarlyRunFigures* early,
+                   FigureBatch& batch) {
   const bool several = tests.size() > 1;
   const bool draw = GnuplotAvailable();
   if (!draw) say("gnuplot with pngcairo not found: the report has no figures");
   int figure_count = 0;
-  FigureBatch batch;  // every figure of the report in one gnuplot process, at the end
 
   std::ofstream report(fs::path(folder) / "report.md");
   report << "# mbid run: " << scenario.name << "\n\n";
@@ -176,8 +176,7 @@ int WriteRunReport(const std::string& folder, const Scenario& scenario,
            << TestsTableMarkdown(names, results) << "\n";
   }
   report << "## Verdict\n\n**" << verdict << "**\n";
-  batch.Draw();
-  if (draw) say(fmt::format("drew {} figures", figure_count));
+  batch.Start();
   return figure_count;
 }
 

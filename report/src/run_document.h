@@ -6,21 +6,23 @@
 
 #include "mbid/model/linear_model.h"
 #include "mbid/model/mechanical_model.h"
+#include "mbid/report/gnuplot.h"
 #include "mbid/report/run_folder.h"
 #include "mbid/validation/scenario.h"
 #include "mbid/validation/test_analysis.h"
 
 namespace mbid::report {
 
-// Draws the run's figures (gnuplot PNGs; a test's own subfolder when there are several) and
-// writes report.md into `folder`: per test the record, Table 1 with the known modes beside it,
-// Route 1's sets, Table 2 and the re-simulation; for several tests the Table 2 spread; the
-// verdict. Returns the number of figures drawn.
-// `early`, if given, has drawn some tests' record and identification figures already.
+// Writes report.md into `folder` and starts drawing its figures (gnuplot PNGs; a test's own
+// subfolder when there are several) through `batch`, whose Finish the caller calls: per test
+// the record, Table 1 with the known modes beside it, Route 1's sets, Table 2 and the
+// re-simulation; for several tests the Table 2 spread; the verdict. Returns the number of
+// figures. `early`, if given, has drawn some tests' record and identification figures already.
 int WriteRunReport(const std::string& folder, const validation::Scenario& scenario,
                    const model::MechanicalModel& model, const std::vector<model::Mode>& exact_modes,
                    const std::vector<validation::RunTest>& tests, const std::string& verdict,
-                   const std::function<void(const std::string&)>& say, EarlyRunFigures* early);
+                   const std::function<void(const std::string&)>& say, EarlyRunFigures* early,
+                   FigureBatch& batch);
 
 // Where a test's figures go, relative to the run folder: "" for a run of one test, else its
 // own subfolder "<name>/".

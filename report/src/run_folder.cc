@@ -1,5 +1,7 @@
 #include "mbid/report/run_folder.h"
 
+#include <fmt/format.h>
+
 #include <filesystem>
 #include <fstream>
 
@@ -7,6 +9,7 @@
 #include "mbid/common/json_io.h"
 #include "mbid/common/output_folder.h"
 #include "mbid/identification/modal_result.h"
+#include "mbid/report/gnuplot.h"
 #include "mbid/report/run_report.h"
 #include "mbid/updating/result_io.h"
 #include "mbid/validation/json_summaries.h"
@@ -137,6 +140,11 @@ int WriteRunFolder(const validation::CycleResult& cycle, const validation::Scena
   const std::vector<std::string>& reasons = cycle.reasons;
   const simulation::Excitation& excitation = cycle.excitation;
   const bool several = tests.size() > 1;
+  // The figures are drawn while run.h5 and summary.json are written.
+  FigureBatch figures;
+  const int figure_count =
+      WriteRunReport((folder / "").string(), scenario, *cycle.model, cycle.exact_modes, tests,
+                     cycle.verdict_line, say, early, figures);
   H5Writer run(folder / "run.h5");
   run.WriteScenarioYaml(scenario.yaml_text);
   const RunTest& first = tests.front();
@@ -203,9 +211,9 @@ int WriteRunFolder(const validation::CycleResult& cycle, const validation::Scena
   }
   summary["validation"] = validation;
 
-  const int figure_count = WriteRunReport((folder / "").string(), scenario, *cycle.model,
-                                          cycle.exact_modes, tests, cycle.verdict_line, say, early);
   WriteJson(summary, (folder / "summary.json").string());
+  figures.Finish();
+  if (GnuplotAvailable()) say(fmt::format("drew {} figures", figure_count));
   run.Commit();
   return figure_count;
 }

@@ -1,11 +1,16 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace mbid::report {
+
+namespace internal {
+struct FigureDrawing;
+}
 
 // One curve or point set of a figure.
 struct PlotSeries {
@@ -63,10 +68,17 @@ class FigureBatch {
   // DrawFigure does. With 2 figures or more and `processes` 2, two gnuplot processes draw
   // alternate figures at once; 1 draws them all in one (beside other work).
   void Draw(int processes = 2);
+  // Draw in two halves: Start has the figures added so far drawn on threads of their own and
+  // returns, so that the caller can write its other files meanwhile; Finish waits, commits the
+  // PNGs if all were drawn and throws as Draw does (nothing to do without a Start). A drawing
+  // not finished when the batch ends is waited for and its PNGs dropped.
+  void Start(int processes = 2);
+  void Finish();
 
  private:
   FigureBatch* outer_;
   std::vector<std::pair<Figure, std::string>> figures_;
+  std::unique_ptr<internal::FigureDrawing> drawing_;
 };
 
 // What DrawFigure gives gnuplot: the data file (one block per series, separated by two blank
@@ -77,5 +89,11 @@ std::string GnuplotCommands(const Figure& figure, const std::string& data_path,
 
 // True if a gnuplot with the pngcairo terminal is on PATH; checked once per process.
 bool GnuplotAvailable();
+
+// Starts up to `processes` gnuplot processes (fewer if that many already wait) that set up their
+// terminal at once and then wait for figures: the figures drawn later in this process skip
+// gnuplot's start, about half of a figure's time. For figures whose drawing users wait for, such
+// as `mbid run`'s last ones. Unused processes end with this one.
+void PrepareGnuplot(int processes);
 
 }  // namespace mbid::report
