@@ -111,8 +111,13 @@ TEST_F(RunRecordsTest, EachRecordIsTunedWithItsOwnExcitation) {
   const fs::path heavy =
       WriteVariant(base, "heavy.yaml", "  payload_mass_kg: 650.0", "  payload_mass_kg: 1300.0");
   ASSERT_EQ(Run("simulate " + heavy.string() + " -o " + (dir_ / "heavy.h5").string()).exit_code, 0);
+  // One local fit per record, from the scenario's values (the truth of both): what is checked
+  // here is the excitation each record is tuned with, and a record tuned with its neighbour's
+  // (the heavy drop as 650 kg) ends many standard deviations off in that fit too. The global
+  // search would add 12 s of design points.
   std::ofstream(base, std::ios::app) << "record:\n  - {name: light, file: light.h5}\n"
-                                     << "  - {name: heavy, file: heavy.h5}\n";
+                                     << "  - {name: heavy, file: heavy.h5}\n"
+                                     << "updating: {global_search: {enabled: false}}\n";
   const fs::path out = dir_ / "both";
   const CommandResult result = Run("run " + base.string() + " -o " + out.string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
