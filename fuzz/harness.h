@@ -18,16 +18,32 @@
 
 namespace mbid::fuzz {
 
+// A folder of this process, removed when the process ends normally (a crash leaves it, with
+// the input that crashed it).
+class ScratchFolder {
+ public:
+  ScratchFolder()
+      : path_(std::filesystem::temp_directory_path() /
+              ("mbid-fuzz-" + std::to_string(static_cast<long long>(getpid())))) {
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
 // `data` written to a file with the given extension (readers choose the format by it), in a
 // folder of this process so that parallel fuzzers do not share it.
 inline std::string WriteInput(const uint8_t* data, size_t size, const std::string& extension) {
-  static const std::filesystem::path folder = [] {
-    const auto path = std::filesystem::temp_directory_path() /
-                      ("mbid-fuzz-" + std::to_string(static_cast<long long>(getpid())));
-    std::filesystem::create_directories(path);
-    return path;
-  }();
-  const std::string path = (folder / ("input" + extension)).string();
+  static const ScratchFolder folder;
+  const std::string path = (folder.path() / ("input" + extension)).string();
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   out.close();
