@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -27,7 +28,9 @@ class TempDir {
   TempDir() {
     static std::atomic<int> counter{0};  // distinct names for several TempDirs in one test
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    const std::string test = info == nullptr ? "test" : std::string(info->name());
+    std::string test = info == nullptr ? "test" : std::string(info->name());
+    // A parameterized test's name is "Name/Param": one folder, not a folder left in another.
+    std::replace(test.begin(), test.end(), '/', '_');
     path_ = std::filesystem::temp_directory_path() /
             ("mbid_common_" + test + "_" + std::to_string(::getpid()) + "_" +
              std::to_string(counter++));
