@@ -21,8 +21,6 @@
 #include "mbid/common/atomic_file.h"
 #include "mbid/common/interrupt_cleanup.h"
 
-extern char** environ;
-
 namespace mbid::report {
 namespace {
 
@@ -48,20 +46,11 @@ int Spawn(const std::vector<std::string>& arguments, const std::string& log_path
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
                                    O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  // mbid blocks SIGINT/SIGTERM in its threads (interrupt_cleanup.h); the child must not inherit
-  // that, or Ctrl-C would not stop it.
-  posix_spawnattr_t attributes;
-  posix_spawnattr_init(&attributes);
-  sigset_t none;
-  sigemptyset(&none);
-  posix_spawnattr_setsigmask(&attributes, &none);
-  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
   std::vector<char*> argv;
   for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
   argv.push_back(nullptr);
   pid_t pid = 0;
-  const int error = posix_spawnp(&pid, argv[0], &actions, &attributes, argv.data(), environ);
-  posix_spawnattr_destroy(&attributes);
+  const int error = internal::SpawnUnblocked(&pid, actions, argv.data());
   posix_spawn_file_actions_destroy(&actions);
   if (error != 0) {
     errno = error;

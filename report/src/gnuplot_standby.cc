@@ -71,18 +71,10 @@ std::optional<StandbyGnuplot> Spawn() {
   posix_spawn_file_actions_adddup2(&actions, input[0], STDIN_FILENO);
   posix_spawn_file_actions_adddup2(&actions, output[1], STDOUT_FILENO);
   posix_spawn_file_actions_adddup2(&actions, output[1], STDERR_FILENO);
-  // Not mbid's blocked SIGINT/SIGTERM (interrupt_cleanup.h): Ctrl-C must stop gnuplot too.
-  posix_spawnattr_t attributes;
-  posix_spawnattr_init(&attributes);
-  sigset_t none;
-  sigemptyset(&none);
-  posix_spawnattr_setsigmask(&attributes, &none);
-  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
   char name[] = "gnuplot";
   char* argv[] = {name, nullptr};
   pid_t pid = -1;
-  const int error = posix_spawnp(&pid, name, &actions, &attributes, argv, environ);
-  posix_spawnattr_destroy(&attributes);
+  const int error = SpawnUnblocked(&pid, actions, argv);
   posix_spawn_file_actions_destroy(&actions);
   CloseQuietly(input[0]);
   CloseQuietly(output[1]);
@@ -149,6 +141,18 @@ Pool& ThePool() {
 }
 
 }  // namespace
+
+int SpawnUnblocked(pid_t* pid, const posix_spawn_file_actions_t& actions, char* const argv[]) {
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t none;
+  sigemptyset(&none);
+  posix_spawnattr_setsigmask(&attributes, &none);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
+  const int error = posix_spawnp(pid, argv[0], &actions, &attributes, argv, environ);
+  posix_spawnattr_destroy(&attributes);
+  return error;
+}
 
 void StartStandbyGnuplot(int count) { ThePool().Fill(count); }
 

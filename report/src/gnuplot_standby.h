@@ -1,6 +1,7 @@
 // gnuplot processes started ahead of the figures they will draw (gnuplot.h, PrepareGnuplot).
 #pragma once
 
+#include <spawn.h>
 #include <sys/types.h>
 
 #include <optional>
@@ -15,6 +16,11 @@ struct StandbyGnuplot {
   int input = -1;   // its standard input
   int output = -1;  // its standard output and error
 };
+
+// posix_spawnp of argv[0] with `actions`, the child's signal mask emptied: mbid blocks SIGINT
+// and SIGTERM in its threads (interrupt_cleanup.h), and a gnuplot that inherited that would not
+// stop at Ctrl-C. Returns posix_spawnp's error number (0 on success).
+int SpawnUnblocked(pid_t* pid, const posix_spawn_file_actions_t& actions, char* const argv[]);
 
 // Starts standby processes until `count` wait (at most that many are kept).
 void StartStandbyGnuplot(int count);
