@@ -9,6 +9,7 @@
 #include "mbid/validation/result_writers.h"
 #include "mbid/validation/scenario.h"
 #include "steps.h"
+#include "vectors.h"
 
 namespace mbid::campaign {
 using validation::LoadScenarioFromText;
@@ -21,7 +22,7 @@ namespace {
 
 using internal::Number;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using internal::kNaN;
 
 // A swept value in the row: a number when the scalar is one, otherwise its YAML text.
 nlohmann::ordered_json ValueJson(const YAML::Node& value) {

@@ -11,11 +11,12 @@
 #include "mbid/campaign/campaign.h"
 #include "mbid/campaign/campaign_case.h"
 #include "mbid/common/error.h"
+#include "vectors.h"
 
 namespace mbid::campaign {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using internal::kNaN;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kMaxBisections = 200;  // log2 of any range over any tolerance above 1e-15
 
@@ -82,9 +83,7 @@ class Evaluator {
   mutable std::map<double, Point> cache_;
 };
 
-Eigen::VectorXd ToVector(const std::vector<double>& values) {
-  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
-}
+using internal::ToVector;
 
 // A joint's curves from the cases' summary rows (the cases that swept its damper, in campaign
 // order); `damping` and `points` receive the sweep for the bisection.

@@ -7,6 +7,7 @@
 
 #include "mbid/campaign/damper_sizing.h"
 #include "mbid/report/gnuplot.h"
+#include "vectors.h"
 
 namespace mbid::campaign {
 using report::DrawFigure;
@@ -18,9 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Eigen::VectorXd ToVector(const std::vector<double>& values) {
-  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
-}
+using internal::ToVector;
 
 // The x range of a joint's figures: its sweep, padded on a log axis.
 std::string XRange(const DamperSizingSpec& spec, const JointSizing& joint) {

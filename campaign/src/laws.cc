@@ -11,11 +11,12 @@
 #include "mbid/campaign/campaign_case.h"
 #include "mbid/common/eigen_decompositions.h"
 #include "units.h"
+#include "vectors.h"
 
 namespace mbid::campaign {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using internal::kNaN;
 constexpr int kMaxDegree = 4;
 // Singular values of the scaled design matrix below this fraction of the largest mean the
 // cases do not determine the terms (variables that do not vary, too few distinct values).
@@ -91,9 +92,7 @@ PolynomialLaw Unfitted(PolynomialLaw law, const std::string& why) {
   return law;
 }
 
-Eigen::VectorXd ToVector(const std::vector<double>& values) {
-  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
-}
+using internal::ToVector;
 
 }  // namespace
 

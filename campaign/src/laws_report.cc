@@ -9,6 +9,7 @@
 #include "mbid/campaign/laws.h"
 #include "mbid/report/gnuplot.h"
 #include "units.h"
+#include "vectors.h"
 
 namespace mbid::campaign {
 using report::DrawFigure;
@@ -22,9 +23,7 @@ namespace fs = std::filesystem;
 constexpr int kMaxCurves = 4;  // curves per figure for the other variables' values
 constexpr int kCurvePoints = 101;
 
-Eigen::VectorXd ToVector(const std::vector<double>& values) {
-  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
-}
+using internal::ToVector;
 
 // The cases' values of the law's quantity against its first variable, the law and its
 // +-2 std band, drawn into `path`.

@@ -14,7 +14,7 @@ namespace {
 // y_(j+2) - 2 r cos(theta) y_(j+1) + r^2 y_j + (2 r cos(theta) - 1 - r^2) c = 0,
 // so eq. 3 with p = 2 has B1 = -2 r cos(theta), B2 = r^2, B0 = -(1 + B1 + B2) c, and the roots
 // of mu^2 + B1 mu + B2 are r e^(+-i theta): by hand, lambda = ln(r) / tau +- i theta / tau.
-struct OneMode {
+struct OneModeByHand {
   double tau = 0.1;        // s
   double decay = 0.5;      // 1/s
   double frequency = 1.0;  // Hz, damped
@@ -30,7 +30,7 @@ struct OneMode {
 };
 
 TEST(PronySvdTest, OneModeOrderTwoByHand) {
-  const OneMode mode;
+  const OneModeByHand mode;
   const double r = std::exp(-mode.decay * mode.tau);
   const double theta = 2 * M_PI * mode.frequency * mode.tau;
   const PronySvdSolution solution =
@@ -59,10 +59,10 @@ TEST(PronySvdTest, OneModeOrderTwoByHand) {
 }
 
 TEST(PronySvdTest, ConstantTermCarriesTheOffset) {
-  OneMode mode;
+  OneModeByHand mode;
   mode.offset = 0.7;
   const PronySvdSolution solution = SolvePronySvd(mode.Record(50), mode.tau, 2, 1e-12);
-  // B0 = -(1 + B1 + B2) c (see OneMode).
+  // B0 = -(1 + B1 + B2) c (see OneModeByHand).
   const double b1 = solution.B(0, 0);
   const double b2 = solution.B(0, 1);
   EXPECT_NEAR(solution.B0(0), -(1 + b1 + b2) * 0.7, 1e-10);

@@ -15,11 +15,11 @@
 namespace mbid::model {
 namespace {
 
-const std::string kReferenceScenario =
+const std::string kTruckCraneScenario =
     std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
 
 TruckCraneParameters ReferenceParameters() {
-  return ReadTruckCraneParameters(YamlReader::FromFile(kReferenceScenario).Child("model"));
+  return ReadTruckCraneParameters(YamlReader::FromFile(kTruckCraneScenario).Child("model"));
 }
 
 // The reference tables carry 10 significant digits and come from an independent implementation:

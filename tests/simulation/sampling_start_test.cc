@@ -15,17 +15,18 @@
 namespace mbid::simulation {
 namespace {
 
-const std::string kReference = std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
+const std::string kSamplingCraneYaml =
+    std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
 
-struct Crane {
+struct SampledCrane {
   std::unique_ptr<model::MechanicalModel> model;
   Excitation excitation;
   SimulationOptions simulation;
 };
 
-Crane LoadCrane() {
-  const YamlReader root = YamlReader::FromFile(kReference);
-  Crane crane;
+SampledCrane LoadSampledCrane() {
+  const YamlReader root = YamlReader::FromFile(kSamplingCraneYaml);
+  SampledCrane crane;
   crane.model = model::MakeModel(root.Child("model"));
   crane.excitation = ReadExcitation(root.Child("excitation"), *crane.model);
   crane.simulation = ReadSimulationOptions(root.Child("simulation"));
@@ -63,7 +64,7 @@ TEST(SamplingStartTest, WholeSampleStartKeepsTheBitsOfTheRecordFromThatSample) {
   // sample 7, and the burst from sample 60 (1.2 s, inside the forcing, which ends at 2 s) and
   // from sample 120 (after it): each the rows of today's record from t = 0, bit for bit.
   // A start 1e-9 tau off the grid (a printed time column) counts as the grid point.
-  Crane crane = LoadCrane();
+  SampledCrane crane = LoadSampledCrane();
   crane.simulation.duration_s = 3.0;
   const double tau = 1.0 / 50;
   for (const auto& [excitation, k] : {std::pair<Excitation, int>{crane.excitation, 7},
@@ -87,7 +88,7 @@ TEST(SamplingStartTest, SensitivitiesFollowTheSameSamples) {
   // same steps); with a start of 0.37 tau its values agree with Simulate's at the same times to
   // the integration error (another integrator: 1e-7 of the 1e-2 rad amplitude is far above the
   // 1e-8 tolerances' error and far below any sampling mistake, 0.37 tau of a 1.5 Hz swing ~ 4e-4).
-  Crane crane = LoadCrane();
+  SampledCrane crane = LoadSampledCrane();
   crane.simulation.duration_s = 2.0;
   const double tau = 1.0 / 50;
   const SensitivityOptions sensitivity;
@@ -120,7 +121,7 @@ TEST(SamplingStartTest, FractionalStartSamplesBetweenTheGridPoints) {
   // whose sample 100 j + 37 lies at the same time (j + 0.37) tau. Both are dense outputs of
   // CVODES, whose first step depends on the first output time: they agree to the integration
   // error (1e-7 rad of the 1e-2 rad swing, as above), not bit for bit.
-  Crane crane = LoadCrane();
+  SampledCrane crane = LoadSampledCrane();
   crane.simulation.duration_s = 2.0;
   const double tau = 1.0 / 50;
   const SimulationResult late =
@@ -147,7 +148,7 @@ TEST(SamplingStartTest, FractionalStartSamplesBetweenTheGridPoints) {
 }
 
 TEST(SamplingStartTest, RejectsAStartOutsideTheRecord) {
-  Crane crane = LoadCrane();
+  SampledCrane crane = LoadSampledCrane();
   crane.simulation.duration_s = 1.0;
   for (const double start : {-0.001, 1.5, std::nan("")}) {
     EXPECT_THROW(Simulate(*crane.model, crane.excitation, crane.simulation, Sensors(50.0, start)),

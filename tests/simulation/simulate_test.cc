@@ -18,10 +18,11 @@
 namespace mbid::simulation {
 namespace {
 
-const std::string kReference = std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
+const std::string kReferenceCraneYaml =
+    std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";
 
 model::TruckCraneParameters ReferenceParameters() {
-  return model::ReadTruckCraneParameters(YamlReader::FromFile(kReference).Child("model"));
+  return model::ReadTruckCraneParameters(YamlReader::FromFile(kReferenceCraneYaml).Child("model"));
 }
 
 SensorOptions NoiselessSensors(double rate_hz, std::vector<std::string> channels) {
@@ -309,7 +310,7 @@ TEST(SimulateTest, AutoRunsAdamsOnTheCraneAndBdfWithAHeavilyDampedJoint) {
 }
 
 TEST(SimulateTest, ReadsScenarioSections) {
-  const YamlReader root = YamlReader::FromFile(kReference);
+  const YamlReader root = YamlReader::FromFile(kReferenceCraneYaml);
   const model::MultibodyModel crane = model::MakeTruckCrane(ReferenceParameters());
   const Excitation excitation = ReadExcitation(root.Child("excitation"), crane);
   ASSERT_NE(excitation.get_if<InitialDeflection>(), nullptr);

@@ -11,11 +11,11 @@
 #include <string>
 
 #include "mbid/updating/characteristic.h"
+#include "nan.h"
 
 namespace mbid::updating::internal {
 
 using Complex = std::complex<double>;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string Format(double value);
 

@@ -14,7 +14,7 @@
 namespace mbid::updating {
 namespace {
 
-std::string Format(double value) {
+std::string FormatBrief(double value) {
   std::ostringstream out;
   out.precision(4);
   out << value;
@@ -65,9 +65,10 @@ FisherInformation CalcFisherInformation(const model::MechanicalModel& model, con
     const auto found = test.sensors.noise_std.find(channels[static_cast<size_t>(c)]);
     const double value = found == test.sensors.noise_std.end() ? 0.0 : found->second;
     if (!(value > 0) || !std::isfinite(value)) {
-      throw InputError(test.name, "noise_std." + channels[static_cast<size_t>(c)],
-                       found == test.sensors.noise_std.end() ? "no noise level" : Format(value),
-                       "a positive noise standard deviation per channel (the weights)");
+      throw InputError(
+          test.name, "noise_std." + channels[static_cast<size_t>(c)],
+          found == test.sensors.noise_std.end() ? "no noise level" : FormatBrief(value),
+          "a positive noise standard deviation per channel (the weights)");
     }
     sigma[c] = value;
   }
@@ -75,7 +76,7 @@ FisherInformation CalcFisherInformation(const model::MechanicalModel& model, con
   for (const std::string& name : parameters) {
     const double value = model.GetParameter(name);  // InputError for an unknown name
     if (!(value > 0)) {
-      throw InputError(test.name, name, Format(value),
+      throw InputError(test.name, name, FormatBrief(value),
                        "a positive parameter value (information in log coordinates)");
     }
     values.push_back(value);

@@ -14,14 +14,13 @@
 #include "fit_unknowns.h"
 #include "mbid/common/eigen_decompositions.h"
 #include "mbid/common/error.h"
+#include "nan.h"
 #include "prepared_test.h"
 #include "statistics.h"
 #include "test_evaluator.h"
 
 namespace mbid::updating::internal {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 class ProgressCallback final : public ceres::IterationCallback {
  public:

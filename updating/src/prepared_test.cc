@@ -6,13 +6,9 @@
 #include <string>
 
 #include "mbid/common/error.h"
+#include "nan.h"
 
 namespace mbid::updating::internal {
-namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-}  // namespace
 
 PreparedTest PrepareTest(const model::MechanicalModel& model, const TestRecord& test, int index,
                          const std::vector<Unknown>& unknowns, const UpdateOptions& options) {

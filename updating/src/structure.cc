@@ -16,11 +16,12 @@
 #include "mbid/common/error.h"
 #include "mbid/simulation/sensor.h"
 #include "mbid/simulation/simulate.h"
+#include "nan.h"
 
 namespace mbid::updating {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using internal::kNaN;
 
 // The candidate's options: only parameters its model has; starts from the reference's estimates
 // where asked; one thread per fit (the ranking runs fits side by side instead).

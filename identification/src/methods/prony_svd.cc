@@ -85,18 +85,18 @@ Estimate EstimatePronySvd(const AnalysisRecord& record, const IdentificationOpti
 }
 
 // Rows j = 0..s-p of eq. 3 must at least match the m p + 1 unknowns per channel.
-int MinimumSamples(const IdentificationOptions& options, int channels) {
+int PronyMinimumSamples(const IdentificationOptions& options, int channels) {
   return (channels + 1) * options.prony.order + 1;
 }
 
-std::string Requirement(const IdentificationOptions& options, int channels) {
+std::string PronyRequirement(const IdentificationOptions& options, int channels) {
   return fmt::format("order p = {} with {} channels", options.prony.order, channels);
 }
 
 }  // namespace
 
 MethodDefinition PronySvdMethod() {
-  return {"prony-svd", &MinimumSamples, &Requirement, &EstimatePronySvd};
+  return {"prony-svd", &PronyMinimumSamples, &PronyRequirement, &EstimatePronySvd};
 }
 
 }  // namespace mbid::identification
