@@ -65,8 +65,8 @@ Eigen::Vector3d Vector3(const YamlReader& parent, const std::string& key,
   return parent.Has(key) ? Vector3(parent, key, context) : fallback;
 }
 
-Eigen::Matrix3d Rotation(const YamlReader& parent, const std::string& key,
-                         const ExpressionContext& context) {
+Eigen::Matrix3d ReadRotation(const YamlReader& parent, const std::string& key,
+                             const ExpressionContext& context) {
   if (!parent.Has(key)) return Eigen::Matrix3d::Identity();
   const YamlReader list = parent.Child(key);
   if (list.node().IsNull()) return Eigen::Matrix3d::Identity();
@@ -136,9 +136,9 @@ JointDescription ReadJoint(const YamlReader& joint, const ExpressionContext& con
     }
   }
   result.in_parent_m = Vector3(joint, "in_parent_m", context, Eigen::Vector3d::Zero());
-  result.in_parent_rotation = Rotation(joint, "in_parent_rotation_deg", context);
+  result.in_parent_rotation = ReadRotation(joint, "in_parent_rotation_deg", context);
   result.in_body_m = Vector3(joint, "in_body_m", context, Eigen::Vector3d::Zero());
-  result.in_body_rotation = Rotation(joint, "in_body_rotation_deg", context);
+  result.in_body_rotation = ReadRotation(joint, "in_body_rotation_deg", context);
   return result;
 }
 

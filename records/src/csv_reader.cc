@@ -18,6 +18,7 @@
 #include "mbid/common/utf8.h"
 #include "number_marks.h"
 #include "readers.h"
+#include "text_util.h"
 
 namespace mbid::records::internal {
 namespace {
@@ -34,8 +35,6 @@ int PrintedPlace(const std::string& text, char decimal) {
   const int decimals = point < exponent_at ? static_cast<int>(exponent_at - point - 1) : 0;
   return exponent - decimals;
 }
-
-std::string LineField(int line) { return fmt::format("line {}", line); }
 
 // mbid's metadata comments: "# units: s,rad,rad", "# sample_interval_s: 0.01", "# source: x".
 struct Metadata {

@@ -21,12 +21,10 @@
 namespace mbid::records::internal {
 namespace {
 
-constexpr char kExpectedFile[] = "a LabVIEW measurement file (.lvm, docs/records-formats.md)";
+constexpr char kLvmFile[] = "a LabVIEW measurement file (.lvm, docs/records-formats.md)";
 constexpr char kEndOfHeader[] = "***End_of_Header***";
 
 enum class XColumns { kOne, kMulti, kNone };
-
-std::string LineField(int line) { return fmt::format("line {}", line); }
 
 // The decimal place of a number's last printed digit, as a power of ten: "0.0123" -> -4,
 // "1.5E-3" -> -4, "12" -> 0.
@@ -72,7 +70,7 @@ class LvmReader {
   RawTable Read() {
     if (lines_.empty() || TrimView(SplitFirst(lines_[0].text)) != "LabVIEW Measurement") {
       throw InputError(path_, LineField(1), "the first line is not 'LabVIEW Measurement'",
-                       kExpectedFile);
+                       kLvmFile);
     }
     ReadFileHeader();
     std::vector<Segment> segments;
@@ -474,7 +472,7 @@ class LvmReader {
 }  // namespace
 
 RawTable ReadLvm(const std::string& path) {
-  const std::string text = ReadWholeFile(path, kExpectedFile);
+  const std::string text = ReadWholeFile(path, kLvmFile);
   ValidateUtf8Text(text, path);
   return LvmReader(path, text).Read();
 }

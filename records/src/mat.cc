@@ -127,10 +127,10 @@ RawTable MatReader::Read() {
   CheckV5Structure();
   mat_.reset(Mat_Open(path_.c_str(), MAT_ACC_RDONLY));
   if (!mat_) {
-    throw InputError(path_, "", "not a MAT file matio can open", kExpectedFile);
+    throw InputError(path_, "", "not a MAT file matio can open", kMatFile);
   }
   if (Mat_GetVersion(mat_.get()) == MAT_FT_MAT4) {
-    throw InputError(path_, "", "a MATLAB v4 file (or not a MAT file at all)", kExpectedFile);
+    throw InputError(path_, "", "a MATLAB v4 file (or not a MAT file at all)", kMatFile);
   }
   ReadDirectory();
   if (infos_.count("mbid_layout")) return ReadMbidLayout();
@@ -147,7 +147,7 @@ InputError MatReader::VarError(const std::string& name, const std::string& probl
 void MatReader::ReadHead() {
   std::FILE* file = std::fopen(path_.c_str(), "rb");
   if (file == nullptr) {
-    throw InputError(path_, "", std::string("cannot open: ") + std::strerror(errno), kExpectedFile);
+    throw InputError(path_, "", std::string("cannot open: ") + std::strerror(errno), kMatFile);
   }
   char head[128];
   const size_t n = std::fread(head, 1, sizeof(head), file);
@@ -157,11 +157,10 @@ void MatReader::ReadHead() {
   const long size = std::ftell(file);
   std::fclose(file);
   if (failed) {
-    throw InputError(path_, "", std::string("cannot read: ") + std::strerror(error), kExpectedFile);
+    throw InputError(path_, "", std::string("cannot read: ") + std::strerror(error), kMatFile);
   }
   if (n < 128) {
-    throw InputError(path_, "", fmt::format("{} bytes, shorter than a MAT header", n),
-                     kExpectedFile);
+    throw InputError(path_, "", fmt::format("{} bytes, shorter than a MAT header", n), kMatFile);
   }
   file_size_ = size > 0 ? static_cast<double>(size) : 0.0;
 }
@@ -172,7 +171,7 @@ void MatReader::ReadDirectory() {
     MatVar var(Mat_VarReadNextInfo(mat_.get()));
     if (!var) break;
     if (order_.size() >= 100000) {
-      throw InputError(path_, "", "more than 100000 variables", kExpectedFile);
+      throw InputError(path_, "", "more than 100000 variables", kMatFile);
     }
     const std::string name = var->name != nullptr ? var->name : "";
     if (name.empty() || infos_.count(name)) continue;
@@ -186,7 +185,7 @@ void MatReader::ReadDirectory() {
     infos_[name] = std::move(info);
   }
   if (order_.empty()) {
-    throw InputError(path_, "", "no variables could be read", kExpectedFile);
+    throw InputError(path_, "", "no variables could be read", kMatFile);
   }
 }
 
@@ -354,7 +353,7 @@ RawTable ReadMat(const std::string& path) {
   // matio trusts much of a file (and libhdf5 under it, for v7.3, can crash on a corrupt one):
   // the whole read is tried in a child process first.
   SilenceMatio();
-  mbid::internal::SurviveInChild(path, kExpectedFile, "matio", [&] { MatReader(path).Read(); });
+  mbid::internal::SurviveInChild(path, kMatFile, "matio", [&] { MatReader(path).Read(); });
   return MatReader(path).Read();
 }
 

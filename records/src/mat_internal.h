@@ -21,7 +21,7 @@
 namespace mbid::records::internal {
 
 // Not inline: an internal-linkage constant per file (uff58's has the same name).
-constexpr char kExpectedFile[] = "a MATLAB .mat file, v5 or v7.3 (docs/records-formats.md)";
+constexpr char kMatFile[] = "a MATLAB .mat file, v5 or v7.3 (docs/records-formats.md)";
 constexpr char kMbidLayout[] = "mbid measurement 1";
 
 // Text from a file for a message: printable ASCII only, at most 64 characters.

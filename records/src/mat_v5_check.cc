@@ -176,7 +176,7 @@ class V5Check {
 // A v5 file (version 0x0100 at byte 124, endian mark "IM" or "MI" at 126): its arrays'
 // dimensions against their bytes, before matio trusts them.
 void MatReader::CheckV5Structure() {
-  const std::string bytes = ReadWholeFile(path_, kExpectedFile);
+  const std::string bytes = ReadWholeFile(path_, kMatFile);
   if (bytes.size() < 128) return;
   const bool little_mark = bytes[126] == 'I' && bytes[127] == 'M';
   const bool big_mark = bytes[126] == 'M' && bytes[127] == 'I';

@@ -79,4 +79,7 @@ inline std::string ReadWholeFile(const std::string& path, const std::string& exp
 // anything that size is allocated.
 inline constexpr long long kMaxSamples = 100000000;
 
+// The field of an error about a line of a text file: "line 12".
+inline std::string LineField(int line) { return "line " + std::to_string(line); }
+
 }  // namespace mbid::records::internal

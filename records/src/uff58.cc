@@ -20,7 +20,7 @@
 namespace mbid::records::internal {
 namespace {
 
-constexpr char kExpectedFile[] =
+constexpr char kUff58File[] =
     "a universal file of dataset 58 time responses (docs/records-formats.md)";
 
 // Record 7, field 1: the ordinate data types of dataset 58.
@@ -55,8 +55,6 @@ const char* DirectionText(long long direction) {
 
 bool IsDelimiter(std::string_view line) { return TrimView(line) == "-1"; }
 
-std::string LineField(int line) { return fmt::format("line {}", line); }
-
 RawTable Uff58Reader::Read() {
   // Datasets are framed by lines "    -1"; anything before the first frame is not UFF.
   bool seen_frame = false;
@@ -71,7 +69,7 @@ RawTable Uff58Reader::Read() {
     ReadDataset();
   }
   if (datasets_.empty()) {
-    throw InputError(path_, "", "no dataset 58 in the file", kExpectedFile);
+    throw InputError(path_, "", "no dataset 58 in the file", kUff58File);
   }
   return Combine();
 }
@@ -395,7 +393,7 @@ RawTable Uff58Reader::Combine() {
 }
 
 RawTable ReadUff58(const std::string& path) {
-  const std::string bytes = ReadWholeFile(path, kExpectedFile);
+  const std::string bytes = ReadWholeFile(path, kUff58File);
   return Uff58Reader(path, bytes).Read();
 }
 

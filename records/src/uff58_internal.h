@@ -62,8 +62,6 @@ class Lines {
 
 bool IsDelimiter(std::string_view line);
 
-std::string LineField(int line);
-
 // One dataset 58 as read: its time base and its ordinates.
 struct Dataset {
   std::string where;  // "dataset 2 (line 40)"

@@ -17,15 +17,9 @@ namespace {
 using testing::Crane;
 using testing::LoadCrane;
 
-const std::vector<std::string> kAllParameters{"c_alpha", "c_gamma", "c_eta", "c_theta",
-                                              "d_alpha", "d_gamma", "d_eta", "d_theta"};
+using testing::kAllParameters;
 
-std::string Sci(double value) {
-  std::ostringstream out;
-  out.precision(2);
-  out << std::scientific << value;
-  return out.str();
-}
+using testing::Sci;
 
 // Starts every stiffness at `c_factor` and every damping at `d_factor` times the truth.
 UpdateOptions StartOff(const Crane& crane, double c_factor, double d_factor) {

@@ -4,7 +4,9 @@
 // model, excitation and simulation, and records simulated from it.
 #include <cmath>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/model_factory.h"
@@ -13,6 +15,18 @@
 #include "mbid/updating/output_error.h"
 
 namespace mbid::updating::testing {
+
+// The reference crane's joint parameters, as the updating tunes them.
+inline const std::vector<std::string> kAllParameters{"c_alpha", "c_gamma", "c_eta", "c_theta",
+                                                     "d_alpha", "d_gamma", "d_eta", "d_theta"};
+
+// Measured numbers for the XML report (RecordProperty), in scientific notation.
+inline std::string Sci(double value) {
+  std::ostringstream out;
+  out.precision(2);
+  out << std::scientific << value;
+  return out.str();
+}
 
 inline const std::string kReferenceScenario =
     std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml";

@@ -14,19 +14,12 @@
 namespace mbid::updating {
 namespace {
 
-// Measured numbers for the XML report, in scientific notation.
-std::string Sci(double value) {
-  std::ostringstream out;
-  out.precision(2);
-  out << std::scientific << value;
-  return out.str();
-}
+using testing::Sci;
 
 using testing::Crane;
 using testing::LoadCrane;
 
-const std::vector<std::string> kAllParameters{"c_alpha", "c_gamma", "c_eta", "c_theta",
-                                              "d_alpha", "d_gamma", "d_eta", "d_theta"};
+using testing::kAllParameters;
 
 // Starts every stiffness at `c_factor` and every damping at `d_factor` times the truth.
 UpdateOptions StartOff(const model::MechanicalModel& model, double c_factor, double d_factor,

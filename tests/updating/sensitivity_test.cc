@@ -14,19 +14,12 @@
 namespace mbid::simulation {
 namespace {
 
-// Measured numbers for the XML report, in scientific notation.
-std::string Sci(double value) {
-  std::ostringstream out;
-  out.precision(2);
-  out << std::scientific << value;
-  return out.str();
-}
+using updating::testing::Sci;
 
 using updating::testing::Crane;
 using updating::testing::LoadCrane;
 
-const std::vector<std::string> kAllParameters{"c_alpha", "c_gamma", "c_eta", "c_theta",
-                                              "d_alpha", "d_gamma", "d_eta", "d_theta"};
+using updating::testing::kAllParameters;
 
 // The reference: Richardson-extrapolated central differences (4 D(h/2) - D(h)) / 3 with
 // h = 1e-3 of the value, simulated with Adams at 1e-12: truncation O(h^4) ~ 1e-12 and
