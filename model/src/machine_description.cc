@@ -9,12 +9,13 @@
 #include <map>
 #include <set>
 
+#include "degrees.h"
 #include "mbid/common/error.h"
 
 namespace mbid::model {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+using internal::kDegToRad;
 
 [[noreturn]] void Fail(const std::string& field, const std::string& problem,
                        const std::string& expected) {

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "degrees.h"
 #include "mbid/common/error.h"
 #include "mbid/model/multibody_model.h"
 #include "mbid/model/truck_crane_description.h"
@@ -22,7 +23,7 @@ double ReadMass(const YamlReader& reader, const std::string& key) {
   return mass_kg;
 }
 
-constexpr double kDegToRad = M_PI / 180.0;
+using internal::kDegToRad;
 
 Eigen::Vector3d ReadVector3(const YamlReader& node, const std::string& key) {
   const std::array<double, 3> v = node.Vector3(key);

@@ -3,18 +3,12 @@
 #include <cmath>
 #include <random>
 
+#include "channel_value.h"
 #include "mbid/common/error.h"
 #include "mbid/simulation/scenario_sections.h"
 
 namespace mbid::simulation {
-namespace {
-
-double Lookup(const std::map<std::string, double>& values, const std::string& key) {
-  const auto found = values.find(key);
-  return found == values.end() ? 0.0 : found->second;
-}
-
-}  // namespace
+using internal::ChannelValueOrZero;
 
 Measurement SynthesizeModalRecord(const ModalRecordSpec& spec, Measurement* exact,
                                   std::map<std::string, double>* noise_std) {
@@ -28,8 +22,8 @@ Measurement SynthesizeModalRecord(const ModalRecordSpec& spec, Measurement* exac
   clean.values = Eigen::MatrixXd::Zero(samples, static_cast<Eigen::Index>(spec.channels.size()));
   for (size_t c = 0; c < spec.channels.size(); ++c) {
     for (const ModalComponent& mode : spec.modes) {
-      const double amplitude = Lookup(mode.amplitude, spec.channels[c]);
-      const double phase = Lookup(mode.phase_rad, spec.channels[c]);
+      const double amplitude = ChannelValueOrZero(mode.amplitude, spec.channels[c]);
+      const double phase = ChannelValueOrZero(mode.phase_rad, spec.channels[c]);
       for (int j = 0; j < samples; ++j) {
         const double t = j * tau;
         clean.values(j, static_cast<Eigen::Index>(c)) +=
@@ -43,7 +37,7 @@ Measurement SynthesizeModalRecord(const ModalRecordSpec& spec, Measurement* exac
   std::normal_distribution<double> unit_normal(0.0, 1.0);
   if (noise_std != nullptr) noise_std->clear();
   for (size_t c = 0; c < spec.channels.size(); ++c) {
-    double std_dev = Lookup(spec.noise_std, spec.channels[c]);
+    double std_dev = ChannelValueOrZero(spec.noise_std, spec.channels[c]);
     const auto target = spec.target_correlation.find(spec.channels[c]);
     if (target != spec.target_correlation.end()) {
       const auto column = clean.values.col(static_cast<Eigen::Index>(c));

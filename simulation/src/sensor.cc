@@ -3,15 +3,10 @@
 #include <cmath>
 #include <random>
 
+#include "channel_value.h"
+
 namespace mbid::simulation {
-namespace {
-
-double Lookup(const std::map<std::string, double>& values, const std::string& channel) {
-  const auto found = values.find(channel);
-  return found == values.end() ? 0.0 : found->second;
-}
-
-}  // namespace
+using internal::ChannelValueOrZero;
 
 Measurement ApplySensor(const Measurement& clean, const SensorOptions& options) {
   Measurement measured = clean;
@@ -19,9 +14,9 @@ Measurement ApplySensor(const Measurement& clean, const SensorOptions& options) 
   std::normal_distribution<double> unit_normal(0.0, 1.0);
   for (int c = 0; c < clean.channel_count(); ++c) {
     const std::string& channel = clean.channels[c];
-    const double noise_std = Lookup(options.noise_std, channel);
-    const double bias = Lookup(options.bias, channel);
-    const double step = Lookup(options.quantization_step, channel);
+    const double noise_std = ChannelValueOrZero(options.noise_std, channel);
+    const double bias = ChannelValueOrZero(options.bias, channel);
+    const double step = ChannelValueOrZero(options.quantization_step, channel);
     for (int j = 0; j < clean.samples(); ++j) {
       // Draw even when noise_std = 0, so adding noise to one channel does not shift the others.
       double value = clean.values(j, c) + bias + noise_std * unit_normal(generator);

@@ -9,12 +9,10 @@
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/simulation/scenario_sections.h"
+#include "sample_count.h"
 
 namespace mbid::validation {
 namespace {
-
-// As the scenario's limit: 1e8 samples per channel is beyond any test this tool is for.
-constexpr double kMaxSamples = 1e8;
 
 bool IsSensorEffectKey(const std::string& key) {
   for (const char* base : {"noise_std", "bias", "quantization_step"}) {
@@ -111,18 +109,9 @@ CandidateFile ReadCandidateFile(const std::string& path, const Scenario& scenari
     candidate.test.sensors.noise_std = noise;
     candidate.test.sensors.bias.clear();
     candidate.test.sensors.quantization_step.clear();
-    const double samples =
-        std::floor(candidate.test.simulation.duration_s * candidate.test.sensors.sample_rate_hz +
-                   1e-9) +
-        1;
-    if (!(samples <= kMaxSamples && samples >= 2)) {
-      throw InputError(
-          path, entry.field() + ".simulation.duration_s, sensors.sample_rate_hz",
-          fmt::format("{:g} s at {:g} Hz is {:.3g} samples per channel",
-                      candidate.test.simulation.duration_s, candidate.test.sensors.sample_rate_hz,
-                      samples),
-          fmt::format("2 to {:g} samples (duration_s x sample_rate_hz + 1)", kMaxSamples));
-    }
+    internal::CheckSampleCount(
+        path, entry.field() + ".simulation.duration_s, sensors.sample_rate_hz",
+        candidate.test.simulation.duration_s, candidate.test.sensors.sample_rate_hz);
     file.candidates.push_back(std::move(candidate));
     file.own_noise.push_back(own_noise);
   }

@@ -12,6 +12,7 @@
 #include "mbid/model/model_factory.h"
 #include "mbid/simulation/scenario_sections.h"
 #include "mbid/validation/identification_settings.h"
+#include "sample_count.h"
 
 namespace mbid::validation {
 
@@ -51,10 +52,6 @@ Scenario LoadScenario(const std::string& path) {
   return LoadScenarioFromText(text.str(), path);
 }
 
-namespace {
-constexpr double kMaxSamples = 1e8;
-}  // namespace
-
 Scenario LoadScenarioFromText(const std::string& text, const std::string& source) {
   Scenario scenario{
       source, "", text, YamlReader::FromString(text, source), false, {}, {}, {}, {}, 0.95,
@@ -85,18 +82,9 @@ Scenario LoadScenarioFromText(const std::string& text, const std::string& source
   if (scenario.root.Has("sensors")) {
     scenario.sensors = simulation::ReadSensorOptions(scenario.root.Child("sensors"), *model);
   }
-  // The record's size before anything allocates it: 1e8 samples per channel (0.8 GB of doubles)
-  // is beyond any test this tool is for.
-  const double samples =
-      std::floor(scenario.simulation.duration_s * scenario.sensors.sample_rate_hz + 1e-9) + 1;
-  if (!(samples <= kMaxSamples && samples >= 2)) {
-    // Either key may be the wrong one; the message gives both values.
-    throw InputError(
-        scenario.root.source(), "simulation.duration_s, sensors.sample_rate_hz",
-        fmt::format("{:g} s at {:g} Hz is {:.3g} samples per channel",
-                    scenario.simulation.duration_s, scenario.sensors.sample_rate_hz, samples),
-        fmt::format("2 to {:g} samples (duration_s x sample_rate_hz + 1)", kMaxSamples));
-  }
+  internal::CheckSampleCount(scenario.root.source(),
+                             "simulation.duration_s, sensors.sample_rate_hz",
+                             scenario.simulation.duration_s, scenario.sensors.sample_rate_hz);
   if (scenario.root.Has("structure")) {
     const YamlReader structure = scenario.root.Child("structure");
     structure.ExpectMap({"alternatives"});
