@@ -63,6 +63,12 @@ int Spawn(const std::vector<std::string>& arguments, const std::string& log_path
   return status;
 }
 
+// The terminal of every figure; processes started ahead set it up for the default size.
+std::string TerminalCommand(const Figure& figure) {
+  return fmt::format("set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n",
+                     figure.width_px, figure.height_px);
+}
+
 // A path gnuplot cannot take for an option.
 std::string AsArgument(const std::string& path) {
   return !path.empty() && path[0] == '-' ? "./" + path : path;
@@ -95,7 +101,15 @@ void CheckWritten(std::ofstream& out, const std::string& path) {
 }  // namespace
 
 void PrepareGnuplot(int processes) {
-  if (GnuplotAvailable()) internal::StartStandbyGnuplot(processes);
+  if (!GnuplotAvailable()) return;
+  // The terminal of a figure of the default size, set up by drawing an empty plot into
+  // /dev/null; `reset` leaves the terminal as it is.
+  const std::string warm_up = TerminalCommand(Figure()) +
+                              "set output '/dev/null'\n"
+                              "set xrange [0:1]\nset yrange [0:1]\n"
+                              "plot 0.5 notitle\n"
+                              "unset output\nreset\n";
+  internal::StartStandbyGnuplot(processes, warm_up);
 }
 
 bool GnuplotAvailable() {
@@ -244,8 +258,7 @@ std::string GnuplotCommands(const Figure& figure, const std::string& data_path,
                             const std::string& png_path) {
   std::ostringstream script;
   script << "reset\n";
-  script << fmt::format("set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n",
-                        figure.width_px, figure.height_px);
+  script << TerminalCommand(figure);
   script << "set output " << Quote(png_path) << "\n";
   script << "set title " << Quote(figure.title) << "\n";
   script << "set xlabel " << Quote(figure.x_label) << "\n";

@@ -17,15 +17,6 @@ extern char** environ;
 namespace mbid::report::internal {
 namespace {
 
-// The terminal every figure of the report uses (GnuplotCommands), set up once by drawing an
-// empty plot into /dev/null; `reset` leaves the terminal as it is.
-constexpr char kWarmUp[] =
-    "set terminal pngcairo size 1000,420 font 'Sans,10' noenhanced\n"
-    "set output '/dev/null'\n"
-    "set xrange [0:1]\nset yrange [0:1]\n"
-    "plot 0.5 notitle\n"
-    "unset output\nreset\n";
-
 void CloseQuietly(int fd) {
   if (fd >= 0) ::close(fd);
 }
@@ -57,7 +48,7 @@ bool WriteAll(int fd, const std::string& text) {
   return ok;
 }
 
-std::optional<StandbyGnuplot> Spawn() {
+std::optional<StandbyGnuplot> Spawn(const std::string& warm_up) {
   // Close-on-exec: no other child of mbid may hold these pipes open.
   int input[2], output[2];
   if (::pipe2(input, O_CLOEXEC) != 0) return std::nullopt;
@@ -84,7 +75,7 @@ std::optional<StandbyGnuplot> Spawn() {
     return std::nullopt;
   }
   StandbyGnuplot process{pid, input[1], output[0]};
-  if (!WriteAll(process.input, kWarmUp)) {
+  if (!WriteAll(process.input, warm_up)) {
     CloseQuietly(process.input);
     CloseQuietly(process.output);
     while (::waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
@@ -108,10 +99,10 @@ class Pool {
     for (const StandbyGnuplot& process : waiting_) Dismiss(process);
   }
 
-  void Fill(int count) {
+  void Fill(int count, const std::string& warm_up) {
     std::lock_guard<std::mutex> lock(mutex_);
     while (static_cast<int>(waiting_.size()) < count) {
-      const std::optional<StandbyGnuplot> process = Spawn();
+      const std::optional<StandbyGnuplot> process = Spawn(warm_up);
       if (!process) return;
       waiting_.push_back(*process);
     }
@@ -154,7 +145,7 @@ int SpawnUnblocked(pid_t* pid, const posix_spawn_file_actions_t& actions, char* 
   return error;
 }
 
-void StartStandbyGnuplot(int count) { ThePool().Fill(count); }
+void StartStandbyGnuplot(int count, const std::string& warm_up) { ThePool().Fill(count, warm_up); }
 
 std::optional<StandbyGnuplot> TakeStandbyGnuplot() { return ThePool().Take(); }
 

@@ -22,8 +22,9 @@ struct StandbyGnuplot {
 // stop at Ctrl-C. Returns posix_spawnp's error number (0 on success).
 int SpawnUnblocked(pid_t* pid, const posix_spawn_file_actions_t& actions, char* const argv[]);
 
-// Starts standby processes until `count` wait (at most that many are kept).
-void StartStandbyGnuplot(int count);
+// Starts standby processes until `count` wait (at most that many are kept); each runs
+// `warm_up` at once (its terminal's set-up).
+void StartStandbyGnuplot(int count, const std::string& warm_up);
 
 // A waiting process, if one is still alive; the caller runs it with RunStandby.
 std::optional<StandbyGnuplot> TakeStandbyGnuplot();

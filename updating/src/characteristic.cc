@@ -19,18 +19,11 @@ using internal::CalcShape;
 using internal::Complex;
 using internal::DistanceToReference;
 using internal::FitAmplitudes;
-using internal::Format;
+using internal::FormatValue;
 using internal::InadmissibleReason;
 using internal::kNaN;
 
 namespace internal {
-
-std::string Format(double value) {
-  std::ostringstream out;
-  out.precision(4);
-  out << value;
-  return out.str();
-}
 
 // A(lambda) = M lambda^2 + D lambda + C with D = diag(d), C = diag(c) + K_g.
 Eigen::MatrixXcd CalcCharacteristicMatrix(const CharacteristicProblem& problem, Complex lambda,
@@ -139,7 +132,8 @@ void Validate(const CharacteristicProblem& problem) {
   }
   for (const Complex& lambda : problem.lambda) {
     if (!(lambda.imag() > 0) || !std::isfinite(lambda.real())) {
-      fail("lambda", "pole " + Format(lambda.real()) + " + " + Format(lambda.imag()) + "i",
+      fail("lambda",
+           "pole " + FormatValue(lambda.real()) + " + " + FormatValue(lambda.imag()) + "i",
            "finite poles with Im > 0 (one member of each conjugate pair)");
     }
   }
@@ -169,7 +163,7 @@ bool CharacteristicOptions::IsValid(std::string* why) const {
   };
   if (starts < 1) return fail("starts: " + std::to_string(starts) + "; expected >= 1");
   if (!(start_spread >= 1.0 && std::isfinite(start_spread))) {
-    return fail("start_spread: " + Format(start_spread) + "; expected a finite value >= 1");
+    return fail("start_spread: " + FormatValue(start_spread) + "; expected a finite value >= 1");
   }
   if (max_iterations < 1) {
     return fail("max_iterations: " + std::to_string(max_iterations) + "; expected >= 1");
@@ -178,7 +172,7 @@ bool CharacteristicOptions::IsValid(std::string* why) const {
     return fail("residual_tolerance and duplicate_tolerance must be > 0");
   }
   if (!(ambiguity_ratio >= 1)) {
-    return fail("ambiguity_ratio: " + Format(ambiguity_ratio) + "; expected >= 1");
+    return fail("ambiguity_ratio: " + FormatValue(ambiguity_ratio) + "; expected >= 1");
   }
   return true;
 }
@@ -371,7 +365,7 @@ CharacteristicResult SolveCharacteristicEquation(const CharacteristicProblem& pr
     message << result.solutions.size() << " solution set(s) of eq. 7 from " << options.starts
             << " starts, " << admissible << " admissible; chose the one "
             << (by_mismatch ? "whose initial state agrees best with the test (mismatch " +
-                                  Format(result.solutions[0].mismatch) + ")"
+                                  FormatValue(result.solutions[0].mismatch) + ")"
                             : "nearest the reference values (no record for eq. 8)");
     for (int s = 1; s < admissible && by_mismatch; ++s) {
       if (result.solutions[static_cast<size_t>(s)].mismatch <
@@ -381,7 +375,8 @@ CharacteristicResult SolveCharacteristicEquation(const CharacteristicProblem& pr
     }
     if (!result.rivals.empty()) {
       result.ambiguous = true;
-      message << "; ambiguous: the next set's mismatch is " << Format(result.solutions[1].mismatch)
+      message << "; ambiguous: the next set's mismatch is "
+              << FormatValue(result.solutions[1].mismatch)
               << ", so the record does not single out one set";
     }
   } else if (!result.solutions.empty()) {
@@ -393,8 +388,8 @@ CharacteristicResult SolveCharacteristicEquation(const CharacteristicProblem& pr
   } else {
     result.status = CharacteristicResult::Status::kNoSolution;
     message << "eq. 7 not solved from any of " << options.starts
-            << " starts: smallest scaled residual " << Format(result.best_residual)
-            << " above the tolerance " << Format(options.residual_tolerance);
+            << " starts: smallest scaled residual " << FormatValue(result.best_residual)
+            << " above the tolerance " << FormatValue(options.residual_tolerance);
   }
   result.message = message.str();
   return result;

@@ -10,14 +10,13 @@
 #include <limits>
 #include <string>
 
+#include "format_value.h"
 #include "mbid/updating/characteristic.h"
 #include "nan.h"
 
 namespace mbid::updating::internal {
 
 using Complex = std::complex<double>;
-
-std::string Format(double value);
 
 // A(lambda) = M lambda^2 + D lambda + C with D = diag(d), C = diag(c) + K_g.
 Eigen::MatrixXcd CalcCharacteristicMatrix(const CharacteristicProblem& problem, Complex lambda,

@@ -17,13 +17,13 @@ std::string InadmissibleReason(const CharacteristicProblem& problem,
   for (Eigen::Index i = 0; i < solution.c.size(); ++i) {
     if (!(solution.c[i] > 0)) {
       reason += (reason.empty() ? "" : ", ") + ("c_" + problem.coordinates[i]) + " = " +
-                Format(solution.c[i]) + " <= 0";
+                FormatValue(solution.c[i]) + " <= 0";
     }
   }
   for (Eigen::Index i = 0; i < solution.d.size(); ++i) {
     if (!(solution.d[i] >= 0)) {
       reason += (reason.empty() ? "" : ", ") + ("d_" + problem.coordinates[i]) + " = " +
-                Format(solution.d[i]) + " < 0";
+                FormatValue(solution.d[i]) + " < 0";
     }
   }
   return reason;

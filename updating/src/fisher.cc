@@ -6,22 +6,13 @@
 #include <sstream>
 
 #include "baseline.h"
+#include "format_value.h"
 #include "mbid/common/eigen_decompositions.h"
 #include "mbid/common/error.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/simulation/sensitivity.h"
 
 namespace mbid::updating {
-namespace {
-
-std::string FormatBrief(double value) {
-  std::ostringstream out;
-  out.precision(4);
-  out << value;
-  return out.str();
-}
-
-}  // namespace
 
 TestDesign MakeRecordedDesign(const TestRecord& test, const Eigen::VectorXd& noise_std,
                               const simulation::IntegratorOptions& integrator) {
@@ -67,7 +58,7 @@ FisherInformation CalcFisherInformation(const model::MechanicalModel& model, con
     if (!(value > 0) || !std::isfinite(value)) {
       throw InputError(
           test.name, "noise_std." + channels[static_cast<size_t>(c)],
-          found == test.sensors.noise_std.end() ? "no noise level" : FormatBrief(value),
+          found == test.sensors.noise_std.end() ? "no noise level" : internal::FormatValue(value),
           "a positive noise standard deviation per channel (the weights)");
     }
     sigma[c] = value;
@@ -76,7 +67,7 @@ FisherInformation CalcFisherInformation(const model::MechanicalModel& model, con
   for (const std::string& name : parameters) {
     const double value = model.GetParameter(name);  // InputError for an unknown name
     if (!(value > 0)) {
-      throw InputError(test.name, name, FormatBrief(value),
+      throw InputError(test.name, name, internal::FormatValue(value),
                        "a positive parameter value (information in log coordinates)");
     }
     values.push_back(value);

@@ -8,13 +8,6 @@
 
 namespace mbid::updating::internal {
 
-std::string FormatValue(double value) {
-  std::ostringstream out;
-  out.precision(4);
-  out << value;
-  return out.str();
-}
-
 std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,
                                      const std::vector<TestRecord>& tests,
                                      const UpdateOptions& options) {

@@ -7,13 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "format_value.h"
 #include "mbid/model/mechanical_model.h"
 #include "mbid/updating/output_error.h"
 
 namespace mbid::updating::internal {
-
-// A number in messages: 4 significant digits.
-std::string FormatValue(double value);
 
 // One unknown of the fit: a shared model parameter or a nuisance parameter of one test.
 struct Unknown {
