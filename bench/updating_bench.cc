@@ -15,10 +15,12 @@
 #include <optional>
 
 #include "mbid/common/yaml_reader.h"
+#include "mbid/model/linear_model.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/simulation/scenario_sections.h"
 #include "mbid/simulation/sensitivity.h"
 #include "mbid/simulation/simulate.h"
+#include "mbid/updating/characteristic.h"
 #include "mbid/updating/output_error.h"
 
 namespace {
@@ -142,6 +144,23 @@ void BM_AnchorSensitivityRun(benchmark::State& state) {
   state.counters["nonlinear_iterations"] = static_cast<double>(s.nonlinear_iterations);
 }
 
+// Route 1 (eq. 7, 100 starts, then eq. 8 on the record for each set) for the crane's exact
+// poles: what `mbid update` and `mbid run` spend between identification and the fit.
+void BM_Route1(benchmark::State& state) {
+  const Setup& setup = Reference();
+  std::vector<std::complex<double>> lambda;
+  for (const mbid::model::Mode& mode : mbid::model::CalcModes(setup.model->Linearize())) {
+    lambda.push_back(mode.lambda);
+  }
+  const mbid::updating::CharacteristicProblem problem = mbid::updating::MakeCharacteristicProblem(
+      *setup.model, lambda, setup.test.record, setup.test.excitation);
+  mbid::updating::CharacteristicResult result;
+  for (auto _ : state) {
+    result = mbid::updating::SolveCharacteristicEquation(problem, {});
+  }
+  state.counters["sets"] = static_cast<double>(result.solutions.size());
+}
+
 void BM_UpdateSensitivitiesCentered(benchmark::State& state) {
   RunUpdate(state, UpdateOptions::Jacobian::kSensitivities,
             mbid::simulation::SensitivityOptions::DifferenceQuotient::kCentered);
@@ -163,6 +182,7 @@ BENCHMARK(BM_AnchorPlainSimulation)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecon
 // First argument 0: centered quotients, 1: forward, 2: kStateJacobian; second 0: the
 // scenario's method (auto: Adams), 1: BDF (what the scenario named before session 8).
 BENCHMARK(BM_AnchorSensitivityRun)->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Route1)->Unit(benchmark::kMillisecond);
 // One fit takes seconds: one iteration each, wall time (the threads work in parallel).
 BENCHMARK(BM_UpdateSensitivitiesCentered)
     ->Arg(1)

@@ -38,10 +38,14 @@ Eigen::MatrixXcd CalcCharacteristicMatrix(const CharacteristicProblem& problem, 
 namespace {
 
 // det(A) with A's row and column i removed: d det(A) / d A_ii, exact even where A is singular.
-Complex CalcPrincipalMinor(const Eigen::MatrixXcd& A, Eigen::Index i) {
+// Sizes 3 and 4 use Eigen's closed-form determinants and no heap: Route 1 evaluates these
+// hundreds of thousands of times.
+template <int N>
+Complex CalcPrincipalMinor(const Eigen::Matrix<Complex, N, N>& A, Eigen::Index i) {
   const Eigen::Index n = A.rows();
   if (n == 1) return 1.0;
-  Eigen::MatrixXcd minor(n - 1, n - 1);
+  constexpr int kMinor = N == Eigen::Dynamic ? Eigen::Dynamic : N - 1;
+  Eigen::Matrix<Complex, kMinor, kMinor> minor(n - 1, n - 1);
   for (Eigen::Index r = 0, rr = 0; r < n; ++r) {
     if (r == i) continue;
     for (Eigen::Index s = 0, ss = 0; s < n; ++s) {
@@ -82,19 +86,36 @@ class CharacteristicCost final : public ceres::CostFunction {
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    const Eigen::Map<const Eigen::VectorXd> x(parameters[0], 2 * n_);
-    const Eigen::VectorXd c = problem_.c_reference.cwiseProduct(x.head(n_));
-    const Eigen::VectorXd d = problem_.d_reference.cwiseProduct(x.tail(n_));
+    switch (n_) {
+      case 3:
+        return EvaluateSized<3>(parameters[0], residuals, jacobians);
+      case 4:
+        return EvaluateSized<4>(parameters[0], residuals, jacobians);
+      default:
+        return EvaluateSized<Eigen::Dynamic>(parameters[0], residuals, jacobians);
+    }
+  }
+
+ private:
+  template <int N>
+  bool EvaluateSized(const double* parameters, double* residuals, double** jacobians) const {
+    const Eigen::Map<const Eigen::VectorXd> x(parameters, 2 * n_);
     const Eigen::Index columns = 2 * n_;
+    Eigen::Matrix<Complex, N, N> A(n_, n_);
     for (size_t k = 0; k < problem_.lambda.size(); ++k) {
       const Complex lambda = problem_.lambda[k];
-      const Eigen::MatrixXcd A = CalcCharacteristicMatrix(problem_, lambda, c, d);
-      const Complex det = A.determinant() / scale_[static_cast<Eigen::Index>(k)];
+      // A(lambda) = M lambda^2 + D lambda + C, as CalcCharacteristicMatrix forms it.
+      A = problem_.M.cast<Complex>() * (lambda * lambda) + problem_.K_g.cast<Complex>();
+      for (Eigen::Index i = 0; i < n_; ++i) {
+        A(i, i) += problem_.c_reference[i] * x[i] + problem_.d_reference[i] * x[n_ + i] * lambda;
+      }
+      const double scale = scale_[static_cast<Eigen::Index>(k)];
+      const Complex det = A.determinant() / scale;
       residuals[2 * k] = det.real();
       residuals[2 * k + 1] = det.imag();
       if (jacobians == nullptr || jacobians[0] == nullptr) continue;
       for (Eigen::Index i = 0; i < n_; ++i) {
-        const Complex minor = CalcPrincipalMinor(A, i) / scale_[static_cast<Eigen::Index>(k)];
+        const Complex minor = CalcPrincipalMinor<N>(A, i) / scale;
         const Complex by_c = minor * problem_.c_reference[i];
         const Complex by_d = minor * lambda * problem_.d_reference[i];
         jacobians[0][(2 * k) * columns + i] = by_c.real();
@@ -106,7 +127,6 @@ class CharacteristicCost final : public ceres::CostFunction {
     return true;
   }
 
- private:
   const CharacteristicProblem& problem_;
   Eigen::VectorXd scale_;
   Eigen::Index n_;

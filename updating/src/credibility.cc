@@ -6,6 +6,8 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 
+#include "distributions.h"
+
 namespace mbid::updating {
 namespace {
 
@@ -26,7 +28,8 @@ void Whiteness(const Eigen::VectorXd& residual, int lags, double* q, double* p, 
   }
   *q *= n * (n + 2);
   *time = std::max(1.0, *time);
-  *p = boost::math::cdf(boost::math::complement(boost::math::chi_squared(count), *q));
+  *p = boost::math::cdf(boost::math::complement(
+      boost::math::chi_squared_distribution<double, internal::DistributionPolicy>(count), *q));
 }
 
 }  // namespace

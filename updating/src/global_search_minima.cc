@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "distributions.h"
 #include "global_search_internal.h"
 #include "mbid/updating/global_search.h"
 
@@ -36,12 +37,14 @@ std::vector<std::string> Differences(const UpdateResult& a, const UpdateResult& 
 }  // namespace internal
 
 double FQuantile(double alpha, double d1, double d2) {
-  return boost::math::quantile(boost::math::complement(boost::math::fisher_f(d1, d2), alpha));
+  return boost::math::quantile(boost::math::complement(
+      boost::math::fisher_f_distribution<double, internal::DistributionPolicy>(d1, d2), alpha));
 }
 
 double FSurvival(double f, double d1, double d2) {
   if (!(f > 0)) return 1.0;
-  return boost::math::cdf(boost::math::complement(boost::math::fisher_f(d1, d2), f));
+  return boost::math::cdf(boost::math::complement(
+      boost::math::fisher_f_distribution<double, internal::DistributionPolicy>(d1, d2), f));
 }
 
 }  // namespace mbid::updating
