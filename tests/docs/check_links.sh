@@ -35,21 +35,22 @@ report() {  # file line message
 # (c) Written so that this script does not match itself.
 outside='\.\./shared|shared/(docs|seeds)'
 
+# (a) and (c): one grep over every text file (-I skips binary ones), file:line:match per hit.
+# (a) docs/<name>.md, not as the tail of a longer path (tests/docs/x.md, ../docs/x.md).
+while IFS= read -r hit; do
+  f=${hit%%:*} rest=${hit#*:}
+  line=${rest%%:*} match=${rest#*:}
+  ref=docs/${match##*docs/}
+  [[ -f $ref ]] || report "$f" "$line" "$ref does not exist"
+done < <(printf '%s\0' "${files[@]}" |
+         xargs -0 grep -HInoE '(^|[^A-Za-z0-9_./-])docs/[A-Za-z0-9_.-]+\.md' -- || true)
+# (c)
+while IFS= read -r hit; do
+  f=${hit%%:*} rest=${hit#*:}
+  report "$f" "${rest%%:*}" "points outside the repository: '${rest#*:}'"
+done < <(printf '%s\0' "${files[@]}" | xargs -0 grep -HInoE "$outside" -- || true)
+
 for f in "${files[@]}"; do
-  # Text files only (grep -I skips binary ones).
-  grep -Iq . "$f" 2>/dev/null || continue
-
-  # (a) docs/<name>.md, not as the tail of a longer path (tests/docs/x.md, ../docs/x.md).
-  while IFS=: read -r line ref; do
-    [[ -f $ref ]] || report "$f" "$line" "$ref does not exist"
-  done < <(grep -noE '(^|[^A-Za-z0-9_./-])docs/[A-Za-z0-9_.-]+\.md' "$f" |
-           sed -E 's/^([0-9]+):.*(docs\/[A-Za-z0-9_.-]+\.md)$/\1:\2/')
-
-  # (c)
-  while IFS=: read -r line match; do
-    report "$f" "$line" "points outside the repository: '$match'"
-  done < <(grep -noE "$outside" "$f" || true)
-
   # (b) Markdown pages only.
   [[ $f == *.md ]] || continue
   dir=$(dirname "$f")
