@@ -11,6 +11,12 @@
 namespace mbid::updating {
 namespace {
 
+// Significance of the whiteness test and of a chi^2 above the noise's.
+constexpr double kWhitenessLevel = 1e-3;
+// chi^2/dof (and inflation) above which the standard deviations are not taken as they are: a
+// residual rms 10% above the noise.
+constexpr double kNoticeableExcess = 1.2;
+
 // Ljung-Box Q of `r` over `lags` lags, and the integrated autocorrelation time.
 void Whiteness(const Eigen::VectorXd& residual, int lags, double* q, double* p, double* time) {
   const Eigen::VectorXd r = residual.array() - residual.mean();
@@ -58,19 +64,29 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
       Whiteness(r, options.whiteness_lags, &fit.whiteness_q[c], &fit.whiteness_p[c],
                 &fit.correlation_time[c]);
       // A residual white at the 0.1% level is not inflated for its sampling wiggle.
-      if (fit.whiteness_p[c] < 1e-3 && fit.correlation_time[c] > worst_time) {
+      if (fit.whiteness_p[c] < kWhitenessLevel && fit.correlation_time[c] > worst_time) {
         worst_time = fit.correlation_time[c];
         worst_channel = fit.channels[static_cast<size_t>(c)] + " of " + fit.name;
       }
     }
   }
   const double k = static_cast<double>(result.parameters.size()) + baseline_terms;
-  result.chi_square_per_dof = 2 * result.final_cost / std::max(1.0, residuals - k);
+  const double dof = std::max(1.0, residuals - k);
+  result.chi_square_per_dof = 2 * result.final_cost / dof;
   result.weights_from_records = from_records;
   const double excess = from_records ? std::max(1.0, result.chi_square_per_dof) : 1.0;
   result.std_inflation = std::sqrt(excess * worst_time);
   result.credibility.clear();
   const bool misfit = from_records && result.chi_square_per_dof > options.max_chi_square_per_dof;
+  // Noise is white or coloured but has the records' level: a residual above it that is also
+  // not white holds signal the model does not reproduce (a local minimum, or a model that lacks
+  // something), however small the excess; a white excess is a noise level stated too low.
+  const bool structured =
+      !misfit && from_records && result.chi_square_per_dof > kNoticeableExcess &&
+      !worst_channel.empty() &&
+      boost::math::cdf(boost::math::complement(
+          boost::math::chi_squared_distribution<double, internal::DistributionPolicy>(dof),
+          2 * result.final_cost)) < kWhitenessLevel;
   if (misfit) {
     result.credibility.push_back(fmt::format(
         "the re-simulation misses the records by {:.3g} times their noise (chi^2/dof = {:.4g} > "
@@ -78,8 +94,16 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
         "this fit",
         std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof,
         options.max_chi_square_per_dof));
+  } else if (structured) {
+    result.credibility.push_back(fmt::format(
+        "the residual is {:.3g} times the records' noise (chi^2/dof = {:.4g}) and not white "
+        "(correlation time {:.3g} samples on {}): the excess is signal the model does not "
+        "reproduce, a local minimum or a model that lacks something; no parameter is determined "
+        "by this fit",
+        std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof, worst_time,
+        worst_channel));
   } else {
-    if (excess > 1.2) {
+    if (excess > kNoticeableExcess) {
       result.credibility.push_back(fmt::format(
           "the residual is {:.3g} times the records' noise (chi^2/dof = {:.4g}): standard "
           "deviations scaled up by {:.3g}",
@@ -97,7 +121,8 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
         "the noise was estimated from this fit's own residual: a misfit cannot be told from "
         "noise except by the residual's whiteness");
   }
-  result.credible = !misfit && result.std_inflation <= std::sqrt(1.2 * 1.2);
+  result.credible = !misfit && !structured && result.std_inflation <= kNoticeableExcess;
+  result.explains_records = from_records && !misfit && !structured;
 
   result.undetermined.clear();
   for (ParameterEstimate& p : result.parameters) {
@@ -114,6 +139,10 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
     if (misfit && p.test.empty()) {
       p.determined = false;
       p.why_undetermined = "the fit does not explain the records (chi^2/dof too large)";
+    } else if (structured && p.test.empty()) {
+      p.determined = false;
+      p.why_undetermined =
+          "the fit does not explain the records (a residual above the noise, not white)";
     } else if (!std::isfinite(relative)) {
       p.determined = false;
       p.why_undetermined = "no standard deviation: the records leave it in a flat direction";

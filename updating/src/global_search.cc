@@ -281,8 +281,7 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   bool settled = false;
   if (search.complete_starts) {
     for (const Run& run : full) {
-      settled = settled || (!run.failed && Converged(run.fit) && run.fit.weights_from_records &&
-                            run.fit.chi_square_per_dof <= options.max_chi_square_per_dof);
+      settled = settled || (!run.failed && Converged(run.fit) && run.fit.explains_records);
     }
   }
   const int design_count = settled ? 0 : search.design_starts;

@@ -212,6 +212,7 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
   json["credibility"] = {{"credible", result.credible},
                          {"chi_square_per_dof", NumberOrNull(result.chi_square_per_dof)},
                          {"weights_from_records", result.weights_from_records},
+                         {"explains_records", result.explains_records},
                          {"std_inflation", NumberOrNull(result.std_inflation)},
                          {"reasons", result.credibility}};
   json["tests"] = nlohmann::json::array();

@@ -103,10 +103,12 @@ struct UpdateOptions {
   // Credibility of the Fisher standard deviations (credibility.cc). With weights from the
   // record's own noise (the identification's residual), 2 cost / (N - k) is about 1 when the
   // model explains the record; above `max_chi_square_per_dof` the fit does not (a local
-  // minimum, or a model that lacks something) and no parameter is reported determined. Between
-  // 1 and it, and for residuals whose integrated autocorrelation time over `whiteness_lags` lags
-  // exceeds 1 (not white), the standard deviations are inflated by sqrt(chi^2/dof * time) before
-  // the undetermined test, and the result says so.
+  // minimum, or a model that lacks something) and no parameter is reported determined; nor
+  // above 1.2 (significantly, at the 0.1% level) with a residual that is not white: the excess
+  // is then signal the model leaves out, not noise. Between 1 and it, and for residuals whose
+  // integrated autocorrelation time over `whiteness_lags` lags exceeds 1 (not white), the
+  // standard deviations are inflated by sqrt(chi^2/dof * time) before the undetermined test,
+  // and the result says so.
   double max_chi_square_per_dof = 4.0;
   int whiteness_lags = 20;
   // Ceres' Levenberg-Marquardt starts with this trust region radius (Ceres' default is 1e4):
@@ -214,6 +216,9 @@ struct UpdateResult {
   bool weights_from_records = false;
   double std_inflation = 1;
   bool credible = true;
+  // Weights from the records' noise and a residual that is that noise: neither above
+  // max_chi_square_per_dof, nor noticeably above 1 and not white (signal left unexplained).
+  bool explains_records = false;
   std::vector<std::string> credibility;
   std::vector<TestFit> tests;
   // Work: simulations (with and without sensitivities), right-hand-side evaluations (all
