@@ -358,10 +358,12 @@ TEST(CredibilityTest, WhiteExcessOverTheNoiseOnlyInflates) {
 }
 
 TEST(CredibilityTest, ColouredExcessOverTheNoiseDeterminesNothing) {
-  // The same excess, but coloured (AR(1), rho = 0.8): signal the model does not reproduce,
-  // which no inflation makes trustworthy (a missed minimum, above).
-  const UpdateResult result = AssessResidual(Ar1Noise(20000, 0.8, 1.2, 15));
-  EXPECT_GT(result.chi_square_per_dof, 1.2);
+  // A smaller excess, coloured (AR(1), rho = 0.8, 1.08 times the noise: chi^2/dof 1.17, spread
+  // 3% over 20000 samples of correlation time 8.9): signal the model does not reproduce, which
+  // no inflation makes trustworthy. Missed minima of the load drop ended at 1.15-1.34.
+  const UpdateResult result = AssessResidual(Ar1Noise(20000, 0.8, 1.08, 15));
+  EXPECT_GT(result.chi_square_per_dof, 1.05);
+  EXPECT_LT(result.chi_square_per_dof, 1.2);
   EXPECT_FALSE(result.explains_records);
   EXPECT_FALSE(result.credible);
   EXPECT_FALSE(result.parameters[0].determined);

@@ -104,7 +104,7 @@ struct UpdateOptions {
   // record's own noise (the identification's residual), 2 cost / (N - k) is about 1 when the
   // model explains the record; above `max_chi_square_per_dof` the fit does not (a local
   // minimum, or a model that lacks something) and no parameter is reported determined; nor
-  // above 1.2 (significantly, at the 0.1% level) with a residual that is not white: the excess
+  // above 1.05 (significantly, at the 0.1% level) with a residual that is not white: the excess
   // is then signal the model leaves out, not noise. Between 1 and it, and for residuals whose
   // integrated autocorrelation time over `whiteness_lags` lags exceeds 1 (not white), the
   // standard deviations are inflated by sqrt(chi^2/dof * time) before the undetermined test,
