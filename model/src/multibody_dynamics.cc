@@ -94,22 +94,23 @@ auto Elements(V& v) -> decltype(&v[0]) {
 
 }  // namespace
 
-MechanicalModel::StateDerivative MultibodyModel::MakeStateDerivative() const {
-  struct Scratch {
-    SimTK::Vector mobility_forces, residual, u_dot;
-    SimTK::Vector_<SimTK::SpatialVec> body_forces;
-    const SimTK::Vector no_accelerations;  // u' = 0 for the inverse dynamics, made once
-  };
-  auto scratch = std::make_shared<Scratch>();
-  return [&m = *impl_, scratch](const SimTK::State& state, double* y_dot) {
-    SimTK::Vector& mobility = scratch->mobility_forces;
-    SimTK::Vector_<SimTK::SpatialVec>& body = scratch->body_forces;
+namespace {
+
+// The applied forces as Simbody's force elements sum them, for a state realized to Position
+// (gravity) and Velocity (dampers).
+struct AppliedForces {
+  SimTK::Vector mobility;
+  SimTK::Vector_<SimTK::SpatialVec> body;
+
+  // M: MultibodyModel::Impl (private to the model, hence deduced).
+  template <typename M>
+  void Sum(const M& m, const SimTK::State& state) {
     mobility.resize(state.getNU());
     mobility = 0;
     body.resize(m.matter.getNumBodies());
     body = SimTK::SpatialVec(Vec3(0), Vec3(0));
     // Force::UniformGravity: m g at the mass center, about the body origin, in Ground.
-    for (const Impl::Weight& w : m.weights) {
+    for (const auto& w : m.weights) {
       const Vec3 r = m.matter.getMobilizedBody(w.body).getBodyRotation(state) * w.mass_center_B;
       body[w.body] += SimTK::SpatialVec(r % w.force_G, w.force_G);
     }
@@ -117,17 +118,32 @@ MechanicalModel::StateDerivative MultibodyModel::MakeStateDerivative() const {
     const double* q = Elements(state.getQ());
     const double* u = Elements(state.getU());
     double* f = Elements(mobility);
-    for (const Impl::Coordinate& c : m.coordinate_data) {
+    for (const auto& c : m.coordinate_data) {
       if (c.spring < 0) continue;
       const SimTK::Force::MobilityLinearSpring& spring = m.springs[static_cast<size_t>(c.spring)];
       f[c.u] += -spring.getStiffness(state) * (q[c.q] - spring.getQZero(state)) -
                 m.dampers[static_cast<size_t>(c.spring)].getDamping(state) * u[c.u];
     }
     AddExternalLoads(m.matter, m.external_load, m.locate_point, state, body, mobility);
+  }
+};
+
+}  // namespace
+
+MechanicalModel::StateDerivative MultibodyModel::MakeStateDerivative() const {
+  struct Scratch {
+    AppliedForces applied;
+    SimTK::Vector residual, u_dot;
+    const SimTK::Vector no_accelerations;  // u' = 0 for the inverse dynamics, made once
+  };
+  auto scratch = std::make_shared<Scratch>();
+  return [&m = *impl_, scratch](const SimTK::State& state, double* y_dot) {
+    scratch->applied.Sum(m, state);
     // u' = M^-1 (f_applied - f_inertial): Simbody's forward-dynamics operator needs the Dynamics
     // stage, its inverse dynamics (residual = f_inertial - f_applied at u' = 0) and M^-1 only
     // Velocity. u' = -(M^-1 residual): M^-1's arithmetic is odd in its argument, bit for bit.
-    m.matter.calcResidualForceIgnoringConstraints(state, mobility, body, scratch->no_accelerations,
+    m.matter.calcResidualForceIgnoringConstraints(state, scratch->applied.mobility,
+                                                  scratch->applied.body, scratch->no_accelerations,
                                                   scratch->residual);
     m.matter.multiplyByMInv(state, scratch->residual, scratch->u_dot);
     const SimTK::Vector& q_dot = state.getQDot();
@@ -136,6 +152,25 @@ MechanicalModel::StateDerivative MultibodyModel::MakeStateDerivative() const {
     for (int i = 0; i < nq; ++i) y_dot[i] = q_dot_data[i];
     const double* u_dot = Elements(scratch->u_dot);
     for (int i = 0; i < scratch->u_dot.size(); ++i) y_dot[nq + i] = -u_dot[i];
+  };
+}
+
+MechanicalModel::Residual MultibodyModel::MakeResidual() const {
+  struct Scratch {
+    AppliedForces applied;
+    SimTK::Vector u_dot, residual;
+  };
+  auto scratch = std::make_shared<Scratch>();
+  return [&m = *impl_, scratch](const SimTK::State& state, const double* u_dot, double* residual) {
+    scratch->applied.Sum(m, state);
+    const int nu = state.getNU();
+    scratch->u_dot.resize(nu);
+    double* u_dot_data = Elements(scratch->u_dot);
+    for (int i = 0; i < nu; ++i) u_dot_data[i] = u_dot[i];
+    m.matter.calcResidualForceIgnoringConstraints(
+        state, scratch->applied.mobility, scratch->applied.body, scratch->u_dot, scratch->residual);
+    const double* r = Elements(scratch->residual);
+    for (int i = 0; i < nu; ++i) residual[i] = r[i];
   };
 }
 

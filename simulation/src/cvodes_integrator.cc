@@ -305,6 +305,7 @@ void CvodesIntegrator::set_parameter_force_derivative(ParameterForceDerivative d
 void CvodesIntegrator::set_state_derivative(StateDerivative derivative) {
   impl_->set_state_derivative(std::move(derivative));
 }
+void CvodesIntegrator::set_residual(Residual residual) { impl_->set_residual(std::move(residual)); }
 void CvodesIntegrator::set_jacobian(Eigen::MatrixXd jacobian) {
   impl_->set_jacobian(std::move(jacobian));
 }

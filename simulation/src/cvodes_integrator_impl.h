@@ -91,6 +91,8 @@ class CvodesIntegrator::Impl {
     state_derivative_ = std::move(derivative);
   }
 
+  void set_residual(CvodesIntegrator::Residual residual) { residual_ = std::move(residual); }
+
   void set_jacobian(Eigen::MatrixXd jacobian) { jacobian_ = std::move(jacobian); }
 
   void Initialize(SimTK::State state);
@@ -161,11 +163,14 @@ class CvodesIntegrator::Impl {
   }
 
   // s_i' = J s_i + df/dp_i for CVODES (kStateJacobian), see cvodes_sensitivities.cc.
-  static int SensitivityRhs(int count, realtype t, N_Vector y, N_Vector /*y_dot*/, N_Vector* s,
+  static int SensitivityRhs(int count, realtype t, N_Vector y, N_Vector y_dot, N_Vector* s,
                             N_Vector* s_dot, void* user_data, N_Vector, N_Vector);
 
   // J = df/dY and df/dp at (t, Y) unless they are cached for these very bits.
-  void UpdateSensitivityJacobian(double t, const realtype* y);
+  // `y_dot` is f(t, Y) (the forward columns' base).
+  void UpdateSensitivityJacobian(double t, const realtype* y, const realtype* y_dot);
+  // J's columns by forward differences of the residual at fixed u' (residual_ set, no z).
+  void FormJacobianFromResidual(const realtype* y, const realtype* y_dot);
 
   // Y_j of the working state, through q, u or z so that only the stages above it are redone.
   void SetEntry(int j, int nq, int nu, double value) {
@@ -222,6 +227,7 @@ class CvodesIntegrator::Impl {
   const SimTK::MultibodySystem* multibody_ = nullptr;
   bool forward_dynamics_operator_ = false;
   StateDerivative state_derivative_;
+  CvodesIntegrator::Residual residual_;
   SimTK::Vector u_dot_;                                   // scratch of CalcDerivative
   SimTK::Vector_<SimTK::SpatialVec> body_accelerations_;  // scratch of CalcDerivative
   IntegratorOptions options_;
@@ -231,12 +237,16 @@ class CvodesIntegrator::Impl {
   Eigen::MatrixXd jacobian_;  // empty: difference quotients
   // kStateJacobian's cache: J and df/dp at (jacobian_time_, jacobian_y_), and scratch.
   bool jacobian_cached_ = false;
+  bool forward_jacobian_ = false;  // forward columns (else central)
   double jacobian_time_ = 0.0;
   std::vector<double> jacobian_y_;
   Eigen::MatrixXd state_jacobian_;
   Eigen::MatrixXd parameter_derivative_;
   Eigen::VectorXd f_forward_, column_, dforce_;
   SimTK::Vector mobility_force_, m_inv_force_;
+  // FormJacobianFromResidual's scratch: M^-1 by columns, dresidual/dY, u' at (t, Y).
+  Eigen::MatrixXd m_inverse_, residual_jacobian_;
+  Eigen::VectorXd base_residual_, residual_column_;
   long own_sensitivity_rhs_ = 0;
   long sensitivity_jacobians_ = 0;
   SimTK::State state_;

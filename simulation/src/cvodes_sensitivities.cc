@@ -23,6 +23,11 @@ namespace {
 // steps of 1e-8 left 2e-4 errors in the excavator's weak swing-boom coupling (measured against
 // Richardson-extrapolated differences).
 constexpr double kJacobianStep = 1e-5;
+// Forward-difference step of J's columns (from the f(t, Y) CVODES hands over), relative to
+// max(|Y_j|, 1), chosen against Richardson-extrapolated differences (sensitivity_test.cc): at
+// 1e-8 roundoff left 1.2e-4 in the excavator's weak swing-boom coupling, at 1e-6 truncation
+// 4.8e-7 on the crane; 1e-7 keeps both below the forward quotients' errors.
+constexpr double kForwardJacobianStep = 1e-7;
 // Central-difference step of df/dp where no closed form is known, relative to the parameter's
 // scale: exact to roundoff (~1e-12) for forces affine in p, O(h^2) ~ 1e-8 otherwise.
 constexpr double kParameterStep = 1e-4;
@@ -60,7 +65,9 @@ void CvodesIntegrator::Impl::InitializeSensitivities(const std::vector<double>& 
     throw std::invalid_argument("CvodesIntegrator: invalid SensitivityOptions: " + why);
   }
   const bool fixed_point = nonlinear_solver_ != nullptr;
-  const bool own_rhs = options.right_hand_side == SensitivityOptions::RightHandSide::kStateJacobian;
+  const bool own_rhs =
+      options.right_hand_side == SensitivityOptions::RightHandSide::kStateJacobian ||
+      (options.right_hand_side == SensitivityOptions::RightHandSide::kAuto && count > n);
   if (!own_rhs && fixed_point &&
       options.corrector == SensitivityOptions::Corrector::kSimultaneous &&
       options.difference_quotient == SensitivityOptions::DifferenceQuotient::kForward) {
@@ -88,6 +95,8 @@ void CvodesIntegrator::Impl::InitializeSensitivities(const std::vector<double>& 
   sensitivity_scale_ = scale;
   const bool simultaneous = options.corrector == SensitivityOptions::Corrector::kSimultaneous;
   jacobian_cached_ = false;
+  forward_jacobian_ =
+      options.difference_quotient == SensitivityOptions::DifferenceQuotient::kForward;
   const int corrector = simultaneous ? CV_SIMULTANEOUS : CV_STAGGERED;
   if (own_rhs) {
     Check(CVodeSensInit(cv, count, corrector, &Impl::SensitivityRhs, sensitivity_vectors_.get()),
@@ -129,12 +138,12 @@ void CvodesIntegrator::Impl::InitializeSensitivities(const std::vector<double>& 
 
 // s_i' = J s_i + df/dp_i for CVODES (kStateJacobian); J and df/dp come from the cache of
 // (t, Y), so every sensitivity and corrector iteration at one point shares one J.
-int CvodesIntegrator::Impl::SensitivityRhs(int count, realtype t, N_Vector y, N_Vector /*y_dot*/,
+int CvodesIntegrator::Impl::SensitivityRhs(int count, realtype t, N_Vector y, N_Vector y_dot,
                                            N_Vector* s, N_Vector* s_dot, void* user_data, N_Vector,
                                            N_Vector) {
   auto* self = static_cast<Impl*>(user_data);
   return self->Guarded(t, [&] {
-    self->UpdateSensitivityJacobian(t, N_VGetArrayPointer(y));
+    self->UpdateSensitivityJacobian(t, N_VGetArrayPointer(y), N_VGetArrayPointer(y_dot));
     const Eigen::Index ny = self->state_jacobian_.rows();
     for (int i = 0; i < count; ++i) {
       const Eigen::Map<const Eigen::VectorXd> s_i(N_VGetArrayPointer(s[i]), ny);
@@ -146,7 +155,8 @@ int CvodesIntegrator::Impl::SensitivityRhs(int count, realtype t, N_Vector y, N_
 }
 
 // J = df/dY and df/dp at (t, Y) unless they are cached for these very bits.
-void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype* y) {
+void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype* y,
+                                                       const realtype* y_dot) {
   const int ny = state_.getNY();
   if (jacobian_cached_ && t == jacobian_time_ && std::equal(y, y + ny, jacobian_y_.data())) {
     return;
@@ -160,7 +170,22 @@ void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype*
   f_forward_.resize(ny);
   column_.resize(ny);
   SetTimeAndY(t, y);  // nominal parameters: the input hook applies sensitivity_p_ as it is
-  system_->realize(state_, SimTK::Stage::Position);  // for M^-1 below
+  const bool from_residual =
+      forward_jacobian_ && residual_ && forward_dynamics_operator_ && state_.getNZ() == 0;
+  system_->realize(state_, from_residual ? SimTK::Stage::Velocity : SimTK::Stage::Position);
+  if (from_residual) {
+    const SimTK::SimbodyMatterSubsystem& matter = multibody_->getMatterSubsystem();
+    // M^-1 by columns, one operator call per mobility: it serves df/dp and the acceleration
+    // rows of J.
+    m_inverse_.resize(nu, nu);
+    mobility_force_.resize(nu);
+    for (int i = 0; i < nu; ++i) {
+      mobility_force_ = 0;
+      mobility_force_[i] = 1;
+      matter.multiplyByMInv(state_, mobility_force_, m_inv_force_);
+      for (int r = 0; r < nu; ++r) m_inverse_(r, i) = m_inv_force_[r];
+    }
+  }
   // df/dp_k = [0 | M^-1 dF/dp_k] where the forces' derivative is known, while the state is
   // realized at (t, Y) (M^-1 reuses its articulated-body inertias); the rest by differences.
   std::vector<int> differenced;
@@ -178,24 +203,46 @@ void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype*
       continue;
     }
     parameter_derivative_.col(k).setZero();
+    if (from_residual) {
+      parameter_derivative_.col(k).segment(nq, nu).noalias() = m_inverse_ * dforce_;
+      continue;
+    }
     for (int i = 0; i < nu; ++i) mobility_force_[i] = dforce_[i];
     multibody_->getMatterSubsystem().multiplyByMInv(state_, mobility_force_, m_inv_force_);
     for (int i = 0; i < nu; ++i) parameter_derivative_(nq + i, k) = m_inv_force_[i];
   }
-  // Columns of J: only the perturbed entry changes, so a speed keeps the Position stage.
-  for (int j = 0; j < ny; ++j) {
-    const double h = kJacobianStep * std::max(std::abs(y[j]), 1.0);
-    const double forward = y[j] + h;
-    const double backward = y[j] - h;
-    SetEntry(j, nq, nu, forward);
-    CalcDerivative(column_.data());
-    f_forward_ = column_;
-    SetEntry(j, nq, nu, backward);
-    CalcDerivative(column_.data());
-    SetEntry(j, nq, nu, y[j]);
-    state_jacobian_.col(j) = (f_forward_ - column_) / (forward - backward);
+  if (from_residual) {
+    FormJacobianFromResidual(y, y_dot);
+  } else if (forward_jacobian_) {
+    // Forward columns from f(t, Y), which CVODES computed at these Y with the nominal
+    // parameters. Speeds first: the Position stage realized for M^-1 above serves them all.
+    const Eigen::Map<const Eigen::VectorXd> f_nominal(y_dot, ny);
+    for (int jj = 0; jj < ny; ++jj) {
+      const int j = (jj + nq) % ny;  // u, z, then q
+      const double h = kForwardJacobianStep * std::max(std::abs(y[j]), 1.0);
+      const double forward = y[j] + h;
+      SetEntry(j, nq, nu, forward);
+      CalcDerivative(column_.data());
+      SetEntry(j, nq, nu, y[j]);
+      state_jacobian_.col(j) = (column_ - f_nominal) / (forward - y[j]);
+    }
+    own_sensitivity_rhs_ += ny;
+  } else {
+    // Columns of J: only the perturbed entry changes, so a speed keeps the Position stage.
+    for (int j = 0; j < ny; ++j) {
+      const double h = kJacobianStep * std::max(std::abs(y[j]), 1.0);
+      const double forward = y[j] + h;
+      const double backward = y[j] - h;
+      SetEntry(j, nq, nu, forward);
+      CalcDerivative(column_.data());
+      f_forward_ = column_;
+      SetEntry(j, nq, nu, backward);
+      CalcDerivative(column_.data());
+      SetEntry(j, nq, nu, y[j]);
+      state_jacobian_.col(j) = (f_forward_ - column_) / (forward - backward);
+    }
+    own_sensitivity_rhs_ += 2 * ny;
   }
-  own_sensitivity_rhs_ += 2 * ny;
   for (int k : differenced) {
     // The input hook reads the parameters from sensitivity_p_ (as for CVODES' quotients).
     const double nominal = sensitivity_p_[k];
@@ -221,6 +268,37 @@ void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype*
   jacobian_time_ = t;
   jacobian_y_.assign(y, y + ny);
   jacobian_cached_ = true;
+}
+
+// J by forward differences from (t, Y), realized to Velocity: q' = N(q) u read from the state,
+// u' through the residual r(Y, u') = M u' + f_inertial - f_applied, which vanishes at the
+// u' of f(t, Y): du'/dY = -M^-1 dr/dY at fixed u' (the implicit function theorem), so each
+// column costs a realization and an inverse dynamics, and M^-1 is applied once to all of them.
+// Speeds first: they keep the Position stage.
+void CvodesIntegrator::Impl::FormJacobianFromResidual(const realtype* y, const realtype* y_dot) {
+  const int nq = state_.getNQ();
+  const int nu = state_.getNU();
+  const int ny = nq + nu;
+  const double* base_u_dot = y_dot + nq;
+  base_residual_.resize(nu);
+  residual_column_.resize(nu);
+  residual_(state_, base_u_dot, base_residual_.data());
+  residual_jacobian_.resize(nu, ny);
+  for (int jj = 0; jj < ny; ++jj) {
+    const int j = (jj + nq) % ny;  // u, then q
+    const double h = kForwardJacobianStep * std::max(std::abs(y[j]), 1.0);
+    const double forward = y[j] + h;
+    const double step = forward - y[j];
+    SetEntry(j, nq, nu, forward);
+    system_->realize(state_, SimTK::Stage::Velocity);
+    residual_(state_, base_u_dot, residual_column_.data());
+    const SimTK::Vector& q_dot = state_.getQDot();
+    for (int i = 0; i < nq; ++i) state_jacobian_(i, j) = (q_dot[i] - y_dot[i]) / step;
+    residual_jacobian_.col(j) = (residual_column_ - base_residual_) / step;
+    SetEntry(j, nq, nu, y[j]);
+  }
+  state_jacobian_.bottomRows(nu).noalias() = -m_inverse_ * residual_jacobian_;
+  own_sensitivity_rhs_ += ny;
 }
 
 }  // namespace mbid::simulation

@@ -48,8 +48,10 @@ bool SensitivityOptions::IsValid(std::string* why) const {
     return false;
   };
   if (right_hand_side != RightHandSide::kStateJacobian &&
-      right_hand_side != RightHandSide::kCvodesQuotients) {
-    return fail("right_hand_side: unknown value; expected kStateJacobian or kCvodesQuotients");
+      right_hand_side != RightHandSide::kCvodesQuotients &&
+      right_hand_side != RightHandSide::kAuto) {
+    return fail(
+        "right_hand_side: unknown value; expected kStateJacobian, kCvodesQuotients or kAuto");
   }
   if (corrector != Corrector::kSimultaneous && corrector != Corrector::kStaggered) {
     return fail("corrector: unknown value; expected kSimultaneous or kStaggered");

@@ -109,6 +109,7 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
 
   CvodesIntegrator integrator(simulated.system(), options.integrator);
   integrator.set_state_derivative(simulated.MakeStateDerivative());
+  integrator.set_residual(simulated.MakeResidual());
   // The right-hand side reads the parameters CVODES perturbs; only changed ones are applied
   // (each invalidates the state's Instance stage).
   std::vector<double> applied(p.begin(), p.begin() + model_count);

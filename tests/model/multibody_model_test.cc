@@ -564,6 +564,25 @@ TEST(MultibodyModelTest, StateDerivativeEqualsSimbodysForceElements) {
         EXPECT_NEAR(fast[static_cast<size_t>(i)], y_dot[i], 1e-12 * scale)
             << machine->type() << " trial " << trial << " Y' " << i;
       }
+      // The residual of the same forces vanishes at the state's own u' (relative to M u', the
+      // inertial forces) and is -M u' at u' = 0.
+      const MechanicalModel::Residual residual = machine->MakeResidual();
+      ASSERT_TRUE(residual) << machine->type();
+      std::vector<double> at_u_dot(static_cast<size_t>(n)), at_zero(static_cast<size_t>(n));
+      const std::vector<double> zero(static_cast<size_t>(n), 0.0);
+      residual(s, &y_dot[n], at_u_dot.data());
+      residual(s, zero.data(), at_zero.data());
+      SimTK::Vector u_dot(n), m_u_dot;
+      for (int i = 0; i < n; ++i) u_dot[i] = y_dot[n + i];
+      machine->system().getMatterSubsystem().multiplyByM(s, u_dot, m_u_dot);
+      double force_scale = 0;
+      for (int i = 0; i < n; ++i) force_scale = std::max(force_scale, std::abs(m_u_dot[i]));
+      for (int i = 0; i < n; ++i) {
+        EXPECT_NEAR(at_u_dot[static_cast<size_t>(i)], 0.0, 1e-11 * force_scale)
+            << machine->type() << " trial " << trial << " residual " << i;
+        EXPECT_NEAR(at_zero[static_cast<size_t>(i)], -m_u_dot[i], 1e-11 * force_scale)
+            << machine->type() << " trial " << trial << " residual at u' = 0, " << i;
+      }
     }
   }
 }

@@ -75,6 +75,13 @@ void CheckAgainstDifferences(const Crane& crane, double duration_s,
   const SensitivityResult result_jacobian = SimulateWithSensitivities(
       *crane.model, crane.excitation, options, sensors, names, {}, jacobian);
   EXPECT_GT(result_jacobian.statistics.sensitivity_jacobians, 0);
+  // The fit's right-hand side where it has more sensitivities than states: J by forward
+  // differences of the inverse-dynamics residual.
+  SensitivityOptions forward_jacobian = jacobian;
+  forward_jacobian.difference_quotient = SensitivityOptions::DifferenceQuotient::kForward;
+  const SensitivityResult result_forward_jacobian = SimulateWithSensitivities(
+      *crane.model, crane.excitation, options, sensors, names, {}, forward_jacobian);
+  EXPECT_GT(result_forward_jacobian.statistics.sensitivity_jacobians, 0);
   ASSERT_EQ(result.output_sensitivities.size(), names.size());
   EXPECT_GT(result.statistics.rhs_evaluations_for_sensitivities, 0);
   // One right-hand side per sensitivity instead of two.
@@ -93,10 +100,18 @@ void CheckAgainstDifferences(const Crane& crane, double duration_s,
     const double error_forward = RelativeError(result_forward.output_sensitivities[k], expected);
     const double error_adams = RelativeError(result_adams.output_sensitivities[k], expected);
     const double error_jacobian = RelativeError(result_jacobian.output_sensitivities[k], expected);
+    const double error_forward_jacobian =
+        RelativeError(result_forward_jacobian.output_sensitivities[k], expected);
     ::testing::Test::RecordProperty("relative_error_" + names[k],
                                     Sci(error) + " forward " + Sci(error_forward) + " adams " +
-                                        Sci(error_adams) + " jacobian " + Sci(error_jacobian));
+                                        Sci(error_adams) + " jacobian " + Sci(error_jacobian) +
+                                        " forward jacobian " + Sci(error_forward_jacobian));
+    // As accurate as the forward quotients it stands in for: measured 0.1-1.2x their error
+    // (1.9e-8..1.0e-6 here), so 1.5x plus 1e-7 of integration scatter.
+    EXPECT_LT(error_forward_jacobian, 1.5 * error_forward + 1e-7)
+        << names[k] << " (forward state Jacobian)";
     EXPECT_LT(error_jacobian, 1e-4) << names[k] << " (state-Jacobian right-hand side)";
+    EXPECT_LT(error_forward_jacobian, 1e-4) << names[k] << " (forward state Jacobian)";
     EXPECT_LT(error, 1e-4) << names[k];
     EXPECT_LT(error_forward, 1e-4) << names[k] << " (forward quotients)";
     EXPECT_LT(error_adams, 1e-4) << names[k] << " (Adams, forward quotients)";
@@ -122,6 +137,10 @@ TEST(SensitivityTest, RateOutputsOfADescribedMachineMatchCentralDifferences) {
   jacobian.right_hand_side = SensitivityOptions::RightHandSide::kStateJacobian;
   const SensitivityResult result_jacobian = SimulateWithSensitivities(
       *machine.model, machine.excitation, options, sensors, names, {}, jacobian);
+  SensitivityOptions forward_jacobian = jacobian;
+  forward_jacobian.difference_quotient = SensitivityOptions::DifferenceQuotient::kForward;
+  const SensitivityResult result_forward_jacobian = SimulateWithSensitivities(
+      *machine.model, machine.excitation, options, sensors, names, {}, forward_jacobian);
   const SimulationOptions tight = Tight(options);
   for (size_t k = 0; k < names.size(); ++k) {
     auto simulate_at = [&](double value) {
@@ -155,6 +174,12 @@ TEST(SensitivityTest, RateOutputsOfADescribedMachineMatchCentralDifferences) {
       const double error_jacobian =
           RelativeError(result_jacobian.output_sensitivities[k].col(c), expected.col(c));
       EXPECT_LT(error_jacobian, 1e-4) << names[k] << " " << sensors.channels[c] << " (Jacobian)";
+      // Forward columns at step 1e-7: at most 4e-5 on the weak swing-boom coupling (CVODES'
+      // forward quotients 1.1e-4 there), 6e-6 elsewhere; the channel's own scale, as above.
+      const double error_forward_jacobian =
+          RelativeError(result_forward_jacobian.output_sensitivities[k].col(c), expected.col(c));
+      EXPECT_LT(error_forward_jacobian, 1e-4)
+          << names[k] << " " << sensors.channels[c] << " (forward Jacobian)";
     }
   }
 }
@@ -185,6 +210,57 @@ TEST(SensitivityTest, ForcedTestCarriesSensitivitiesAcrossTheRestart) {
   impulse.duration_s = 0.2;
   crane.excitation = impulse;
   CheckAgainstDifferences(crane, 2.0, {"c_theta", "d_theta", "c_alpha"});
+}
+
+TEST(SensitivityTest, AutoFormsTheStateJacobianOnlyForMoreSensitivitiesThanStates) {
+  // The fit's default (kAuto): the crane has NY = 8 states. Its eight joint parameters stay
+  // with CVODES' quotients (the same bits as before kAuto); with the payload mass beside them
+  // (nine sensitivities) the state Jacobian is formed, and it gives the same sensitivities.
+  const Crane crane = LoadCrane(updating::testing::kLoadDropScenario);
+  SimulationOptions options = crane.simulation;
+  options.duration_s = 1.0;
+  options.integrator.interpolate_outputs = true;
+  const double mass = crane.excitation.get<simulation::LoadDrop>().payload_mass_kg;
+  auto initial_q = [&](double m) {
+    Excitation changed = crane.excitation;
+    changed.get<simulation::LoadDrop>().payload_mass_kg = m;
+    return CalcInitialCoordinates(*crane.model, changed);
+  };
+  InitialStateDirection direction;
+  direction.name = "payload_mass_kg";
+  direction.dq0_dp = (initial_q(mass * 1.0001) - initial_q(mass * 0.9999)) / (2e-4 * mass);
+  direction.scale = mass;
+  SensitivityOptions automatic = updating::UpdateOptions().sensitivity;
+  ASSERT_EQ(automatic.right_hand_side, SensitivityOptions::RightHandSide::kAuto);
+  SensitivityOptions quotients = automatic;
+  quotients.right_hand_side = SensitivityOptions::RightHandSide::kCvodesQuotients;
+  const SensitivityResult joints = SimulateWithSensitivities(
+      *crane.model, crane.excitation, options, crane.sensors, kAllParameters, {}, automatic);
+  const SensitivityResult joints_quotients = SimulateWithSensitivities(
+      *crane.model, crane.excitation, options, crane.sensors, kAllParameters, {}, quotients);
+  EXPECT_EQ(joints.statistics.sensitivity_jacobians, 0);
+  for (size_t k = 0; k < kAllParameters.size(); ++k) {
+    EXPECT_EQ(joints.output_sensitivities[k], joints_quotients.output_sensitivities[k]);
+  }
+  const SensitivityResult nine =
+      SimulateWithSensitivities(*crane.model, crane.excitation, options, crane.sensors,
+                                kAllParameters, {direction}, automatic);
+  const SensitivityResult nine_quotients =
+      SimulateWithSensitivities(*crane.model, crane.excitation, options, crane.sensors,
+                                kAllParameters, {direction}, quotients);
+  EXPECT_GT(nine.statistics.sensitivity_jacobians, 0);
+  ASSERT_EQ(nine.output_sensitivities.size(), 9u);
+  for (size_t k = 0; k < 9; ++k) {
+    // Both within 1e-6 of Richardson-extrapolated differences (the tests above), so within
+    // 1e-5 of each other at the sensitivity tolerance's step sequence.
+    EXPECT_LT(RelativeError(nine.output_sensitivities[k], nine_quotients.output_sensitivities[k]),
+              1e-5)
+        << k;
+  }
+  // Fewer right-hand sides' work: 9 quotients per corrector iteration against one J of NY
+  // columns (half of them redo only the Velocity stage).
+  EXPECT_LT(nine.statistics.rhs_evaluations_for_sensitivities,
+            nine_quotients.statistics.rhs_evaluations_for_sensitivities);
 }
 
 TEST(SensitivityTest, PayloadMassDirectionMatchesCentralDifferences) {

@@ -43,8 +43,17 @@ void CheckParameterKeys(const YamlReader& node, const UpdateOptions& options) {
 simulation::SensitivityOptions ReadSensitivity(const YamlReader& node,
                                                simulation::SensitivityOptions o) {
   using simulation::SensitivityOptions;
-  node.ExpectMap({"corrector", "difference_quotient", "relative_tolerance", "absolute_tolerance",
-                  "error_control"});
+  node.ExpectMap({"right_hand_side", "corrector", "difference_quotient", "relative_tolerance",
+                  "absolute_tolerance", "error_control"});
+  const char* rhs_default =
+      o.right_hand_side == SensitivityOptions::RightHandSide::kStateJacobian     ? "state_jacobian"
+      : o.right_hand_side == SensitivityOptions::RightHandSide::kCvodesQuotients ? "quotients"
+                                                                                 : "auto";
+  const std::string rhs =
+      node.Choice("right_hand_side", {"auto", "quotients", "state_jacobian"}, rhs_default);
+  o.right_hand_side = rhs == "state_jacobian" ? SensitivityOptions::RightHandSide::kStateJacobian
+                      : rhs == "quotients"    ? SensitivityOptions::RightHandSide::kCvodesQuotients
+                                              : SensitivityOptions::RightHandSide::kAuto;
   const bool staggered = o.corrector == SensitivityOptions::Corrector::kStaggered;
   o.corrector = node.Choice("corrector", {"simultaneous", "staggered"},
                             staggered ? "staggered" : "simultaneous") == "staggered"

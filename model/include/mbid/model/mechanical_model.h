@@ -88,6 +88,15 @@ class MechanicalModel {
   // outlive it. Empty where the model has no such shortcut.
   using StateDerivative = std::function<void(const SimTK::State& state, double* y_dot)>;
   virtual StateDerivative MakeStateDerivative() const { return {}; }
+  // The inverse-dynamics residual M u' + f_inertial - f_applied (one per mobility) of a state
+  // realized to Stage::Velocity at given accelerations u' (NU values each): zero at the state's own
+  // u', and MakeStateDerivative's u' = -M^-1 residual(0). Its derivative in Y at fixed u' gives the
+  // state Jacobian's acceleration rows, du'/dY = -M^-1 dresidual/dY, without an M^-1 per
+  // column (forward sensitivities). Same scratch and lifetime rules; empty where the model has
+  // no StateDerivative.
+  using Residual =
+      std::function<void(const SimTK::State& state, const double* u_dot, double* residual)>;
+  virtual Residual MakeResidual() const { return {}; }
 
   // The Simbody system; realized to Topology.
   virtual const SimTK::MultibodySystem& system() const = 0;

@@ -45,6 +45,7 @@ class MultibodyModel final : public MechanicalModel {
   // Gravity, the joints' springs and dampers and the external loads, summed as Simbody's force
   // elements sum them.
   StateDerivative MakeStateDerivative() const override;
+  Residual MakeResidual() const override;
 
   const SimTK::MultibodySystem& system() const override;
   SimTK::State MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const override;

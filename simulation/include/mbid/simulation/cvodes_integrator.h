@@ -60,6 +60,12 @@ class CvodesIntegrator {
   // default) realizes the force subsystem.
   using StateDerivative = std::function<void(const SimTK::State& state, double* y_dot)>;
   void set_state_derivative(StateDerivative derivative);
+  // The inverse-dynamics residual of the same forces (MechanicalModel::MakeResidual): with it,
+  // the forward-difference state Jacobian of the sensitivities (kStateJacobian, kForward)
+  // differences the residual at fixed u' and applies M^-1 once per mobility, not per column.
+  using Residual =
+      std::function<void(const SimTK::State& state, const double* u_dot, double* residual)>;
+  void set_residual(Residual residual);
 
   // A constant approximation of the Jacobian df/dY (NY x NY), e.g. the model's linearization,
   // for the Newton iteration; empty (the default) forms it from difference quotients of f (NY

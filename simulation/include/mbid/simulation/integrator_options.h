@@ -53,13 +53,19 @@ struct SensitivityOptions {
     // CVODES' own difference quotients of f along (s_i, p_i): one (forward) or two (centered)
     // right-hand sides per sensitivity and corrector iteration.
     kCvodesQuotients,
-    // J = df/dY formed once per distinct (t, Y) by central differences of f (2 NY right-hand
-    // sides) and reused for every sensitivity and corrector iteration; df/dp_i in closed form
-    // where CvodesIntegrator::set_parameter_force_derivative knows it, else central differences
-    // of f in p_i alone. Cheaper than forward quotients only for more than 2 NY sensitivities
-    // (the crane, 8 parameters and NY = 8: 1.9x their right-hand sides), but as close to
-    // Richardson-extrapolated differences as centered ones (docs/performance.md, session 8).
+    // J = df/dY formed once per distinct (t, Y) and reused for every sensitivity and corrector
+    // iteration; df/dp_i in closed form where CvodesIntegrator::set_parameter_force_derivative
+    // knows it, else central differences of f in p_i alone. `difference_quotient` says how J's
+    // columns are differenced: centered, 2 NY right-hand sides, as close to
+    // Richardson-extrapolated differences as centered quotients; forward from the f(t, Y)
+    // CVODES hands over, and with CvodesIntegrator::set_residual through the inverse-dynamics
+    // residual at fixed u' (M^-1 once per mobility): about 6 right-hand sides' work on the crane
+    // (NY = 8), more accurate than forward quotients (docs/performance.md, session 17).
     kStateJacobian,
+    // kStateJacobian where there are more sensitivities than states (each forward quotient
+    // costs a right-hand side, J about 0.8 per position and 0.5 per speed), kCvodesQuotients
+    // otherwise.
+    kAuto,
   };
   enum class Corrector {
     kSimultaneous,  // state and sensitivities in one nonlinear system (CV_SIMULTANEOUS)

@@ -41,6 +41,7 @@ struct PlanOptions {
   simulation::SensitivityOptions sensitivity = [] {
     simulation::SensitivityOptions o;
     o.difference_quotient = simulation::SensitivityOptions::DifferenceQuotient::kForward;
+    o.right_hand_side = simulation::SensitivityOptions::RightHandSide::kAuto;
     return o;
   }();
   double ridge = 1e-12;  // relative to the mean diagonal of F

@@ -59,6 +59,7 @@ namespace mbid::updating {
 //       max_step_s: 0
 //       interpolate_outputs: true
 //     sensitivity:                         # CVODES forward sensitivities (docs/toolchain.md)
+//       right_hand_side: auto              # auto | quotients | state_jacobian
 //       corrector: simultaneous            # simultaneous | staggered
 //       difference_quotient: forward       # forward | centered (twice the work)
 //       relative_tolerance: 1.0e-6         # looser than the state's on purpose
