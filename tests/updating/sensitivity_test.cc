@@ -212,14 +212,9 @@ TEST(SensitivityTest, ForcedTestCarriesSensitivitiesAcrossTheRestart) {
   CheckAgainstDifferences(crane, 2.0, {"c_theta", "d_theta", "c_alpha"});
 }
 
-TEST(SensitivityTest, AutoFormsTheStateJacobianOnlyForMoreSensitivitiesThanStates) {
-  // The fit's default (kAuto): the crane has NY = 8 states. Its eight joint parameters stay
-  // with CVODES' quotients (the same bits as before kAuto); with the payload mass beside them
-  // (nine sensitivities) the state Jacobian is formed, and it gives the same sensitivities.
-  const Crane crane = LoadCrane(updating::testing::kLoadDropScenario);
-  SimulationOptions options = crane.simulation;
-  options.duration_s = 1.0;
-  options.integrator.interpolate_outputs = true;
+// The load drop's payload mass as a nuisance parameter acting only through the initial state:
+// dq(0)/dm by central differences of the loaded equilibrium.
+InitialStateDirection PayloadMassDirection(const Crane& crane) {
   const double mass = crane.excitation.get<simulation::LoadDrop>().payload_mass_kg;
   auto initial_q = [&](double m) {
     Excitation changed = crane.excitation;
@@ -230,6 +225,18 @@ TEST(SensitivityTest, AutoFormsTheStateJacobianOnlyForMoreSensitivitiesThanState
   direction.name = "payload_mass_kg";
   direction.dq0_dp = (initial_q(mass * 1.0001) - initial_q(mass * 0.9999)) / (2e-4 * mass);
   direction.scale = mass;
+  return direction;
+}
+
+TEST(SensitivityTest, AutoFormsTheStateJacobianOnlyForMoreSensitivitiesThanStates) {
+  // The fit's default (kAuto): the crane has NY = 8 states. Its eight joint parameters stay
+  // with CVODES' quotients (the same bits as before kAuto); with the payload mass beside them
+  // (nine sensitivities) the state Jacobian is formed, and it gives the same sensitivities.
+  const Crane crane = LoadCrane(updating::testing::kLoadDropScenario);
+  SimulationOptions options = crane.simulation;
+  options.duration_s = 1.0;
+  options.integrator.interpolate_outputs = true;
+  const InitialStateDirection direction = PayloadMassDirection(crane);
   SensitivityOptions automatic = updating::UpdateOptions().sensitivity;
   ASSERT_EQ(automatic.right_hand_side, SensitivityOptions::RightHandSide::kAuto);
   SensitivityOptions quotients = automatic;
@@ -273,15 +280,7 @@ TEST(SensitivityTest, PayloadMassDirectionMatchesCentralDifferences) {
   SensorOptions sensors;
   sensors.sample_rate_hz = 50.0;
   const double mass = crane.excitation.get<simulation::LoadDrop>().payload_mass_kg;
-  auto initial_q = [&](double m) {
-    Excitation changed = crane.excitation;
-    changed.get<simulation::LoadDrop>().payload_mass_kg = m;
-    return CalcInitialCoordinates(*crane.model, changed);
-  };
-  InitialStateDirection direction;
-  direction.name = "payload_mass_kg";
-  direction.dq0_dp = (initial_q(mass * 1.0001) - initial_q(mass * 0.9999)) / (2e-4 * mass);
-  direction.scale = mass;
+  const InitialStateDirection direction = PayloadMassDirection(crane);
   const SensitivityResult result = SimulateWithSensitivities(*crane.model, crane.excitation,
                                                              options, sensors, {}, {direction}, {});
   const SimulationOptions tight = Tight(options);
