@@ -129,12 +129,29 @@ void BM_AnchorSensitivityRun(benchmark::State& state) {
     sensitivity.right_hand_side =
         mbid::simulation::SensitivityOptions::RightHandSide::kStateJacobian;
   }
+  if (state.range(0) >= 4) {
+    sensitivity.corrector = mbid::simulation::SensitivityOptions::Corrector::kStaggered;
+  }
+  // Third argument 1: the four initial deflections beside the joints (as
+  // updating.fit_initial_deflection adds them): twelve sensitivities for eight states.
+  std::vector<mbid::simulation::InitialStateDirection> directions;
+  if (state.range(2) == 1) {
+    const int n = setup.model->coordinate_count();
+    for (int j = 0; j < n; ++j) {
+      mbid::simulation::InitialStateDirection direction;
+      direction.name = "deflection_" + std::to_string(j);
+      direction.dq0_dp = Eigen::VectorXd::Unit(n, j);
+      direction.scale = 0.01;  // rad, the fit's span for a deflection near 0
+      directions.push_back(direction);
+    }
+  }
   mbid::simulation::SimulationOptions simulation = FitSimulation(setup);
   if (state.range(1) == 1) simulation.integrator.method = Method::kBdf;
   mbid::simulation::SensitivityResult result;
   for (auto _ : state) {
-    result = mbid::simulation::SimulateWithSensitivities(
-        *setup.model, setup.test.excitation, simulation, FitSensors(setup), names, {}, sensitivity);
+    result = mbid::simulation::SimulateWithSensitivities(*setup.model, setup.test.excitation,
+                                                         simulation, FitSensors(setup), names,
+                                                         directions, sensitivity);
   }
   const auto& s = result.statistics;
   state.counters["rhs_evaluations"] = static_cast<double>(
@@ -180,11 +197,13 @@ void BM_UpdateNumeric(benchmark::State& state) {
 
 BENCHMARK(BM_AnchorPlainSimulation)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // First argument: CVODES' quotients centered (0) or forward (1), the state-Jacobian right-hand
-// side with central (2) or forward (3) columns; second 0: the scenario's method (auto: Adams),
-// 1: BDF (what the scenario named before session 8).
+// side with central (2) or forward (3) columns, 5: 3 with the staggered corrector; second 0:
+// the scenario's method (auto: Adams), 1: BDF (what the scenario named before session 8); third
+// 1: twelve sensitivities (the initial deflections beside the joints).
 BENCHMARK(BM_AnchorSensitivityRun)
-    ->ArgsProduct({{0, 1, 2, 3}, {0, 1}})
+    ->ArgsProduct({{0, 1, 2, 3, 5}, {0, 1}, {0}})
     ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_AnchorSensitivityRun)->ArgsProduct({{1, 3}, {0}, {1}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Route1)->Unit(benchmark::kMillisecond);
 // One fit takes seconds: one iteration each, wall time (the threads work in parallel).
 BENCHMARK(BM_UpdateSensitivitiesCentered)
