@@ -14,6 +14,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include <algorithm>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -135,6 +136,15 @@ class CvodesIntegrator::Impl {
     if (state_.getTime() != t) state_.setTime(t);
     CopyToState(y);
     if (hook_) hook_(state_);
+  }
+
+  // The working state holds exactly this Y (its realized stages then still hold).
+
+  bool SameY(const realtype* y) const {
+    const SimTK::Vector& current = state_.getY();
+    const int n = current.size();
+    if (n == 0 || !current.hasContiguousData()) return false;
+    return std::equal(y, y + n, &current[0]);
   }
 
   // Y' = f(t, Y) for CVODES: Simbody's own derivative of [q | u | z].

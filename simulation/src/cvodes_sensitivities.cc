@@ -67,7 +67,7 @@ void CvodesIntegrator::Impl::InitializeSensitivities(const std::vector<double>& 
   const bool fixed_point = nonlinear_solver_ != nullptr;
   const bool own_rhs =
       options.right_hand_side == SensitivityOptions::RightHandSide::kStateJacobian ||
-      (options.right_hand_side == SensitivityOptions::RightHandSide::kAuto && count > n);
+      (options.right_hand_side == SensitivityOptions::RightHandSide::kAuto && count >= n);
   if (!own_rhs && fixed_point &&
       options.corrector == SensitivityOptions::Corrector::kSimultaneous &&
       options.difference_quotient == SensitivityOptions::DifferenceQuotient::kForward) {
@@ -169,7 +169,14 @@ void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype*
   parameter_derivative_.resize(ny, count);
   f_forward_.resize(ny);
   column_.resize(ny);
-  SetTimeAndY(t, y);  // nominal parameters: the input hook applies sensitivity_p_ as it is
+  // Nominal parameters: the input hook applies sensitivity_p_ as it is. CVODES evaluates f at
+  // this very (t, Y) just before: its realized stages (and M^-1's articulated-body inertias)
+  // serve J when the state still holds it.
+  if (state_.getTime() == t && SameY(y)) {
+    if (hook_) hook_(state_);
+  } else {
+    SetTimeAndY(t, y);
+  }
   const bool from_residual =
       forward_jacobian_ && residual_ && forward_dynamics_operator_ && state_.getNZ() == 0;
   system_->realize(state_, from_residual ? SimTK::Stage::Velocity : SimTK::Stage::Position);

@@ -62,9 +62,10 @@ struct SensitivityOptions {
     // residual at fixed u' (M^-1 once per mobility): about 6 right-hand sides' work on the crane
     // (NY = 8), more accurate than forward quotients (docs/performance.md, session 17).
     kStateJacobian,
-    // kStateJacobian where there are more sensitivities than states (each forward quotient
-    // costs a right-hand side, J about 0.8 per position and 0.5 per speed), kCvodesQuotients
-    // otherwise.
+    // kStateJacobian where there are at least as many sensitivities as states (each forward
+    // quotient costs a right-hand side, J about 0.7 of one per state: 0.84 of the quotients'
+    // instructions for the crane's 8 joint parameters, 0.62 with 4 initial deflections beside
+    // them), kCvodesQuotients otherwise.
     kAuto,
   };
   enum class Corrector {

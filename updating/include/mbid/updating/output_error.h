@@ -75,8 +75,8 @@ struct UpdateOptions {
   // Forward difference quotients: one right-hand side per parameter instead of two. The
   // joints' forces are affine in c and d, so the quotients' truncation error stays far below
   // the sensitivity tolerance (measured: as close to central differences as the centered ones).
-  // kAuto: the state Jacobian (forward columns) where a fit has more sensitivities than states,
-  // e.g. initial deflections beside the joints.
+  // kAuto: the state Jacobian (forward columns) where a fit has at least as many sensitivities
+  // as states (every joint's c and d; initial deflections beside them).
   simulation::SensitivityOptions sensitivity = [] {
     simulation::SensitivityOptions o;
     o.difference_quotient = simulation::SensitivityOptions::DifferenceQuotient::kForward;
