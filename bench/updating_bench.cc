@@ -158,6 +158,8 @@ void BM_AnchorSensitivityRun(benchmark::State& state) {
       s.rhs_evaluations + s.rhs_evaluations_for_jacobian + s.rhs_evaluations_for_sensitivities);
   state.counters["rhs_sensitivities"] = static_cast<double>(s.rhs_evaluations_for_sensitivities);
   state.counters["steps"] = static_cast<double>(s.steps);
+  state.counters["jacobians"] = static_cast<double>(s.sensitivity_jacobians);
+  state.counters["jacobian_reuses"] = static_cast<double>(s.sensitivity_jacobian_reuses);
   state.counters["nonlinear_iterations"] = static_cast<double>(s.nonlinear_iterations);
 }
 

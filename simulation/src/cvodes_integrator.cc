@@ -177,6 +177,7 @@ IntegratorStatistics CvodesIntegrator::Impl::statistics() const {
   if (sensitivity_count_ > 0) CVodeGetNumRhsEvalsSens(cv, &s.rhs_evaluations_for_sensitivities);
   s.rhs_evaluations_for_sensitivities += own_sensitivity_rhs_;
   s.sensitivity_jacobians = sensitivity_jacobians_;
+  s.sensitivity_jacobian_reuses = sensitivity_jacobian_reuses_;
   return s;
 }
 
@@ -190,6 +191,7 @@ void CvodesIntegrator::Impl::CreateSolver(int n) {
   jacobian_cached_ = false;
   own_sensitivity_rhs_ = 0;
   sensitivity_jacobians_ = 0;
+  sensitivity_jacobian_reuses_ = 0;
   nonlinear_solver_.reset();
   linear_solver_.reset();
   matrix_.reset();

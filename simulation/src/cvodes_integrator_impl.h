@@ -179,6 +179,8 @@ class CvodesIntegrator::Impl {
   // J = df/dY and df/dp at (t, Y) unless they are cached for these very bits.
   // `y_dot` is f(t, Y) (the forward columns' base).
   void UpdateSensitivityJacobian(double t, const realtype* y, const realtype* y_dot);
+  // df/dp at a later corrector iterate near J's point, J kept.
+  void RefreshParameterDerivative(double t, const realtype* y);
   // J's columns by forward differences of the residual at fixed u' (residual_ set, no z).
   void FormJacobianFromResidual(const realtype* y, const realtype* y_dot);
 
@@ -248,6 +250,9 @@ class CvodesIntegrator::Impl {
   // kStateJacobian's cache: J and df/dp at (jacobian_time_, jacobian_y_), and scratch.
   bool jacobian_cached_ = false;
   bool forward_jacobian_ = false;  // forward columns (else central)
+  // J came from the residual with every df/dp in closed form: a later corrector iterate of the
+  // same step may keep it (RefreshParameterDerivative).
+  bool jacobian_reusable_ = false;
   double jacobian_time_ = 0.0;
   std::vector<double> jacobian_y_;
   Eigen::MatrixXd state_jacobian_;
@@ -259,6 +264,7 @@ class CvodesIntegrator::Impl {
   Eigen::VectorXd base_residual_, residual_column_;
   long own_sensitivity_rhs_ = 0;
   long sensitivity_jacobians_ = 0;
+  long sensitivity_jacobian_reuses_ = 0;
   SimTK::State state_;
   bool has_state_ = false;
   bool initialized_ = false;  // CVODES is ready to advance state_.

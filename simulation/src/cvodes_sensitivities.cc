@@ -28,6 +28,10 @@ constexpr double kJacobianStep = 1e-5;
 // 1e-8 roundoff left 1.2e-4 in the excavator's weak swing-boom coupling, at 1e-6 truncation
 // 4.8e-7 on the crane; 1e-7 keeps both below the forward quotients' errors.
 constexpr double kForwardJacobianStep = 1e-7;
+// A later corrector iterate of the same step within this distance of J's point (relative to
+// max(|Y_j|, 1)) keeps J: it moves J by a tenth of the forward step's own truncation error at
+// most. Newton's corrections within a step are ~rtol |Y|, far below it.
+constexpr double kJacobianReuseDistance = 1e-8;
 // Central-difference step of df/dp where no closed form is known, relative to the parameter's
 // scale: exact to roundoff (~1e-12) for forces affine in p, O(h^2) ~ 1e-8 otherwise.
 constexpr double kParameterStep = 1e-4;
@@ -158,10 +162,22 @@ int CvodesIntegrator::Impl::SensitivityRhs(int count, realtype t, N_Vector y, N_
 void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype* y,
                                                        const realtype* y_dot) {
   const int ny = state_.getNY();
-  if (jacobian_cached_ && t == jacobian_time_ && std::equal(y, y + ny, jacobian_y_.data())) {
-    return;
+  if (jacobian_cached_ && t == jacobian_time_) {
+    if (std::equal(y, y + ny, jacobian_y_.data())) return;
+    if (jacobian_reusable_) {
+      bool near = true;
+      for (int j = 0; j < ny && near; ++j) {
+        near = std::abs(y[j] - jacobian_y_[j]) <=
+               kJacobianReuseDistance * std::max(std::abs(jacobian_y_[j]), 1.0);
+      }
+      if (near) {
+        RefreshParameterDerivative(t, y);
+        return;
+      }
+    }
   }
   jacobian_cached_ = false;
+  jacobian_reusable_ = false;
   const int nq = state_.getNQ();
   const int nu = state_.getNU();
   const int count = sensitivity_count_;
@@ -272,9 +288,27 @@ void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype*
     if (hook_) hook_(state_);
   }
   ++sensitivity_jacobians_;
+  jacobian_reusable_ = from_residual && differenced.empty();
   jacobian_time_ = t;
   jacobian_y_.assign(y, y + ny);
   jacobian_cached_ = true;
+}
+
+// df/dp at a later corrector iterate (t, Y) of J's step, J kept: the closed-form dF/dp at the new
+// q and u times the M^-1 of J's point (the iterates differ by ~rtol |Y|).
+void CvodesIntegrator::Impl::RefreshParameterDerivative(double t, const realtype* y) {
+  const int nq = state_.getNQ();
+  const int nu = state_.getNU();
+  SetTimeAndY(t, y);
+  system_->realize(state_, SimTK::Stage::Position);
+  for (int k = 0; k < sensitivity_count_; ++k) {
+    parameter_derivative_.col(k).setZero();
+    if (!parameter_force_derivative_(state_, k, dforce_) || dforce_.size() != nu) {
+      throw std::logic_error("CvodesIntegrator: a parameter force derivative went missing");
+    }
+    parameter_derivative_.col(k).segment(nq, nu).noalias() = m_inverse_ * dforce_;
+  }
+  ++sensitivity_jacobian_reuses_;
 }
 
 // J by forward differences from (t, Y), realized to Velocity: q' = N(q) u read from the state,

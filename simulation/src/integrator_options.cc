@@ -82,6 +82,7 @@ IntegratorStatistics& IntegratorStatistics::operator+=(const IntegratorStatistic
   rhs_evaluations_for_jacobian += later.rhs_evaluations_for_jacobian;
   rhs_evaluations_for_sensitivities += later.rhs_evaluations_for_sensitivities;
   sensitivity_jacobians += later.sensitivity_jacobians;
+  sensitivity_jacobian_reuses += later.sensitivity_jacobian_reuses;
   last_step_s = later.last_step_s;
   last_order = later.last_order;
   method = later.method;

@@ -109,6 +109,8 @@ struct IntegratorStatistics {
   long rhs_evaluations_for_sensitivities = 0;
   // State Jacobians J formed for the sensitivities (kStateJacobian).
   long sensitivity_jacobians = 0;
+  // Later corrector iterates of a step that kept its J (only df/dp recomputed).
+  long sensitivity_jacobian_reuses = 0;
   double last_step_s = 0.0;
   int last_order = 0;
   // The method CVODES ran (`auto` resolved).
