@@ -63,8 +63,8 @@ struct SensitivityOptions {
     // (NY = 8), more accurate than forward quotients (docs/performance.md, session 17).
     kStateJacobian,
     // kStateJacobian where there are at least as many sensitivities as states (each forward
-    // quotient costs a right-hand side, J about 0.7 of one per state: 0.84 of the quotients'
-    // instructions for the crane's 8 joint parameters, 0.62 with 4 initial deflections beside
+    // quotient costs a right-hand side, J about 0.7 of one per state: 0.80 of the quotients'
+    // instructions for the crane's 8 joint parameters, 0.61 with 4 initial deflections beside
     // them), kCvodesQuotients otherwise.
     kAuto,
   };
