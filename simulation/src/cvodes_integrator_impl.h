@@ -253,6 +253,8 @@ class CvodesIntegrator::Impl {
   // J came from the residual with every df/dp in closed form: a later corrector iterate of the
   // same step may keep it (RefreshParameterDerivative).
   bool jacobian_reusable_ = false;
+  // df/dp is the one at jacobian_y_ (not refreshed at a later iterate since).
+  bool parameter_derivative_at_jacobian_y_ = false;
   double jacobian_time_ = 0.0;
   std::vector<double> jacobian_y_;
   Eigen::MatrixXd state_jacobian_;

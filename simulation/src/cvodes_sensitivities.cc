@@ -163,7 +163,7 @@ void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype*
                                                        const realtype* y_dot) {
   const int ny = state_.getNY();
   if (jacobian_cached_ && t == jacobian_time_) {
-    if (std::equal(y, y + ny, jacobian_y_.data())) return;
+    if (parameter_derivative_at_jacobian_y_ && std::equal(y, y + ny, jacobian_y_.data())) return;
     if (jacobian_reusable_) {
       bool near = true;
       for (int j = 0; j < ny && near; ++j) {
@@ -289,6 +289,7 @@ void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype*
   }
   ++sensitivity_jacobians_;
   jacobian_reusable_ = from_residual && differenced.empty();
+  parameter_derivative_at_jacobian_y_ = true;
   jacobian_time_ = t;
   jacobian_y_.assign(y, y + ny);
   jacobian_cached_ = true;
@@ -308,6 +309,7 @@ void CvodesIntegrator::Impl::RefreshParameterDerivative(double t, const realtype
     }
     parameter_derivative_.col(k).segment(nq, nu).noalias() = m_inverse_ * dforce_;
   }
+  parameter_derivative_at_jacobian_y_ = std::equal(y, y + nq + nu, jacobian_y_.data());
   ++sensitivity_jacobian_reuses_;
 }
 
