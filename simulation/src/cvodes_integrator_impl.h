@@ -139,7 +139,6 @@ class CvodesIntegrator::Impl {
   }
 
   // The working state holds exactly this Y (its realized stages then still hold).
-
   bool SameY(const realtype* y) const {
     const SimTK::Vector& current = state_.getY();
     const int n = current.size();
@@ -249,7 +248,8 @@ class CvodesIntegrator::Impl {
   Eigen::MatrixXd jacobian_;  // empty: difference quotients
   // kStateJacobian's cache: J and df/dp at (jacobian_time_, jacobian_y_), and scratch.
   bool jacobian_cached_ = false;
-  bool forward_jacobian_ = false;  // forward columns (else central)
+  // Forward columns through residual_ where it is set (else central).
+  bool forward_jacobian_ = false;
   // J came from the residual with every df/dp in closed form: a later corrector iterate of the
   // same step may keep it (RefreshParameterDerivative).
   bool jacobian_reusable_ = false;

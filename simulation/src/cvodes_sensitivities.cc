@@ -23,10 +23,11 @@ namespace {
 // steps of 1e-8 left 2e-4 errors in the excavator's weak swing-boom coupling (measured against
 // Richardson-extrapolated differences).
 constexpr double kJacobianStep = 1e-5;
-// Forward-difference step of J's columns (from the f(t, Y) CVODES hands over), relative to
-// max(|Y_j|, 1), chosen against Richardson-extrapolated differences (sensitivity_test.cc): at
-// 1e-8 roundoff left 1.2e-4 in the excavator's weak swing-boom coupling, at 1e-6 truncation
-// 4.8e-7 on the crane; 1e-7 keeps both below the forward quotients' errors.
+// Forward-difference step of J's columns (from the f(t, Y) CVODES hands over, through the
+// model's residual; central columns without one), relative to max(|Y_j|, 1), chosen against
+// Richardson-extrapolated differences (sensitivity_test.cc): at 1e-8 roundoff left 1.2e-4 in the
+// excavator's weak swing-boom coupling, at 1e-6 truncation 4.8e-7 on the crane; 1e-7 keeps both
+// below the forward quotients' errors.
 constexpr double kForwardJacobianStep = 1e-7;
 // A later corrector iterate of the same step within this distance of J's point (relative to
 // max(|Y_j|, 1)) keeps J: it moves J by a tenth of the forward step's own truncation error at
@@ -236,20 +237,6 @@ void CvodesIntegrator::Impl::UpdateSensitivityJacobian(double t, const realtype*
   }
   if (from_residual) {
     FormJacobianFromResidual(y, y_dot);
-  } else if (forward_jacobian_) {
-    // Forward columns from f(t, Y), which CVODES computed at these Y with the nominal
-    // parameters. Speeds first: the Position stage realized for M^-1 above serves them all.
-    const Eigen::Map<const Eigen::VectorXd> f_nominal(y_dot, ny);
-    for (int jj = 0; jj < ny; ++jj) {
-      const int j = (jj + nq) % ny;  // u, z, then q
-      const double h = kForwardJacobianStep * std::max(std::abs(y[j]), 1.0);
-      const double forward = y[j] + h;
-      SetEntry(j, nq, nu, forward);
-      CalcDerivative(column_.data());
-      SetEntry(j, nq, nu, y[j]);
-      state_jacobian_.col(j) = (column_ - f_nominal) / (forward - y[j]);
-    }
-    own_sensitivity_rhs_ += ny;
   } else {
     // Columns of J: only the perturbed entry changes, so a speed keeps the Position stage.
     for (int j = 0; j < ny; ++j) {

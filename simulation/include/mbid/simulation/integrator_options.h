@@ -57,10 +57,11 @@ struct SensitivityOptions {
     // iteration; df/dp_i in closed form where CvodesIntegrator::set_parameter_force_derivative
     // knows it, else central differences of f in p_i alone. `difference_quotient` says how J's
     // columns are differenced: centered, 2 NY right-hand sides, as close to
-    // Richardson-extrapolated differences as centered quotients; forward from the f(t, Y)
-    // CVODES hands over, and with CvodesIntegrator::set_residual through the inverse-dynamics
-    // residual at fixed u' (M^-1 once per mobility): about 6 right-hand sides' work on the crane
-    // (NY = 8), more accurate than forward quotients (docs/performance.md, session 17).
+    // Richardson-extrapolated differences as centered quotients; forward, where
+    // CvodesIntegrator::set_residual gives the inverse-dynamics residual (centered otherwise),
+    // from the f(t, Y) CVODES hands over and the residual at fixed u' (M^-1 once per mobility):
+    // about 6 right-hand sides' work on the crane (NY = 8), more accurate than forward
+    // quotients (docs/performance.md, session 17).
     kStateJacobian,
     // kStateJacobian where there are at least as many sensitivities as states (each forward
     // quotient costs a right-hand side, J about 0.7 of one per state: 0.80 of the quotients'
