@@ -276,6 +276,10 @@ TEST(GlobalSearchTest, RejectsBadOptions) {
   radius.matched_trust_region_radius = -1;
   EXPECT_FALSE(radius.IsValid(&why));
   EXPECT_NE(why.find("matched_trust_region_radius"), std::string::npos);
+  GlobalSearchOptions screen;
+  screen.screen_relative_tolerance = 0;
+  EXPECT_FALSE(screen.IsValid(&why));
+  EXPECT_NE(why.find("screen_relative_tolerance"), std::string::npos);
   const LoadDrop drop(1.0);
   EXPECT_THROW(SearchGlobally(*drop.crane.model, {drop.test}, drop.Options(), "design", {}, search),
                InputError);

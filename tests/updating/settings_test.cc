@@ -70,7 +70,7 @@ updating:
   sensitivity: {corrector: staggered, difference_quotient: centered, error_control: false}
   algebraic: {starts: 20, seed: 3, fit_offset: true, ambiguity_ratio: 3}
   profile: {enabled: true, sigmas: 1.5, max_fits_per_side: 4, max_iterations: 9, tolerance: 0.1}
-  global_search: {threads: 3}
+  global_search: {threads: 3, screen_relative_tolerance: 1.0e-6}
 )",
                                          *crane.model);
   const UpdateOptions& o = settings.options;
@@ -109,7 +109,8 @@ updating:
   EXPECT_EQ(settings.profile.max_fits_per_side, 4);
   EXPECT_EQ(settings.profile.max_iterations, 9);
   EXPECT_EQ(settings.profile.tolerance, 0.1);
-  EXPECT_EQ(settings.profile.threads, 3);                            // the global search's workers
+  EXPECT_EQ(settings.profile.threads, 3);  // the global search's workers
+  EXPECT_EQ(settings.global_search.screen_relative_tolerance, 1e-6);
   EXPECT_FALSE(Read("updating: {}", *crane.model).profile.enabled);  // off by default (cost)
   // A scalar noise level applies to every channel.
   EXPECT_EQ(Read("updating: {noise_std_rad: 3.0e-5}", *crane.model).noise_std.at("psi"), 3e-5);
@@ -156,6 +157,9 @@ TEST(SettingsTest, ErrorsNameTheFieldAndWhatWasExpected) {
   EXPECT_NE(ErrorOf("updating: {profile: {sigma: 2}}", m).find("did you mean 'sigmas'"),
             std::string::npos);
   EXPECT_NE(ErrorOf("updating: {profile: {tolerance: 2}}", m).find("tolerance"), std::string::npos);
+  EXPECT_NE(ErrorOf("updating: {global_search: {screen_relative_tolerance: 2}}", m)
+                .find("screen_relative_tolerance in (0, 1)"),
+            std::string::npos);
   // Errors name the file and the field.
   EXPECT_NE(
       ErrorOf("updating: {algebraic: {starts: 0}}", m).find("scenario.yaml:updating.algebraic"),

@@ -57,6 +57,9 @@ bool GlobalSearchOptions::IsValid(std::string* why) const {
   if (design_starts < 0) return fail("design_starts must be >= 0");
   if (!(screen_fraction > 0 && screen_fraction <= 1)) return fail("screen_fraction in (0, 1]");
   if (screen_iterations < 1) return fail("screen_iterations must be >= 1");
+  if (!(screen_relative_tolerance > 0 && screen_relative_tolerance < 1)) {
+    return fail("screen_relative_tolerance in (0, 1)");
+  }
   if (full_fits < 0) return fail("full_fits must be >= 0");
   if (!(cluster_tolerance > 0 && cluster_tolerance < 1)) {
     return fail("cluster_tolerance in (0, 1)");
@@ -162,6 +165,7 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   UpdateOptions screen = local;
   screen.max_iterations = search.screen_iterations;
   screen.continuation_fractions.clear();
+  internal::LoosenForScreening(search.screen_relative_tolerance, screen);
   struct Screened {
     std::vector<std::map<std::string, double>> design;
     std::vector<Run> batch;

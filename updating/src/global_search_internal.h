@@ -20,6 +20,10 @@ std::vector<std::vector<double>> SpaceFillingDesign(int count, int dimension, st
 // The tests cut to the first `fraction` of each record (the screening window).
 std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double fraction);
 
+// `screen` integrating the state at `relative_tolerance` where its own is tighter, with its
+// absolute and its sensitivities' tolerances loosened by the same factor.
+void LoosenForScreening(double relative_tolerance, UpdateOptions& screen);
+
 // Whether every channel of every test has its noise level given (else fits estimate it).
 bool EveryNoiseGiven(const std::vector<TestRecord>& tests);
 

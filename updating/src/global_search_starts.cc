@@ -74,6 +74,15 @@ std::vector<TestRecord> Window(const std::vector<TestRecord>& tests, double frac
   return window;
 }
 
+void LoosenForScreening(double relative_tolerance, UpdateOptions& screen) {
+  const double factor = relative_tolerance / screen.integrator.relative_tolerance;
+  if (!(factor > 1)) return;
+  screen.integrator.relative_tolerance *= factor;
+  screen.integrator.absolute_tolerance *= factor;
+  screen.sensitivity.relative_tolerance *= factor;
+  screen.sensitivity.absolute_tolerance *= factor;
+}
+
 bool EveryNoiseGiven(const std::vector<TestRecord>& tests) {
   for (const TestRecord& test : tests) {
     for (const std::string& channel : test.record.channels) {

@@ -96,14 +96,16 @@ CharacteristicOptions ReadAlgebraic(const YamlReader& node, CharacteristicOption
 
 GlobalSearchOptions ReadGlobalSearch(const YamlReader& node, GlobalSearchOptions o) {
   node.ExpectMap({"enabled", "design_starts", "seed", "screen_fraction", "screen_iterations",
-                  "full_fits", "cluster_tolerance", "significance", "threads",
-                  "pole_equivalent_starts"});
+                  "screen_relative_tolerance", "full_fits", "cluster_tolerance", "significance",
+                  "threads", "pole_equivalent_starts"});
   o.pole_equivalent_starts = node.Bool("pole_equivalent_starts", o.pole_equivalent_starts);
   o.enabled = node.Bool("enabled", o.enabled);
   o.design_starts = node.Int("design_starts", o.design_starts);
   o.seed = ReadSeed(node, o.seed);
   o.screen_fraction = node.PositiveDouble("screen_fraction", o.screen_fraction);
   o.screen_iterations = node.Int("screen_iterations", o.screen_iterations);
+  o.screen_relative_tolerance =
+      node.PositiveDouble("screen_relative_tolerance", o.screen_relative_tolerance);
   o.full_fits = node.Int("full_fits", o.full_fits);
   o.cluster_tolerance = node.PositiveDouble("cluster_tolerance", o.cluster_tolerance);
   o.significance = node.PositiveDouble("significance", o.significance);

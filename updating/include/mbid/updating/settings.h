@@ -71,6 +71,7 @@ namespace mbid::updating {
 //       seed: 1
 //       screen_fraction: 0.3               # design points fitted on this much of each record
 //       screen_iterations: 20
+//       screen_relative_tolerance: 1.0e-5  # the screens' integration (where the fit's is tighter)
 //       full_fits: 3                       # whole-record fits from the best screened ends
 //       cluster_tolerance: 0.02            # relative distance of one minimum's end points
 //       significance: 0.05                 # F-test level of an alternative minimum
