@@ -63,23 +63,6 @@ void ExpectNoConfidentWrongAnswer(const UpdateResult& result, const model::Mecha
   }
 }
 
-TEST(GlobalSearchTest, LocalFitFromTheDesignModelIsFlaggedNotBelieved) {
-  // The local fit from the design model ends at c_alpha about 0.57 of the truth with a 0.3%
-  // std (the trial): its residual is about 3 times the 1e-5 rad noise, which the
-  // credibility check must turn into "nothing determined".
-  const LoadDrop drop(8.0);
-  GlobalSearchOptions search;
-  search.enabled = false;
-  const GlobalSearchResult result =
-      SearchGlobally(*drop.crane.model, {drop.test}, drop.Options(), "design", {}, search);
-  ASSERT_EQ(result.best.termination, UpdateResult::Termination::kConverged);
-  RecordProperty("chi_square_per_dof", std::to_string(result.best.chi_square_per_dof));
-  // 4: UpdateOptions::max_chi_square_per_dof (residual rms twice the noise).
-  EXPECT_GT(result.best.chi_square_per_dof, 4);
-  EXPECT_FALSE(result.best.credible);
-  for (const ParameterEstimate& p : result.best.parameters) EXPECT_FALSE(p.determined) << p.name;
-}
-
 TEST(GlobalSearchTest, FindsTheTrueMinimumAndReportsTheSwappedOneAsAlternative) {
   const LoadDrop drop(8.0);
   GlobalSearchOptions search;
@@ -117,6 +100,22 @@ TEST(GlobalSearchTest, FindsTheTrueMinimumAndReportsTheSwappedOneAsAlternative) 
                               minimum.p_value < 1e-6);
   }
   EXPECT_TRUE(separated);
+  // The local fit from the design model (the search's primary start, fitted as a local fit
+  // alone would fit it) ends at c_alpha about 0.57 of the truth with a 0.3% std (the issue's
+  // trial): its residual is about 3 times the 1e-5 rad noise, which the credibility check must
+  // turn into "nothing determined".
+  const auto design = std::find_if(result.minima.begin(), result.minima.end(), [](const auto& m) {
+    return std::find(m.starts.begin(), m.starts.end(), "design") != m.starts.end();
+  });
+  ASSERT_NE(design, result.minima.end());
+  const UpdateResult& local = design->fit;
+  ASSERT_EQ(local.termination, UpdateResult::Termination::kConverged);
+  RecordProperty("local_chi_square_per_dof", std::to_string(local.chi_square_per_dof));
+  // 4: UpdateOptions::max_chi_square_per_dof (residual rms twice the noise).
+  EXPECT_GT(local.chi_square_per_dof, 4);
+  EXPECT_FALSE(local.credible);
+  for (const ParameterEstimate& p : local.parameters) EXPECT_FALSE(p.determined) << p.name;
+  EXPECT_NEAR(local.Find("c_alpha").value / drop.crane.model->GetParameter("c_alpha"), 0.57, 0.05);
 }
 
 // The same drop cut to 6 s: no start of the search reaches the true minimum (measured, with the
