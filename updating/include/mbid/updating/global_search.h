@@ -33,8 +33,8 @@ struct GlobalSearchOptions {
   // A screen integrates the state at this relative tolerance where the fit's own is tighter,
   // and loosens the absolute and the sensitivities' tolerances by the same factor: it only
   // seeks a basin, whose end is fitted again at the fit's own tolerances. At 1e-5 the
-  // simulation's error stays three orders below the noise of a 1e-2 signal-to-noise record;
-  // the crane's load-drop screening took 0.4x the CPU of 1e-8 (docs/performance.md).
+  // simulation's error stays far below a noise of 1% of the signal; the crane's load-drop
+  // update took 0.55 of the CPU it took with the screens at 1e-8 (docs/performance.md).
   double screen_relative_tolerance = 1e-5;
   // Whole-record fits from at most this many distinct screened ends, best screened cost first.
   int full_fits = 3;
