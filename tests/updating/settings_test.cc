@@ -67,7 +67,8 @@ updating:
   initial_trust_region_radius: 100
   continuation_fractions: [0.25, 0.5]
   integrator: {method: adams, relative_tolerance: 1.0e-7}
-  sensitivity: {corrector: staggered, difference_quotient: centered, error_control: false}
+  sensitivity: {right_hand_side: quotients, corrector: staggered, difference_quotient: centered,
+                error_control: false}
   algebraic: {starts: 20, seed: 3, fit_offset: true, ambiguity_ratio: 3}
   profile: {enabled: true, sigmas: 1.5, max_fits_per_side: 4, max_iterations: 9, tolerance: 0.1}
   global_search: {threads: 3, screen_relative_tolerance: 1.0e-6}
@@ -100,6 +101,14 @@ updating:
   EXPECT_EQ(o.sensitivity.difference_quotient,
             simulation::SensitivityOptions::DifferenceQuotient::kCentered);
   EXPECT_FALSE(o.sensitivity.error_control);
+  EXPECT_EQ(o.sensitivity.right_hand_side,
+            simulation::SensitivityOptions::RightHandSide::kCvodesQuotients);
+  // Not given: the fit's default, the state Jacobian from as many sensitivities as states.
+  EXPECT_EQ(Read("updating: {}", *crane.model).options.sensitivity.right_hand_side,
+            simulation::SensitivityOptions::RightHandSide::kAuto);
+  EXPECT_EQ(Read("updating: {sensitivity: {right_hand_side: state_jacobian}}", *crane.model)
+                .options.sensitivity.right_hand_side,
+            simulation::SensitivityOptions::RightHandSide::kStateJacobian);
   EXPECT_EQ(settings.algebraic.starts, 20);
   EXPECT_EQ(settings.algebraic.seed, 3u);
   EXPECT_TRUE(settings.algebraic.fit_offset);
@@ -153,6 +162,10 @@ TEST(SettingsTest, ErrorsNameTheFieldAndWhatWasExpected) {
             std::string::npos);
   EXPECT_NE(ErrorOf("updating: {sensitivity: {corrector: simultanous}}", m).find("simultaneous"),
             std::string::npos);
+  EXPECT_NE(ErrorOf("updating: {sensitivity: {right_hand_side: jacobian}}", m)
+                .find("auto, quotients, state_jacobian"),
+            std::string::npos)
+      << ErrorOf("updating: {sensitivity: {right_hand_side: jacobian}}", m);
   EXPECT_NE(ErrorOf("updating: {threads: 0}", m).find("threads"), std::string::npos);
   EXPECT_NE(ErrorOf("updating: {profile: {sigma: 2}}", m).find("did you mean 'sigmas'"),
             std::string::npos);
