@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 #include "mbid/simulation/scenario_sections.h"
 
@@ -45,15 +46,22 @@ simulation::SensitivityOptions ReadSensitivity(const YamlReader& node,
   using simulation::SensitivityOptions;
   node.ExpectMap({"right_hand_side", "corrector", "difference_quotient", "relative_tolerance",
                   "absolute_tolerance", "error_control"});
-  const char* rhs_default =
-      o.right_hand_side == SensitivityOptions::RightHandSide::kStateJacobian     ? "state_jacobian"
-      : o.right_hand_side == SensitivityOptions::RightHandSide::kCvodesQuotients ? "quotients"
-                                                                                 : "auto";
-  const std::string rhs =
-      node.Choice("right_hand_side", {"auto", "quotients", "state_jacobian"}, rhs_default);
-  o.right_hand_side = rhs == "state_jacobian" ? SensitivityOptions::RightHandSide::kStateJacobian
-                      : rhs == "quotients"    ? SensitivityOptions::RightHandSide::kCvodesQuotients
-                                              : SensitivityOptions::RightHandSide::kAuto;
+  // The scenario's name of each right-hand side, once for both directions.
+  using RightHandSide = SensitivityOptions::RightHandSide;
+  const std::vector<std::pair<std::string, RightHandSide>> right_hand_sides{
+      {"auto", RightHandSide::kAuto},
+      {"quotients", RightHandSide::kCvodesQuotients},
+      {"state_jacobian", RightHandSide::kStateJacobian}};
+  std::vector<std::string> names;
+  std::string current;
+  for (const auto& [name, value] : right_hand_sides) {
+    names.push_back(name);
+    if (value == o.right_hand_side) current = name;
+  }
+  const std::string rhs = node.Choice("right_hand_side", names, current);
+  for (const auto& [name, value] : right_hand_sides) {
+    if (name == rhs) o.right_hand_side = value;
+  }
   const bool staggered = o.corrector == SensitivityOptions::Corrector::kStaggered;
   o.corrector = node.Choice("corrector", {"simultaneous", "staggered"},
                             staggered ? "staggered" : "simultaneous") == "staggered"
