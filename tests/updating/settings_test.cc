@@ -39,6 +39,7 @@ TEST(SettingsTest, DefaultsTuneEveryParameterFromTheModel) {
   }
   EXPECT_TRUE(settings.options.integrator.interpolate_outputs);
   EXPECT_EQ(settings.options.jacobian, UpdateOptions::Jacobian::kSensitivities);
+  EXPECT_TRUE(settings.options.speculative_jacobians);
   EXPECT_TRUE(settings.algebraic_start);
   EXPECT_TRUE(settings.noise_std.empty());
   // An empty section is the defaults: cautious first steps from starts of unknown quality,
@@ -65,6 +66,7 @@ updating:
   undetermined_relative_std: 0.5
   threads: 2
   initial_trust_region_radius: 100
+  speculative_jacobians: false
   continuation_fractions: [0.25, 0.5]
   integrator: {method: adams, relative_tolerance: 1.0e-7}
   sensitivity: {right_hand_side: quotients, corrector: staggered, difference_quotient: centered,
@@ -91,6 +93,7 @@ updating:
   EXPECT_EQ(o.undetermined_relative_std, 0.5);
   EXPECT_EQ(o.threads, 2);
   EXPECT_EQ(o.initial_trust_region_radius, 100);
+  EXPECT_FALSE(o.speculative_jacobians);  // the default is true
   // A radius the file gives holds for Route 1's starts too.
   EXPECT_EQ(settings.global_search.matched_trust_region_radius, 100);
   EXPECT_EQ(o.continuation_fractions, (std::vector<double>{0.25, 0.5}));

@@ -166,6 +166,10 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   screen.max_iterations = search.screen_iterations;
   screen.continuation_fractions.clear();
   internal::LoosenForScreening(search.screen_relative_tolerance, screen);
+  // From space-filling points Ceres rejects about a quarter of the trial points, and at the
+  // screens' tolerance a sensitivity run costs ~10 plain ones: speculating does not pay there
+  // (docs/performance.md, session 19).
+  screen.speculative_jacobians = false;
   struct Screened {
     std::vector<std::map<std::string, double>> design;
     std::vector<Run> batch;

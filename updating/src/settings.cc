@@ -178,6 +178,7 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
                                 "whiteness_lags",
                                 "threads",
                                 "initial_trust_region_radius",
+                                "speculative_jacobians",
                                 "continuation_fractions",
                                 "integrator",
                                 "sensitivity",
@@ -284,6 +285,7 @@ UpdatingSettings ReadUpdatingSettings(const YamlReader& node, const model::Mecha
       node.PositiveDouble("max_chi_square_per_dof", options.max_chi_square_per_dof);
   options.whiteness_lags = node.Int("whiteness_lags", options.whiteness_lags);
   options.threads = node.Int("threads", options.threads);
+  options.speculative_jacobians = node.Bool("speculative_jacobians", options.speculative_jacobians);
   options.initial_trust_region_radius =
       node.PositiveDouble("initial_trust_region_radius", options.initial_trust_region_radius);
   // A radius the file gives holds for every start, Route 1's too.

@@ -37,32 +37,81 @@ TestEvaluator::TestEvaluator(const model::MechanicalModel& model,
 
 bool TestEvaluator::Evaluate(const double* x, double* residuals, double* jacobian) {
   const Eigen::Map<const Eigen::VectorXd> point(x, static_cast<Eigen::Index>(unknowns_.size()));
-  const bool at_jacobian_point = jacobian_x_.size() == point.size() && jacobian_x_ == point;
+  if (!current_.At(point) && previous_.At(point)) std::swap(current_, previous_);
+  const bool at_jacobian_point = current_.At(point);
   const bool at_residual_point = residual_x_.size() == point.size() && residual_x_ == point;
   try {
-    if (jacobian != nullptr && !at_jacobian_point) {
-      ComputeWithJacobian(point);
-      jacobian_x_ = point;
-    } else if (jacobian == nullptr && !at_jacobian_point && !at_residual_point) {
-      residuals_ = ComputeResiduals(*models_[0], point);
-      residual_x_ = point;
+    if (jacobian != nullptr) {
+      if (last_trial_x_.size() == point.size() && last_trial_x_ == point) ++accepted_trials_;
+      last_trial_x_.resize(0);
+      if (!at_jacobian_point) ComputeWithJacobian(point);
+      speculation_pending_ = false;
+      current_.iterate = ++iterates_;
+    } else if (!at_jacobian_point && !at_residual_point) {
+      const bool speculate = ShouldSpeculate(point);
+      ++trials_;
+      last_trial_x_ = point;
+      if (speculate) {
+        ComputeWithJacobian(point);
+        speculation_pending_ = true;
+      } else {
+        speculation_pending_ = false;  // the last speculation was not asked for: go plain once
+        residuals_ = ComputeResiduals(*models_[0], point);
+        residual_x_ = point;
+      }
     }
   } catch (const std::exception& e) {
     Invalidate();
     work_.Fail(test_.test->name + ": " + e.what());
     return false;
   }
-  const bool from_jacobian = jacobian != nullptr || at_jacobian_point;
+  const bool from_jacobian = current_.At(point);
   Eigen::Map<Eigen::VectorXd>(residuals, residual_count()) =
-      from_jacobian ? jacobian_residuals_ : residuals_;
+      from_jacobian ? current_.residuals : residuals_;
   if (jacobian != nullptr) {
     Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-        jacobian, residual_count(), static_cast<Eigen::Index>(unknowns_.size())) = jacobian_;
+        jacobian, residual_count(), static_cast<Eigen::Index>(unknowns_.size())) =
+        current_.jacobian;
   }
   return true;
 }
 
+// A trial point is worth its Jacobian when Ceres is expected to ask for it: the step from the
+// last iterate is to be accepted and not to end the fit. So the last iterate's linear model must
+// predict a relative decrease of the cost of 10 function tolerances at least, and the trial
+// points accepted so far (counted from one of one) must outnumber the break-even share
+// 1 - P / S, P and S the right-hand sides of the last plain and sensitivity runs: a speculation
+// Ceres takes saves P, one it rejects wastes S - P. Far starts, whose steps are often rejected,
+// stay plain. After a speculation that was not asked for, the next trial point is plain.
+// Decided on counts only, so the fit's path is the same on every run.
+bool TestEvaluator::ShouldSpeculate(const Eigen::VectorXd& x) const {
+  if (!options_.speculative_jacobians || speculation_pending_ ||
+      options_.jacobian != UpdateOptions::Jacobian::kSensitivities) {
+    return false;
+  }
+  if (plain_rhs_ > 0 && sensitivity_rhs_ > 0) {
+    const double accepted = static_cast<double>(accepted_trials_ + 1) / (trials_ + 1);
+    if (accepted <= 1.0 - static_cast<double>(plain_rhs_) / sensitivity_rhs_) return false;
+  }
+  const JacobianPoint* iterate = current_.iterate >= previous_.iterate ? &current_ : &previous_;
+  if (iterate->iterate == 0) return false;
+  const double cost = iterate->residuals.squaredNorm();
+  if (!(cost > 0)) return false;
+  const Eigen::VectorXd predicted = iterate->residuals + iterate->jacobian * (x - iterate->x);
+  return (cost - predicted.squaredNorm()) > 10 * options_.function_tolerance * cost;
+}
+
+Measurement TestEvaluator::WithRecordTimes(const Measurement& exact) const {
+  Measurement simulated = exact;
+  simulated.start_time_s = test_.test->record.start_time_s;
+  return simulated;
+}
+
 Measurement TestEvaluator::Simulate(const Eigen::VectorXd& x) {
+  if (simulated_x_.size() == x.size() && simulated_x_ == x) return simulated_;
+  for (const JacobianPoint* point : {&current_, &previous_}) {
+    if (point->At(x)) return point->simulated;
+  }
   model::MechanicalModel& model = *models_[0];
   const Excitation excitation = Configure(model, x);
   const simulation::SimulationResult run =
@@ -70,30 +119,31 @@ Measurement TestEvaluator::Simulate(const Eigen::VectorXd& x) {
   ++work_.simulations;
   work_.Count(run.statistics);
   CheckSamples(run.exact.values);
-  Measurement simulated = run.exact;
-  simulated.start_time_s = test_.test->record.start_time_s;
-  return simulated;
+  simulated_x_ = x;
+  simulated_ = WithRecordTimes(run.exact);
+  return simulated_;
 }
 
 Eigen::MatrixXd TestEvaluator::CalcBaselineRegression(const Eigen::VectorXd& x) const {
   const Baseline& baseline = *test_.baseline;
   const int m = test_.test->record.channel_count();
   const int count = static_cast<int>(unknowns_.size());
-  if (baseline.terms() == 0 || jacobian_x_.size() != x.size() || jacobian_x_ != x) {
-    return Eigen::MatrixXd();
-  }
+  const JacobianPoint* at = current_.At(x) ? &current_ : previous_.At(x) ? &previous_ : nullptr;
+  if (baseline.terms() == 0 || at == nullptr) return Eigen::MatrixXd();
   Eigen::MatrixXd regression(baseline.terms() * m, count);
   for (int c = 0; c < m; ++c) {
     // The Jacobian's rows are dy/dx / sigma_c.
     regression.middleRows(baseline.terms() * c, baseline.terms()) =
         test_.sigma[c] *
-        baseline.CalcRegression(unprojected_jacobian_.data() + c, m, residual_count(), count);
+        baseline.CalcRegression(at->unprojected.data() + c, m, residual_count(), count);
   }
   return regression;
 }
 
 void TestEvaluator::Invalidate() {
-  jacobian_x_.resize(0);
+  current_ = JacobianPoint();
+  previous_ = JacobianPoint();
+  speculation_pending_ = false;
   residual_x_.resize(0);
 }
 
@@ -148,35 +198,44 @@ void TestEvaluator::Project(double* v) const {
 
 // Residuals before the baseline's projection.
 Eigen::VectorXd TestEvaluator::ComputeRawResiduals(model::MechanicalModel& model,
-                                                   const Eigen::VectorXd& x) {
+                                                   const Eigen::VectorXd& x,
+                                                   Measurement* simulated) {
   const Excitation excitation = Configure(model, x);
   const simulation::SimulationResult run =
       simulation::Simulate(model, excitation, test_.simulation, test_.sensors);
   ++work_.simulations;
   work_.Count(run.statistics);
-  return Weigh(run.exact.values);
+  if (simulated != nullptr) plain_rhs_ = TotalRhs(run.statistics);
+  Eigen::VectorXd r = Weigh(run.exact.values);
+  if (simulated != nullptr) *simulated = WithRecordTimes(run.exact);
+  return r;
 }
 
 Eigen::VectorXd TestEvaluator::ComputeResiduals(model::MechanicalModel& model,
                                                 const Eigen::VectorXd& x) {
-  Eigen::VectorXd r = ComputeRawResiduals(model, x);
+  Eigen::VectorXd r = ComputeRawResiduals(model, x, &simulated_);
+  simulated_x_ = x;
   Project(r.data());
   return r;
 }
 
 void TestEvaluator::ComputeWithJacobian(const Eigen::VectorXd& x) {
   const int columns = static_cast<int>(unknowns_.size());
-  jacobian_ = Eigen::MatrixXd::Zero(residual_count(), columns);
+  // The last iterate stays (the fit may end there after rejected trial points); the other goes.
+  if (current_.iterate >= previous_.iterate) std::swap(previous_, current_);
+  current_ = JacobianPoint();
+  current_.jacobian = Eigen::MatrixXd::Zero(residual_count(), columns);
   if (options_.jacobian == UpdateOptions::Jacobian::kNumeric) {
     ComputeNumericJacobian(x);
   } else {
     ComputeSensitivityJacobian(x);
   }
+  current_.x = x;
   if (test_.baseline->terms() == 0) return;
   // Variable projection: the basis does not depend on x, so P J is the exact Jacobian of P r.
-  unprojected_jacobian_ = jacobian_;
-  Project(jacobian_residuals_.data());
-  for (int k = 0; k < columns; ++k) Project(jacobian_.col(k).data());
+  current_.unprojected = current_.jacobian;
+  Project(current_.residuals.data());
+  for (int k = 0; k < columns; ++k) Project(current_.jacobian.col(k).data());
 }
 
 // Central differences of whole simulations in Ceres' coordinates; the columns run in
@@ -186,16 +245,18 @@ void TestEvaluator::ComputeNumericJacobian(const Eigen::VectorXd& x) {
   std::vector<std::string> errors(static_cast<size_t>(groups));
   auto run_group = [&](int g) {
     try {
-      if (g == 0) jacobian_residuals_ = ComputeRawResiduals(*models_[0], x);
+      if (g == 0) current_.residuals = ComputeRawResiduals(*models_[0], x, &current_.simulated);
       for (size_t i = static_cast<size_t>(g); i < test_.unknowns.size();
            i += static_cast<size_t>(groups)) {
         const int k = test_.unknowns[i];
         Eigen::VectorXd step = x;
         step[k] = x[k] + options_.numeric_step;
-        const Eigen::VectorXd plus = ComputeRawResiduals(*models_[static_cast<size_t>(g)], step);
+        const Eigen::VectorXd plus =
+            ComputeRawResiduals(*models_[static_cast<size_t>(g)], step, nullptr);
         step[k] = x[k] - options_.numeric_step;
-        const Eigen::VectorXd minus = ComputeRawResiduals(*models_[static_cast<size_t>(g)], step);
-        jacobian_.col(k) = (plus - minus) / (2 * options_.numeric_step);
+        const Eigen::VectorXd minus =
+            ComputeRawResiduals(*models_[static_cast<size_t>(g)], step, nullptr);
+        current_.jacobian.col(k) = (plus - minus) / (2 * options_.numeric_step);
       }
     } catch (const std::exception& e) {
       errors[static_cast<size_t>(g)] = e.what();
@@ -214,6 +275,7 @@ void TestEvaluator::ComputeSensitivityJacobian(const Eigen::VectorXd& x) {
   const Measurement& record = test_.test->record;
   const int m = record.channel_count();
   std::vector<std::string> errors(static_cast<size_t>(groups));
+  std::vector<long> rhs(static_cast<size_t>(groups), 0);
   auto run_group = [&](int g) {
     try {
       model::MechanicalModel& model = *models_[static_cast<size_t>(g)];
@@ -240,7 +302,11 @@ void TestEvaluator::ComputeSensitivityJacobian(const Eigen::VectorXd& x) {
                                                 names, directions, options_.sensitivity);
       ++work_.sensitivity_simulations;
       work_.Count(run.statistics);
-      if (g == 0) jacobian_residuals_ = Weigh(run.exact.values);
+      rhs[static_cast<size_t>(g)] = TotalRhs(run.statistics);
+      if (g == 0) {
+        current_.residuals = Weigh(run.exact.values);
+        current_.simulated = WithRecordTimes(run.exact);
+      }
       CheckSamples(run.exact.values);
       for (size_t i = 0; i < columns.size(); ++i) {
         const int k = columns[i];
@@ -250,7 +316,7 @@ void TestEvaluator::ComputeSensitivityJacobian(const Eigen::VectorXd& x) {
         const Eigen::MatrixXd& dy = run.output_sensitivities[i];
         for (int j = 0; j < record.samples(); ++j) {
           for (int c = 0; c < m; ++c) {
-            jacobian_(j * m + c, k) = dy(j, c) * dp_dx / test_.sigma[c];
+            current_.jacobian(j * m + c, k) = dy(j, c) * dp_dx / test_.sigma[c];
           }
         }
       }
@@ -262,6 +328,8 @@ void TestEvaluator::ComputeSensitivityJacobian(const Eigen::VectorXd& x) {
   for (const std::string& error : errors) {
     if (!error.empty()) throw NumericalError("sensitivities", error);
   }
+  sensitivity_rhs_ = 0;
+  for (long count : rhs) sensitivity_rhs_ += count;
 }
 
 // dq(0)/dp of a nuisance parameter: e_i for a deflection; central differences of the loaded

@@ -22,6 +22,11 @@
 
 namespace mbid::updating::internal {
 
+// A run's right-hand sides, the difference quotients' and the Jacobians' included.
+inline long TotalRhs(const simulation::IntegratorStatistics& s) {
+  return s.rhs_evaluations + s.rhs_evaluations_for_jacobian + s.rhs_evaluations_for_sensitivities;
+}
+
 // Counters shared by all cost functions (evaluated from several threads by Ceres).
 struct Work {
   std::atomic<long> simulations{0};
@@ -30,10 +35,7 @@ struct Work {
   std::mutex mutex;
   std::string last_error;
 
-  void Count(const simulation::IntegratorStatistics& s) {
-    rhs_evaluations +=
-        s.rhs_evaluations + s.rhs_evaluations_for_jacobian + s.rhs_evaluations_for_sensitivities;
-  }
+  void Count(const simulation::IntegratorStatistics& s) { rhs_evaluations += TotalRhs(s); }
   void Fail(const std::string& what) {
     std::lock_guard<std::mutex> lock(mutex);
     last_error = what;
@@ -50,11 +52,14 @@ class TestEvaluator {
   }
 
   // Residuals (and, if `jacobian` is not null, the row-major residuals x unknowns Jacobian in
-  // Ceres' coordinates) at x. Two caches: Ceres asks for the Jacobian at a point whose residuals
-  // it has just evaluated, and the covariance asks again at the solution after rejected trial
-  // points.
+  // Ceres' coordinates) at x. Caches: Ceres asks for the Jacobian at a point whose residuals it
+  // has just evaluated, and the covariance asks again at the solution after rejected trial
+  // points (the last two Jacobians are kept). With UpdateOptions::speculative_jacobians a trial
+  // point that the last iterate's linear model expects to be accepted is evaluated with its
+  // Jacobian at once: a sensitivity run yields the residuals too, so the plain run is saved.
   bool Evaluate(const double* x, double* residuals, double* jacobian);
-  // The simulated record at x (channels x samples of the record) without weights.
+  // The simulated record at x (channels x samples of the record) without weights: the last
+  // evaluation's when it was at x, else a new simulation.
   Measurement Simulate(const Eigen::VectorXd& x);
   // d(baseline coefficients)/dx of each channel at the last Jacobian's point `x`: rows
   // terms * c .. terms * (c + 1) - 1 for channel c, one column per unknown; empty elsewhere.
@@ -67,9 +72,13 @@ class TestEvaluator {
   void CheckSamples(const Eigen::MatrixXd& simulated) const;
   Eigen::VectorXd Weigh(const Eigen::MatrixXd& simulated) const;
   void Project(double* v) const;
-  Eigen::VectorXd ComputeRawResiduals(model::MechanicalModel& model, const Eigen::VectorXd& x);
+  // simulated: where to keep the simulated record for Simulate, if not null.
+  Eigen::VectorXd ComputeRawResiduals(model::MechanicalModel& model, const Eigen::VectorXd& x,
+                                      Measurement* simulated);
   Eigen::VectorXd ComputeResiduals(model::MechanicalModel& model, const Eigen::VectorXd& x);
   void ComputeWithJacobian(const Eigen::VectorXd& x);
+  bool ShouldSpeculate(const Eigen::VectorXd& x) const;
+  Measurement WithRecordTimes(const Measurement& exact) const;
   void ComputeNumericJacobian(const Eigen::VectorXd& x);
   void ComputeSensitivityJacobian(const Eigen::VectorXd& x);
   simulation::InitialStateDirection MakeDirection(const model::MechanicalModel& model,
@@ -81,12 +90,30 @@ class TestEvaluator {
   const UpdateOptions& options_;
   Work& work_;
   std::vector<std::unique_ptr<model::MechanicalModel>> models_;  // one per thread
-  Eigen::VectorXd jacobian_x_;  // where jacobian_ and jacobian_residuals_ were computed
-  Eigen::VectorXd jacobian_residuals_;
-  Eigen::MatrixXd jacobian_;
-  Eigen::MatrixXd unprojected_jacobian_;  // with a baseline: before the projection
-  Eigen::VectorXd residual_x_;            // the last residual-only evaluation
+  // A point evaluated with its Jacobian.
+  struct JacobianPoint {
+    Eigen::VectorXd x;  // empty: none
+    Eigen::VectorXd residuals;
+    Eigen::MatrixXd jacobian;
+    Eigen::MatrixXd unprojected;  // with a baseline: before the projection
+    Measurement simulated;        // the exact outputs (channels x samples)
+    long iterate = 0;             // > 0: Ceres asked for the Jacobian here, the n-th time
+    bool At(const Eigen::Ref<const Eigen::VectorXd>& point) const {
+      return x.size() == point.size() && x == point;
+    }
+  };
+  JacobianPoint current_, previous_;  // current_: the newest, or the one last asked for
+  long iterates_ = 0;
+  bool speculation_pending_ = false;  // the newest Jacobian was speculative, not yet asked for
+  // Trial points (residuals asked for at a new point) and those Ceres accepted (asked for the
+  // Jacobian there next), and the right-hand sides of the last plain and sensitivity runs.
+  long trials_ = 0, accepted_trials_ = 0;
+  Eigen::VectorXd last_trial_x_;
+  long plain_rhs_ = 0, sensitivity_rhs_ = 0;
+  Eigen::VectorXd residual_x_;  // the last residual-only evaluation
   Eigen::VectorXd residuals_;
+  Eigen::VectorXd simulated_x_;  // the last plain simulation's point and exact outputs
+  Measurement simulated_;
 };
 
 // One test's residual block.

@@ -122,6 +122,11 @@ struct UpdateOptions {
   // (0, 1)), then the whole record from there. Short windows have fewer cycles to slip, so fewer
   // local minima; e.g. {0.25}. Empty: fit the whole record at once.
   std::vector<double> continuation_fractions;
+  // A trial point whose predicted cost decrease (the last iterate's linear model) is well above
+  // the function tolerance is simulated with its sensitivities at once: Ceres asks for the
+  // Jacobian at every accepted point, and a sensitivity run yields the residuals too, so the
+  // plain run there is saved; a rejected one costs a sensitivity run instead of a plain one.
+  bool speculative_jacobians = true;
   // Simulations in parallel: tests, and parameter groups of one test's sensitivities.
   int threads = 1;
   // Progress (iteration, cost, step) on standard error unless quiet.

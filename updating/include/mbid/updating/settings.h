@@ -49,6 +49,8 @@ namespace mbid::updating {
 //     initial_trust_region_radius: 10      # Ceres LM; small = cautious first steps; when not
 //                                          #   given, Route 1's sets start at 1000
 //                                          #   (GlobalSearchOptions::matched_trust_region_radius)
+//     speculative_jacobians: true          # sensitivities at once at a trial point the last
+//                                          #   iterate's linear model expects to be accepted
 //     continuation_fractions: []           # e.g. [0.25]: fit the first quarter of each record
 //                                          #   first, then the whole (fewer local minima)
 //     integrator:                          # the fit's simulations; default: the scenario's
