@@ -170,5 +170,50 @@ TEST(TestEvaluatorTest, RejectedSpeculationsTurnTheTrialsPlainAndTheIterateStays
   }
 }
 
+// Through the fit: from 5% off, every trial point Ceres accepts was speculated, so the plain runs
+// there are saved, the sensitivity runs are the same ones, and so is the result.
+TEST(TestEvaluatorTest, AFitFromNearTheTruthSavesItsPlainRunsAndEndsTheSame) {
+  const Crane crane = LoadCrane(testing::kReferenceScenario);
+  const TestRecord test = testing::SimulateTest(crane, "decay", 3.0);
+  auto fit = [&](bool speculative) {
+    UpdateOptions options;
+    options.integrator = crane.simulation.integrator;
+    options.integrator.interpolate_outputs = true;
+    options.quiet = true;
+    options.speculative_jacobians = speculative;
+    for (const std::string& name : testing::kAllParameters) {
+      ParameterSetting setting;
+      setting.name = name;
+      setting.initial = (name[0] == 'c' ? 1.05 : 0.95) * crane.model->GetParameter(name);
+      options.parameters.push_back(setting);
+    }
+    return UpdateModel(*crane.model, {test}, options);
+  };
+  const UpdateResult plain = fit(false);
+  const UpdateResult speculative = fit(true);
+  ASSERT_EQ(plain.termination, UpdateResult::Termination::kConverged) << plain.message;
+  ASSERT_EQ(speculative.termination, UpdateResult::Termination::kConverged);
+  EXPECT_EQ(speculative.iterations, plain.iterations);
+  EXPECT_EQ(speculative.sensitivity_simulations, plain.sensitivity_simulations);
+  // Without speculation: one plain run per trial point and one for the re-simulation; with it,
+  // at most the last trial point's (the one that stops the fit) is plain.
+  EXPECT_GE(plain.simulations, plain.iterations);
+  EXPECT_LE(speculative.simulations, 1);
+  // The same Jacobians at the same points: the same estimates, up to the last trial's cost
+  // (a plain run either way).
+  for (const std::string& name : testing::kAllParameters) {
+    EXPECT_EQ(speculative.Find(name).value, plain.Find(name).value) << name;
+    EXPECT_EQ(speculative.Find(name).std, plain.Find(name).std) << name;
+  }
+  EXPECT_EQ(speculative.final_cost, plain.final_cost);
+  // The re-simulation at the estimate comes from the last sensitivity run there: the same
+  // record as a plain run's to the integration tolerance.
+  ASSERT_EQ(speculative.tests.size(), 1u);
+  EXPECT_LT((speculative.tests[0].simulated.values - plain.tests[0].simulated.values)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-6 * plain.tests[0].simulated.values.cwiseAbs().maxCoeff());
+}
+
 }  // namespace
 }  // namespace mbid::updating::internal
