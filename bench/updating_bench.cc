@@ -2,7 +2,8 @@
 // one run of Route 2, the Jacobian from CVODES forward sensitivities against central
 // differences of whole simulations. The record is reference-crane.yaml (initial deflection,
 // 8 s at 100 Hz, sensor noise 1e-5 rad with seed 1), the noise level given to the fit.
-// Argument: worker threads (sensitivity groups, or columns of the numeric Jacobian).
+// Argument: worker threads (sensitivity groups, or columns of the numeric Jacobian); for
+// BM_UpdateSpeculative a second, updating.speculative_jacobians off (0) or on (1).
 // Counters: Ceres iterations, right-hand-side evaluations of every kind, simulations, and the
 // largest relative error of the eight estimates against the truth. Anchors in the same run: one
 // plain simulation of the record and one sensitivity run of all eight parameters, the units the
@@ -57,7 +58,7 @@ using Method = mbid::simulation::IntegratorOptions::Method;
 // `method`: the scenario's (auto) unless given.
 void RunUpdate(benchmark::State& state, UpdateOptions::Jacobian jacobian,
                mbid::simulation::SensitivityOptions::DifferenceQuotient quotient,
-               std::optional<Method> method = std::nullopt) {
+               std::optional<Method> method = std::nullopt, bool speculative = true) {
   const Setup& setup = Reference();
   UpdateOptions options;
   for (const mbid::model::Parameter& p : setup.model->parameters()) {
@@ -69,6 +70,7 @@ void RunUpdate(benchmark::State& state, UpdateOptions::Jacobian jacobian,
   options.integrator.interpolate_outputs = true;
   if (method) options.integrator.method = *method;
   options.threads = static_cast<int>(state.range(0));
+  options.speculative_jacobians = speculative;
   options.quiet = true;
   mbid::updating::UpdateResult result;
   for (auto _ : state) {
@@ -192,6 +194,12 @@ void BM_UpdateSensitivitiesForwardAdams(benchmark::State& state) {
   RunUpdate(state, UpdateOptions::Jacobian::kSensitivities,
             mbid::simulation::SensitivityOptions::DifferenceQuotient::kForward, Method::kAdams);
 }
+// Argument 1: updating.speculative_jacobians (the default), 0: every trial point plain.
+void BM_UpdateSpeculative(benchmark::State& state) {
+  RunUpdate(state, UpdateOptions::Jacobian::kSensitivities,
+            mbid::simulation::SensitivityOptions::DifferenceQuotient::kForward, std::nullopt,
+            state.range(1) == 1);
+}
 void BM_UpdateNumeric(benchmark::State& state) {
   RunUpdate(state, UpdateOptions::Jacobian::kNumeric,
             mbid::simulation::SensitivityOptions::DifferenceQuotient::kCentered);
@@ -224,6 +232,12 @@ BENCHMARK(BM_UpdateSensitivitiesForwardAdams)
     ->Arg(1)
     ->Iterations(1)
     ->UseRealTime()
+    ->Unit(benchmark::kSecond);
+// Arguments: threads, then speculative Jacobians off (0) and on (1), process CPU time.
+BENCHMARK(BM_UpdateSpeculative)
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Iterations(1)
     ->Unit(benchmark::kSecond);
 BENCHMARK(BM_UpdateNumeric)->Arg(1)->Arg(2)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
 
