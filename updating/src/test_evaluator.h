@@ -54,9 +54,10 @@ class TestEvaluator {
   // Residuals (and, if `jacobian` is not null, the row-major residuals x unknowns Jacobian in
   // Ceres' coordinates) at x. Caches: Ceres asks for the Jacobian at a point whose residuals it
   // has just evaluated, and the covariance asks again at the solution after rejected trial
-  // points (the last two Jacobians are kept). With UpdateOptions::speculative_jacobians a trial
-  // point that the last iterate's linear model expects to be accepted is evaluated with its
-  // Jacobian at once: a sensitivity run yields the residuals too, so the plain run is saved.
+  // points (the last iterate's Jacobian and the newest are kept). With
+  // UpdateOptions::speculative_jacobians a trial point that the last iterate's linear model expects
+  // to be accepted is evaluated with its Jacobian at once: a sensitivity run yields the residuals
+  // too, so the plain run is saved.
   bool Evaluate(const double* x, double* residuals, double* jacobian);
   // The simulated record at x (channels x samples of the record) without weights: the last
   // evaluation's when it was at x, else a new simulation.
