@@ -23,16 +23,7 @@ using testing::Sci;
 
 // Starts every stiffness at `c_factor` and every damping at `d_factor` times the truth.
 UpdateOptions StartOff(const Crane& crane, double c_factor, double d_factor) {
-  UpdateOptions options;
-  for (const std::string& name : kAllParameters) {
-    ParameterSetting setting;
-    setting.name = name;
-    setting.initial = crane.model->GetParameter(name) * (name[0] == 'c' ? c_factor : d_factor);
-    options.parameters.push_back(setting);
-  }
-  options.integrator = crane.simulation.integrator;
-  options.integrator.interpolate_outputs = true;
-  options.quiet = true;
+  UpdateOptions options = testing::FitFromOff(crane, kAllParameters, c_factor, d_factor);
   options.threads = 2;  // sensitivity groups in parallel on the test machine's two cores
   return options;
 }
@@ -141,16 +132,7 @@ TEST(BaselineTest, NumericJacobianProjectsTheSameWay) {
   for (int c = 0; c < 2; ++c) record.values.col(c).array() += offset[c];
   TestRecord test{"offset", record, crane.excitation, {}};
   test.fit_offsets = true;
-  UpdateOptions options;
-  for (const char* name : {"c_theta", "d_theta"}) {
-    ParameterSetting setting;
-    setting.name = name;
-    setting.initial = crane.model->GetParameter(name) * (name[0] == 'c' ? 1.2 : 0.8);
-    options.parameters.push_back(setting);
-  }
-  options.integrator = crane.simulation.integrator;
-  options.integrator.interpolate_outputs = true;
-  options.quiet = true;
+  UpdateOptions options = testing::FitFromOff(crane, {"c_theta", "d_theta"}, 1.2, 0.8);
   for (const auto jacobian :
        {UpdateOptions::Jacobian::kSensitivities, UpdateOptions::Jacobian::kNumeric}) {
     options.jacobian = jacobian;

@@ -19,6 +19,7 @@ namespace mbid::updating::testing {
 // The reference crane's joint parameters, as the updating tunes them.
 inline const std::vector<std::string> kAllParameters{"c_alpha", "c_gamma", "c_eta", "c_theta",
                                                      "d_alpha", "d_gamma", "d_eta", "d_theta"};
+inline const std::vector<std::string> kStiffnesses{"c_alpha", "c_gamma", "c_eta", "c_theta"};
 
 // Measured numbers for the XML report (RecordProperty), in scientific notation.
 inline std::string Sci(double value) {
@@ -68,6 +69,24 @@ inline TestRecord SimulateTest(const Crane& crane, const std::string& name, doub
   const simulation::SimulationResult run =
       simulation::Simulate(*crane.model, crane.excitation, options, crane.sensors);
   return {name, run.measured, crane.excitation, crane.sensors.noise_std};
+}
+
+// The fit's settings for `crane`'s records as the scenario reader makes them (its integrator,
+// outputs interpolated), quiet, with `names` tuned from `c_factor` (stiffnesses c_*) and
+// `d_factor` (dampings d_*) times the truth.
+inline UpdateOptions FitFromOff(const Crane& crane, const std::vector<std::string>& names,
+                                double c_factor, double d_factor) {
+  UpdateOptions options;
+  for (const std::string& name : names) {
+    ParameterSetting setting;
+    setting.name = name;
+    setting.initial = crane.model->GetParameter(name) * (name[0] == 'c' ? c_factor : d_factor);
+    options.parameters.push_back(setting);
+  }
+  options.integrator = crane.simulation.integrator;
+  options.integrator.interpolate_outputs = true;
+  options.quiet = true;
+  return options;
 }
 
 }  // namespace mbid::updating::testing

@@ -23,16 +23,8 @@ struct Probe {
   Probe() {
     // 301 samples: the first tenth is 50 (Window's least).
     test = testing::SimulateTest(crane, "load drop", 3.0);
-    options.integrator = crane.simulation.integrator;
-    options.integrator.interpolate_outputs = true;
-    options.quiet = true;
     // A far start: every stiffness 30% high, as a space-filling point would be.
-    for (const char* name : {"c_alpha", "c_gamma", "c_eta", "c_theta"}) {
-      ParameterSetting setting;
-      setting.name = name;
-      setting.initial = 1.3 * crane.model->GetParameter(name);
-      options.parameters.push_back(setting);
-    }
+    options = testing::FitFromOff(crane, testing::kStiffnesses, 1.3, 1.0);
   }
 };
 

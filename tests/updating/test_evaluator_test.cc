@@ -22,16 +22,8 @@ struct OneRecordFit {
   PreparedTest prepared;
 
   explicit OneRecordFit(bool speculative) {
-    options.integrator = crane.simulation.integrator;
-    options.integrator.interpolate_outputs = true;
-    options.quiet = true;
+    options = testing::FitFromOff(crane, testing::kStiffnesses, 1.03, 1.0);
     options.speculative_jacobians = speculative;
-    for (const char* name : {"c_alpha", "c_gamma", "c_eta", "c_theta"}) {
-      ParameterSetting setting;
-      setting.name = name;
-      setting.initial = 1.03 * crane.model->GetParameter(name);
-      options.parameters.push_back(setting);
-    }
     unknowns = ResolveUnknowns(*crane.model, {test}, options);
     prepared = PrepareTest(*crane.model, test, 0, unknowns, options);
   }
@@ -176,17 +168,8 @@ TEST(TestEvaluatorTest, AFitFromNearTheTruthSavesItsPlainRunsAndEndsTheSame) {
   const Crane crane = LoadCrane(testing::kReferenceScenario);
   const TestRecord test = testing::SimulateTest(crane, "decay", 3.0);
   auto fit = [&](bool speculative) {
-    UpdateOptions options;
-    options.integrator = crane.simulation.integrator;
-    options.integrator.interpolate_outputs = true;
-    options.quiet = true;
+    UpdateOptions options = testing::FitFromOff(crane, testing::kAllParameters, 1.05, 0.95);
     options.speculative_jacobians = speculative;
-    for (const std::string& name : testing::kAllParameters) {
-      ParameterSetting setting;
-      setting.name = name;
-      setting.initial = (name[0] == 'c' ? 1.05 : 0.95) * crane.model->GetParameter(name);
-      options.parameters.push_back(setting);
-    }
     return UpdateModel(*crane.model, {test}, options);
   };
   const UpdateResult plain = fit(false);

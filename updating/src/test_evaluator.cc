@@ -39,10 +39,10 @@ bool TestEvaluator::Evaluate(const double* x, double* residuals, double* jacobia
   const Eigen::Map<const Eigen::VectorXd> point(x, static_cast<Eigen::Index>(unknowns_.size()));
   if (!current_.At(point) && previous_.At(point)) std::swap(current_, previous_);
   const bool at_jacobian_point = current_.At(point);
-  const bool at_residual_point = residual_x_.size() == point.size() && residual_x_ == point;
+  const bool at_residual_point = SamePoint(residual_x_, point);
   try {
     if (jacobian != nullptr) {
-      if (last_trial_x_.size() == point.size() && last_trial_x_ == point) ++accepted_trials_;
+      if (SamePoint(last_trial_x_, point)) ++accepted_trials_;
       last_trial_x_.resize(0);
       if (!at_jacobian_point) ComputeWithJacobian(point);
       speculation_pending_ = false;
@@ -108,7 +108,7 @@ Measurement TestEvaluator::WithRecordTimes(const Measurement& exact) const {
 }
 
 Measurement TestEvaluator::Simulate(const Eigen::VectorXd& x) {
-  if (simulated_x_.size() == x.size() && simulated_x_ == x) return simulated_;
+  if (SamePoint(simulated_x_, x)) return simulated_;
   for (const JacobianPoint* point : {&current_, &previous_}) {
     if (point->At(x)) return point->simulated;
   }

@@ -42,6 +42,11 @@ struct Work {
   }
 };
 
+// Whether `cached` (empty: none) is the point `x`.
+inline bool SamePoint(const Eigen::VectorXd& cached, const Eigen::Ref<const Eigen::VectorXd>& x) {
+  return cached.size() == x.size() && cached == x;
+}
+
 class TestEvaluator {
  public:
   TestEvaluator(const model::MechanicalModel& model, const std::vector<Unknown>& unknowns,
@@ -73,7 +78,8 @@ class TestEvaluator {
   void CheckSamples(const Eigen::MatrixXd& simulated) const;
   Eigen::VectorXd Weigh(const Eigen::MatrixXd& simulated) const;
   void Project(double* v) const;
-  // simulated: where to keep the simulated record for Simulate, if not null.
+  // simulated: where to keep the simulated record for Simulate, if not null (the calling
+  // thread's runs only, which also record a plain run's right-hand sides for ShouldSpeculate).
   Eigen::VectorXd ComputeRawResiduals(model::MechanicalModel& model, const Eigen::VectorXd& x,
                                       Measurement* simulated);
   Eigen::VectorXd ComputeResiduals(model::MechanicalModel& model, const Eigen::VectorXd& x);
@@ -99,9 +105,7 @@ class TestEvaluator {
     Eigen::MatrixXd unprojected;  // with a baseline: before the projection
     Measurement simulated;        // the exact outputs (channels x samples)
     long iterate = 0;             // > 0: Ceres asked for the Jacobian here, the n-th time
-    bool At(const Eigen::Ref<const Eigen::VectorXd>& point) const {
-      return x.size() == point.size() && x == point;
-    }
+    bool At(const Eigen::Ref<const Eigen::VectorXd>& point) const { return SamePoint(x, point); }
   };
   JacobianPoint current_, previous_;  // current_: the newest, or the one last asked for
   long iterates_ = 0;
