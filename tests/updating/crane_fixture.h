@@ -41,8 +41,7 @@ struct Crane {
   simulation::SensorOptions sensors;
 };
 
-inline Crane LoadCrane(const std::string& path) {
-  const YamlReader root = YamlReader::FromFile(path);
+inline Crane LoadCrane(const YamlReader& root) {
   Crane crane;
   crane.model = model::MakeModel(root.Child("model"));
   crane.excitation = simulation::ReadExcitation(root.Child("excitation"), *crane.model);
@@ -50,6 +49,8 @@ inline Crane LoadCrane(const std::string& path) {
   crane.sensors = simulation::ReadSensorOptions(root.Child("sensors"), *crane.model);
   return crane;
 }
+
+inline Crane LoadCrane(const std::string& path) { return LoadCrane(YamlReader::FromFile(path)); }
 
 // The crane's record of `duration_s` at `rate_hz` without sensor effects.
 inline Measurement SimulateExact(const Crane& crane, double duration_s, double rate_hz) {

@@ -10,6 +10,7 @@
 
 #include "crane_fixture.h"
 #include "mbid/updating/credibility.h"
+#include "oscillator_fixture.h"
 
 namespace mbid::updating {
 namespace {
@@ -403,6 +404,45 @@ TEST(CredibilityTest, ResidualFarAboveTheNoiseDeterminesNothing) {
   EXPECT_FALSE(result.credible);
   EXPECT_FALSE(result.parameters[0].determined);
   EXPECT_NE(result.parameters[0].why_undetermined.find("does not explain"), std::string::npos);
+}
+
+// Which given starts the records judged (GlobalSearchResult::judged_starts), on the torsional
+// oscillator's 2 s release: a Route-1 rival listed there is settled by the F-test on the minima
+// instead of being reported undetermined for its initial state (MarkAlgebraicAmbiguity).
+TEST(GlobalSearchTest, ListsTheGivenStartsTheRecordsJudged) {
+  const std::unique_ptr<model::MechanicalModel> truth = testing::MakeOscillator();
+  const TestDesign design = testing::OscillatorRelease("release", 0.01, 1e-5);
+  const Measurement record =
+      simulation::Simulate(*truth, design.excitation, design.simulation, design.sensors).measured;
+  const TestRecord test{"release", record, design.excitation, design.sensors.noise_std};
+  UpdateOptions options;
+  options.quiet = true;
+  options.integrator = design.simulation.integrator;
+  for (const char* name : {"c_angle", "d_angle"}) {
+    ParameterSetting setting;
+    setting.name = name;
+    setting.initial = truth->GetParameter(name);
+    options.parameters.push_back(setting);
+  }
+  GlobalSearchOptions search;
+  search.threads = 1;
+  search.complete_starts = true;  // as after Route 1 solved: no design where the starts fit
+  search.pole_equivalent_starts = false;
+  const std::vector<SearchStart> starts = {
+      // 1e-5 off: its cost within the noise's (a 2% error already starts 3 times higher, the
+      // record holds 1000 times the noise), fitted on the whole record.
+      {"route1 set 1", {{"c_angle", 800.008}, {"d_angle", 8.00008}}, true},
+      // Twice the frequency: its cost starts far above 3 times the best, never fitted.
+      {"route1 set 2", {{"c_angle", 3200.0}, {"d_angle", 8.0}}, true},
+  };
+  const GlobalSearchResult result =
+      SearchGlobally(*truth, {test}, options, "route1", starts, search);
+  ASSERT_EQ(result.best.termination, UpdateResult::Termination::kConverged);
+  EXPECT_EQ(result.full_fits, 2);  // the primary and set 1; set 2 only costed
+  // Costed starts first, then the fitted ones.
+  EXPECT_EQ(result.judged_starts, (std::vector<std::string>{"route1 set 2", "route1 set 1"}));
+  ASSERT_EQ(result.minima.size(), 1u);  // set 1 ended at the primary's minimum
+  EXPECT_FALSE(result.non_unique);
 }
 
 }  // namespace

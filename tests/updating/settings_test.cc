@@ -71,7 +71,7 @@ updating:
   integrator: {method: adams, relative_tolerance: 1.0e-7}
   sensitivity: {right_hand_side: quotients, corrector: staggered, difference_quotient: centered,
                 error_control: false}
-  algebraic: {starts: 20, seed: 3, fit_offset: true, ambiguity_ratio: 3}
+  algebraic: {starts: 20, seed: 3, fit_offset: true, ambiguity_ratio: 3, shape_significance: 0.01}
   profile: {enabled: true, sigmas: 1.5, max_fits_per_side: 4, max_iterations: 9, tolerance: 0.1}
   global_search: {threads: 3, screen_relative_tolerance: 1.0e-6}
 )",
@@ -116,6 +116,8 @@ updating:
   EXPECT_EQ(settings.algebraic.seed, 3u);
   EXPECT_TRUE(settings.algebraic.fit_offset);
   EXPECT_EQ(settings.algebraic.ambiguity_ratio, 3);
+  EXPECT_EQ(settings.algebraic.shape_significance, 0.01);
+  EXPECT_EQ(Read("updating: {}", *crane.model).algebraic.shape_significance, 1e-3);
   EXPECT_TRUE(settings.profile.enabled);
   EXPECT_EQ(settings.profile.sigmas, 1.5);
   EXPECT_EQ(settings.profile.max_fits_per_side, 4);
@@ -180,6 +182,9 @@ TEST(SettingsTest, ErrorsNameTheFieldAndWhatWasExpected) {
   EXPECT_NE(
       ErrorOf("updating: {algebraic: {starts: 0}}", m).find("scenario.yaml:updating.algebraic"),
       std::string::npos);
+  EXPECT_NE(ErrorOf("updating: {algebraic: {shape_significance: 1}}", m)
+                .find("shape_significance: 1; expected in (0, 1)"),
+            std::string::npos);
 }
 
 TEST(SettingsTest, AlgebraicStartFillsOnlyTheStartsNotGiven) {
@@ -242,6 +247,22 @@ TEST(SettingsTest, AlgebraicAmbiguityMarksTheParametersTheRivalsDisagreeOn) {
   EXPECT_TRUE(result.Find("c_alpha").why_undetermined.empty());
   EXPECT_EQ(result.undetermined, marked);
   ASSERT_EQ(result.warnings.size(), 1u);
+
+  // A rival the global search fitted on the whole records (or found far above the best cost)
+  // is judged by the F-test on the minima, not by its initial-state mismatch: nothing marked.
+  UpdateResult judged;
+  judged.parameters = result.parameters;
+  for (ParameterEstimate& estimate : judged.parameters) {
+    estimate.determined = true;
+    estimate.why_undetermined.clear();
+  }
+  EXPECT_EQ(AlgebraicStartLabel(1), "route1 set 1");
+  EXPECT_TRUE(MarkAlgebraicAmbiguity(algebraic, judged, 0.1, {"route1 set 1"}).empty());
+  EXPECT_TRUE(judged.Find("c_gamma").determined);
+  EXPECT_TRUE(judged.undetermined.empty());
+  EXPECT_TRUE(judged.warnings.empty());
+  // Another start judged does not settle this rival.
+  EXPECT_EQ(MarkAlgebraicAmbiguity(algebraic, judged, 0.1, {"route1 set 2", "design 1"}), marked);
 }
 
 TEST(SettingsTest, TestRecordTakesNoiseAndNuisanceSwitches) {

@@ -21,6 +21,7 @@ using internal::DistanceToReference;
 using internal::FitAmplitudes;
 using internal::FormatValue;
 using internal::InadmissibleReason;
+using internal::JudgeShapes;
 using internal::kNaN;
 
 namespace internal {
@@ -194,6 +195,9 @@ bool CharacteristicOptions::IsValid(std::string* why) const {
   if (!(ambiguity_ratio >= 1)) {
     return fail("ambiguity_ratio: " + FormatValue(ambiguity_ratio) + "; expected >= 1");
   }
+  if (!(shape_significance > 0 && shape_significance < 1)) {
+    return fail("shape_significance: " + FormatValue(shape_significance) + "; expected in (0, 1)");
+  }
   return true;
 }
 
@@ -366,11 +370,13 @@ CharacteristicResult SolveCharacteristicEquation(const CharacteristicProblem& pr
       solution.displacement_mismatch = solution.velocity_mismatch = solution.mismatch = kNaN;
     }
   }
+  JudgeShapes(problem, options, found);
   const bool by_mismatch = problem.record.has_value();
   std::stable_sort(found.begin(), found.end(),
                    [&](const CharacteristicSolution& a, const CharacteristicSolution& b) {
                      if (a.admissible != b.admissible) return a.admissible;
                      if (!a.admissible) return a.residual < b.residual;
+                     if (a.fits_shapes != b.fits_shapes) return a.fits_shapes;
                      if (by_mismatch) return a.mismatch < b.mismatch;
                      return DistanceToReference(problem, a) < DistanceToReference(problem, b);
                    });
@@ -382,21 +388,31 @@ CharacteristicResult SolveCharacteristicEquation(const CharacteristicProblem& pr
   if (admissible > 0) {
     result.status = CharacteristicResult::Status::kSolved;
     result.chosen = 0;
-    message << result.solutions.size() << " solution set(s) of eq. 7 from " << options.starts
-            << " starts, " << admissible << " admissible; chose the one "
-            << (by_mismatch ? "whose initial state agrees best with the test (mismatch " +
-                                  FormatValue(result.solutions[0].mismatch) + ")"
-                            : "nearest the reference values (no record for eq. 8)");
+    int misfits = 0;
     for (int s = 1; s < admissible && by_mismatch; ++s) {
-      if (result.solutions[static_cast<size_t>(s)].mismatch <
-          options.ambiguity_ratio * result.solutions[0].mismatch) {
+      const CharacteristicSolution& set = result.solutions[static_cast<size_t>(s)];
+      if (!set.fits_shapes) {
+        ++misfits;
+      } else if (set.mismatch < options.ambiguity_ratio * result.solutions[0].mismatch) {
         result.rivals.push_back(s);
       }
+    }
+    message << result.solutions.size() << " solution set(s) of eq. 7 from " << options.starts
+            << " starts, " << admissible << " admissible; chose the one ";
+    if (!by_mismatch) {
+      message << "nearest the reference values (no record for eq. 8)";
+    } else {
+      if (misfits > 0) {
+        message << "of the " << admissible - misfits
+                << " whose mode shapes reproduce the record (eq. 8) ";
+      }
+      message << "whose initial state agrees best with the test (mismatch "
+              << FormatValue(result.solutions[0].mismatch) << ")";
     }
     if (!result.rivals.empty()) {
       result.ambiguous = true;
       message << "; ambiguous: the next set's mismatch is "
-              << FormatValue(result.solutions[1].mismatch)
+              << FormatValue(result.solutions[static_cast<size_t>(result.rivals.front())].mismatch)
               << ", so the record does not single out one set";
     }
   } else if (!result.solutions.empty()) {

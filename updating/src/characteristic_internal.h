@@ -38,6 +38,12 @@ void FitAmplitudes(const CharacteristicProblem& problem, const CharacteristicOpt
 // How far the set's initial state is from the test's expected one (or from rest).
 void CalcMismatch(const CharacteristicProblem& problem, CharacteristicSolution& solution);
 
+// Marks the admissible sets whose eq. 8 fit leaves significantly more of the record unexplained
+// than the best set's (CharacteristicOptions::shape_significance): their mode shapes are not
+// the record's. Needs FitAmplitudes on every admissible set; nothing without a record.
+void JudgeShapes(const CharacteristicProblem& problem, const CharacteristicOptions& options,
+                 std::vector<CharacteristicSolution>& sets);
+
 // The set's distance from the reference values (log-scaled).
 double DistanceToReference(const CharacteristicProblem& problem,
                            const CharacteristicSolution& solution);

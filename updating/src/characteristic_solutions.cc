@@ -1,11 +1,15 @@
 // Judging eq. 7's solution sets: admissibility, shapes (eq. 6), amplitudes (eq. 8), mismatch.
 #include <Eigen/Dense>
+#include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "characteristic_internal.h"
+#include "distributions.h"
 #include "mbid/common/eigen_decompositions.h"
 #include "mbid/updating/characteristic.h"
 #include "statistics.h"
@@ -39,6 +43,10 @@ Eigen::VectorXcd CalcShape(const CharacteristicProblem& problem, Complex lambda,
   w.cwiseAbs().maxCoeff(&largest);
   return w / w[largest];
 }
+
+// Lags over which eq. 8's residual autocorrelation is summed: up to 101 samples per independent
+// residual, so that a smooth residual (model error) does not pass for white noise.
+constexpr int kResidualLags = 50;
 
 // eq. 8: y_j = sum_k 2 Re(a_k H w_k exp(lambda_k t_j)) (+ offset) by linear least squares in
 // Re a_k, Im a_k (minimum norm where a mode is invisible in the outputs).
@@ -100,15 +108,74 @@ void FitAmplitudes(const CharacteristicProblem& problem, const CharacteristicOpt
       solution.offset[rows[static_cast<size_t>(r)]] = x[2 * n + r];
   }
   const Eigen::VectorXd fit = A * x;
-  solution.correlation =
-      Eigen::VectorXd::Constant(static_cast<Eigen::Index>(problem.outputs.size()), kNaN);
+  const Eigen::Index outputs = static_cast<Eigen::Index>(problem.outputs.size());
+  solution.correlation = Eigen::VectorXd::Constant(outputs, kNaN);
+  solution.residual_ss = Eigen::VectorXd::Constant(outputs, kNaN);
+  solution.total_ss = Eigen::VectorXd::Constant(outputs, kNaN);
+  solution.residual_time = Eigen::VectorXd::Constant(outputs, kNaN);
   for (Eigen::Index r = 0; r < m; ++r) {
     Eigen::VectorXd measured(samples), reconstructed(samples);
     for (Eigen::Index j = 0; j < samples; ++j) {
       measured[j] = b[j * m + r];
       reconstructed[j] = fit[j * m + r];
     }
-    solution.correlation[rows[static_cast<size_t>(r)]] = CalcPearson(measured, reconstructed);
+    const Eigen::Index output = rows[static_cast<size_t>(r)];
+    solution.correlation[output] = CalcPearson(measured, reconstructed);
+    solution.residual_ss[output] = (measured - reconstructed).squaredNorm();
+    solution.total_ss[output] = (measured.array() - measured.mean()).matrix().squaredNorm();
+    double q = 0, p = 0;
+    Whiteness(measured - reconstructed, kResidualLags, &q, &p, &solution.residual_time[output]);
+  }
+}
+
+void JudgeShapes(const CharacteristicProblem& problem, const CharacteristicOptions& options,
+                 std::vector<CharacteristicSolution>& sets) {
+  if (!problem.record) return;
+  const double samples = static_cast<double>(problem.record->samples());
+  // The best set: the least unexplained share of the record, summed over outputs (unit-free).
+  const CharacteristicSolution* best = nullptr;
+  double best_share = std::numeric_limits<double>::infinity();
+  for (const CharacteristicSolution& set : sets) {
+    if (!set.admissible || set.residual_ss.size() == 0) continue;
+    double share = 0;
+    for (Eigen::Index r = 0; r < set.residual_ss.size(); ++r) {
+      if (std::isfinite(set.residual_ss[r]) && set.total_ss[r] > 0) {
+        share += set.residual_ss[r] / set.total_ss[r];
+      }
+    }
+    if (share < best_share) {
+      best_share = share;
+      best = &set;
+    }
+  }
+  if (best == nullptr) return;
+  // The best fit's residual per output is its noise (and model error) level, per independent
+  // sample: a residual correlated over tau samples counts as samples / tau. A floor of 1e-6 of
+  // the signal's amplitude keeps round-off differences of noiseless records equivalent.
+  Eigen::VectorXd variance = best->residual_ss;
+  int used = 0;
+  for (Eigen::Index r = 0; r < variance.size(); ++r) {
+    if (!std::isfinite(variance[r]) || !(best->total_ss[r] > 0)) continue;
+    variance[r] =
+        std::max(variance[r], 1e-12 * best->total_ss[r]) / samples * best->residual_time[r];
+    ++used;
+  }
+  // The amplitudes' degrees of freedom: 2 per mode and an offset per output.
+  const double dof =
+      static_cast<double>(best->amplitudes.size() * 2 + (options.fit_offset ? used : 0));
+  const boost::math::chi_squared_distribution<double, DistributionPolicy> chi_square(dof);
+  const double limit =
+      boost::math::quantile(boost::math::complement(chi_square, options.shape_significance));
+  for (CharacteristicSolution& set : sets) {
+    if (!set.admissible || set.residual_ss.size() == 0) continue;
+    double misfit = 0;
+    for (Eigen::Index r = 0; r < variance.size(); ++r) {
+      if (!std::isfinite(variance[r]) || !(best->total_ss[r] > 0)) continue;
+      misfit += (set.residual_ss[r] - best->residual_ss[r]) / variance[r];
+    }
+    // A set's residual below the best's (another output mix) counts as no misfit.
+    set.shape_misfit = std::max(0.0, misfit);
+    set.fits_shapes = set.shape_misfit <= limit;
   }
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "distributions.h"
+#include "statistics.h"
 
 namespace mbid::updating {
 namespace {
@@ -21,27 +22,6 @@ constexpr double kNoticeableExcess = 1.2;
 // off. Wrong minima of the reference load drop (design model 25-35% off, 4.5-10 s) ended at
 // 1.15-1.34, the true ones at 0.97-0.99.
 constexpr double kStructuredExcess = 1.05;
-
-// Ljung-Box Q of `r` over `lags` lags, and the integrated autocorrelation time.
-void Whiteness(const Eigen::VectorXd& residual, int lags, double* q, double* p, double* time) {
-  const Eigen::VectorXd r = residual.array() - residual.mean();
-  const double n = static_cast<double>(r.size());
-  const double power = r.squaredNorm();
-  const int count = std::min<int>(lags, static_cast<int>(r.size()) / 4);
-  *q = 0;
-  *time = 1;
-  *p = 1;
-  if (count < 1 || !(power > 0)) return;
-  for (int k = 1; k <= count; ++k) {
-    const double rho = r.head(r.size() - k).dot(r.tail(r.size() - k)) / power;
-    *q += rho * rho / (n - k);
-    *time += 2 * rho;
-  }
-  *q *= n * (n + 2);
-  *time = std::max(1.0, *time);
-  *p = boost::math::cdf(boost::math::complement(
-      boost::math::chi_squared_distribution<double, internal::DistributionPolicy>(count), *q));
-}
 
 }  // namespace
 

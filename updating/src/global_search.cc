@@ -259,6 +259,8 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     for (size_t i = 0; i < candidates.size(); ++i) {
       if (!std::isfinite(best_cost) || start_costs[i] <= kPromisingCostRatio * best_cost) {
         promising.push_back(candidates[i]);
+      } else {
+        result.judged_starts.push_back(candidates[i].label);
       }
     }
     std::vector<Run> fitted(promising.size());
@@ -267,6 +269,9 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
       fitted[static_cast<size_t>(i)] =
           fit_full(start.label, start.values, with_radius(local, start.matches_poles));
     });
+    for (const Run& run : fitted) {
+      if (!run.failed && Converged(run.fit)) result.judged_starts.push_back(run.label);
+    }
     full.insert(full.end(), fitted.begin(), fitted.end());
     if (promising.size() < candidates.size()) {
       result.notes.push_back(fmt::format(

@@ -109,6 +109,8 @@ nlohmann::json CharacteristicResultToJson(const CharacteristicResult& result) {
         entry["initial_q"] = PerName(result.coordinates, set.initial_q);
         entry["initial_u"] = PerName(result.coordinates, set.initial_u);
         entry["correlation"] = PerName(result.outputs, set.correlation);
+        entry["shape_misfit"] = NumberOrNull(set.shape_misfit);
+        entry["fits_shapes"] = set.fits_shapes;
       }
       if (set.expected_initial_q.size() > 0) {
         entry["expected_initial_q"] = PerName(result.coordinates, set.expected_initial_q);
@@ -277,7 +279,7 @@ void WriteCharacteristicGroup(H5Writer& file, const CharacteristicResult& result
   Eigen::MatrixXd c(sets, n), d(sets, n), q0 = Eigen::MatrixXd::Constant(sets, n, nan);
   Eigen::MatrixXd u0 = q0;
   Eigen::VectorXd residual(sets), admissible(sets), mismatch(sets), displacement(sets),
-      velocity(sets);
+      velocity(sets), shape_misfit(sets), fits_shapes(sets);
   for (Eigen::Index s = 0; s < sets; ++s) {
     const CharacteristicSolution& set = result.solutions[static_cast<size_t>(s)];
     c.row(s) = set.c.transpose();
@@ -289,6 +291,9 @@ void WriteCharacteristicGroup(H5Writer& file, const CharacteristicResult& result
     mismatch[s] = set.admissible ? set.mismatch : nan;
     displacement[s] = set.admissible ? set.displacement_mismatch : nan;
     velocity[s] = set.admissible ? set.velocity_mismatch : nan;
+    const bool judged = set.admissible && set.residual_ss.size() > 0;
+    shape_misfit[s] = judged ? set.shape_misfit : nan;
+    fits_shapes[s] = judged ? (set.fits_shapes ? 1.0 : 0.0) : nan;
   }
   const std::vector<std::string>& units = result.coordinate_units;
   const bool lengths =
@@ -302,6 +307,8 @@ void WriteCharacteristicGroup(H5Writer& file, const CharacteristicResult& result
   file.WriteVector(group, "mismatch", mismatch, "1");
   file.WriteVector(group, "displacement_mismatch", displacement, "1");
   file.WriteVector(group, "velocity_mismatch", velocity, "1");
+  file.WriteVector(group, "shape_misfit", shape_misfit, "1");
+  file.WriteVector(group, "fits_shapes", fits_shapes, "1");
 }
 
 void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,

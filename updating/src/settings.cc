@@ -88,7 +88,7 @@ std::uint64_t ReadSeed(const YamlReader& node, std::uint64_t fallback) {
 
 CharacteristicOptions ReadAlgebraic(const YamlReader& node, CharacteristicOptions o) {
   node.ExpectMap({"starts", "seed", "start_spread", "max_iterations", "residual_tolerance",
-                  "duplicate_tolerance", "fit_offset", "ambiguity_ratio"});
+                  "duplicate_tolerance", "fit_offset", "ambiguity_ratio", "shape_significance"});
   o.starts = node.Int("starts", o.starts);
   o.seed = ReadSeed(node, o.seed);
   o.start_spread = node.PositiveDouble("start_spread", o.start_spread);
@@ -97,6 +97,7 @@ CharacteristicOptions ReadAlgebraic(const YamlReader& node, CharacteristicOption
   o.duplicate_tolerance = node.PositiveDouble("duplicate_tolerance", o.duplicate_tolerance);
   o.fit_offset = node.Bool("fit_offset", o.fit_offset);
   o.ambiguity_ratio = node.PositiveDouble("ambiguity_ratio", o.ambiguity_ratio);
+  o.shape_significance = node.PositiveDouble("shape_significance", o.shape_significance);
   std::string why;
   if (!o.IsValid(&why)) node.Fail(why, "valid algebraic options (docs/scenarios.md)");
   return o;
@@ -359,6 +360,8 @@ bool ApplyAlgebraicStart(const CharacteristicResult& algebraic, UpdateOptions& o
   return true;
 }
 
+std::string AlgebraicStartLabel(size_t index) { return "route1 set " + std::to_string(index); }
+
 std::vector<SearchStart> MakeAlgebraicStarts(const CharacteristicResult& algebraic,
                                              bool skip_chosen) {
   std::vector<SearchStart> starts;
@@ -366,7 +369,7 @@ std::vector<SearchStart> MakeAlgebraicStarts(const CharacteristicResult& algebra
     const CharacteristicSolution& set = algebraic.solutions[s];
     if (!set.admissible || (skip_chosen && static_cast<int>(s) == algebraic.chosen)) continue;
     SearchStart start;
-    start.label = "route1 set " + std::to_string(s);
+    start.label = AlgebraicStartLabel(s);
     start.matches_poles = true;
     for (size_t i = 0; i < algebraic.coordinates.size(); ++i) {
       const Eigen::Index k = static_cast<Eigen::Index>(i);
@@ -379,11 +382,16 @@ std::vector<SearchStart> MakeAlgebraicStarts(const CharacteristicResult& algebra
 }
 
 std::vector<std::string> MarkAlgebraicAmbiguity(const CharacteristicResult& algebraic,
-                                                UpdateResult& result, double relative_difference) {
+                                                UpdateResult& result, double relative_difference,
+                                                const std::vector<std::string>& judged_starts) {
   std::vector<std::string> names;
   if (!algebraic.ambiguous || algebraic.chosen < 0) return names;
   const CharacteristicSolution& chosen = algebraic.solutions[static_cast<size_t>(algebraic.chosen)];
   for (int rival : algebraic.rivals) {
+    const std::string label = AlgebraicStartLabel(static_cast<size_t>(rival));
+    if (std::find(judged_starts.begin(), judged_starts.end(), label) != judged_starts.end()) {
+      continue;
+    }
     const CharacteristicSolution& other = algebraic.solutions[static_cast<size_t>(rival)];
     for (size_t i = 0; i < algebraic.coordinates.size(); ++i) {
       const Eigen::Index k = static_cast<Eigen::Index>(i);

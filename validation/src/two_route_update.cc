@@ -107,7 +107,9 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
       StartFromAlgebraicRoute(algebraic, &settings, start, note);
   updating::GlobalSearchResult search = updating::SearchGlobally(
       model, records, settings.options, *start, starts, settings.global_search, say);
-  if (algebraic != nullptr) updating::MarkAlgebraicAmbiguity(*algebraic, search.best);
+  if (algebraic != nullptr) {
+    updating::MarkAlgebraicAmbiguity(*algebraic, search.best, 0.1, search.judged_starts);
+  }
   if (settings.profile.enabled) {
     updating::ProfileLikelihood(model, records, settings.options, settings.profile, search.best,
                                 say);

@@ -79,6 +79,11 @@ struct CharacteristicOptions {
   // The choice is ambiguous when the runner-up's mismatch is within this factor of the
   // winner's: the record does not single out one set (e.g. modes it barely excites).
   double ambiguity_ratio = 2.0;
+  // A set whose eq.-8 fit leaves more of the record unexplained than the best set's, by more
+  // than the chi-square quantile at this level (residuals in units of the best fit's residual
+  // per channel), does not reproduce the record's mode shapes: it is ranked after those that
+  // do and is no rival, whatever its initial state.
+  double shape_significance = 1e-3;
 
   bool IsValid(std::string* why) const;
 };
@@ -98,6 +103,16 @@ struct CharacteristicSolution {
   Eigen::VectorXcd amplitudes;
   Eigen::VectorXd offset;       // per output, 0 unless fit_offset
   Eigen::VectorXd correlation;  // per output: Pearson's K of record and eq. 8 reconstruction
+  // Per output: eq. 8's residual and the record's sums of squares about its mean, and the
+  // residual's integrated autocorrelation time in samples (NaN where the record lacks the
+  // output).
+  Eigen::VectorXd residual_ss, total_ss, residual_time;
+  // sum over outputs of (residual_ss - the best set's) / (the best set's residual variance
+  // times its residual_time: a smooth residual, model error rather than noise, has fewer
+  // independent samples): 0 for the set that reproduces the record best; fits_shapes when
+  // below the chi-square quantile of CharacteristicOptions::shape_significance.
+  double shape_misfit = 0;
+  bool fits_shapes = true;
   Eigen::VectorXd initial_q, initial_u;  // rad, rad/s
   Eigen::VectorXd expected_initial_q;    // rad, empty if not known
   // |q(0) - q_expected| / |q_expected| (NaN if not known), |q'(0)| / (omega |q_expected|) or,
@@ -119,8 +134,9 @@ struct CharacteristicResult {
   std::vector<std::string> coordinates;
   std::vector<std::string> coordinate_units;  // "rad" or "m" per coordinate; empty: all "rad"
   std::vector<std::string> outputs;
-  // Admissible sets first, by ascending mismatch (or distance to the reference without a
-  // record), then the others by residual.
+  // Admissible sets first: with a record those that reproduce its shapes (fits_shapes) by
+  // ascending mismatch, then the others by mismatch; without one by distance to the reference.
+  // Then the inadmissible sets by residual.
   std::vector<CharacteristicSolution> solutions;
   int chosen = -1;  // index into solutions, -1 unless kSolved
   // Other admissible sets agree with the test almost as well (CharacteristicOptions::

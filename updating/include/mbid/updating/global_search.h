@@ -101,6 +101,10 @@ struct GlobalSearchResult {
   double wall_time_s = 0;
   double screen_time_s = 0;        // of the given starts' and design points' batch
   std::vector<std::string> notes;  // what the search did, in words
+  // Starts the whole records judged: fitted to a converged end, or starting above the promising
+  // cost (3 times the best). A Route-1 rival among them is settled by the F-test on the minima,
+  // not by its initial-state mismatch.
+  std::vector<std::string> judged_starts;
 };
 
 // The shared model parameters of `options` (every model parameter if it names none) with their

@@ -94,6 +94,7 @@ namespace mbid::updating {
 //       duplicate_tolerance: 1.0e-6        # relative distance of two equal sets
 //       fit_offset: false                  # eq. 8 with a constant per channel
 //       ambiguity_ratio: 2                 # runner-up mismatch within this factor: ambiguous
+//       shape_significance: 1.0e-3         # eq. 8 fit this much worse: shapes not the record's
 struct UpdatingSettings {
   UpdateOptions options;  // parameters carry NaN where the section gives no start or bounds
   CharacteristicOptions algebraic;
@@ -130,13 +131,19 @@ bool ApplyAlgebraicStart(const CharacteristicResult& algebraic, UpdateOptions& o
 std::vector<SearchStart> MakeAlgebraicStarts(const CharacteristicResult& algebraic,
                                              bool skip_chosen);
 
+// The label of Route 1's set `index` as a start of the global search.
+std::string AlgebraicStartLabel(size_t index);
+
 // When Route 1's choice was ambiguous, the parameters in which its rival sets differ from the
 // chosen one by more than `relative_difference` are not determined by the record either, even
 // if Route 2's local standard deviations look small (a second minimum of equal fit): marks them
-// undetermined in `result` with a warning. Returns their names.
+// undetermined in `result` with a warning. Returns their names. Rivals whose start label is in
+// `judged_starts` are left out: the whole-record fits from them settled the question (a
+// minimum as good as the best is then an alternative of the global search).
 std::vector<std::string> MarkAlgebraicAmbiguity(const CharacteristicResult& algebraic,
                                                 UpdateResult& result,
-                                                double relative_difference = 0.1);
+                                                double relative_difference = 0.1,
+                                                const std::vector<std::string>& judged_starts = {});
 
 // A test record with the settings' noise levels and nuisance switches (fit_offsets resolved
 // for this record).
