@@ -90,4 +90,28 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   return result;
 }
 
+FreeDecayStart CalcFreeDecayStart(const model::MechanicalModel& model, const Excitation& excitation,
+                                  const IntegratorOptions& integrator) {
+  FreeDecayStart start;
+  start.q = CalcInitialCoordinates(model, excitation);
+  start.u = Eigen::VectorXd::Zero(model.coordinate_count());
+  start.time_s = excitation.CalcForcingEndTime();
+  const std::unique_ptr<model::MechanicalModel> forced =
+      internal::MakeForcedModel(model, excitation);
+  if (forced == nullptr || !(start.time_s > 0)) return start;
+  SimTK::State initial = forced->MakeState(start.q, start.u);
+  IntegratorOptions options = integrator;
+  options.interpolate_outputs = false;  // stop exactly at the forcing's end
+  CvodesIntegrator cvodes(forced->system(), options);
+  cvodes.set_jacobian(internal::CalcNewtonJacobian(*forced, initial));
+  cvodes.set_state_derivative(forced->MakeStateDerivative());
+  cvodes.Initialize(std::move(initial));
+  const SimTK::State& end = cvodes.AdvanceTo(start.time_s, kUnrealized);
+  for (Eigen::Index i = 0; i < start.q.size(); ++i) {
+    start.q[i] = end.getQ()[static_cast<int>(i)];
+    start.u[i] = end.getU()[static_cast<int>(i)];
+  }
+  return start;
+}
+
 }  // namespace mbid::simulation

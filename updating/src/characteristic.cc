@@ -285,6 +285,18 @@ CharacteristicProblem MakeCharacteristicProblem(
       }
       return simulation::CalcInitialCoordinates(*copy, test);
     };
+  } else if (excitation) {
+    std::shared_ptr<model::MechanicalModel> copy = model.Clone();
+    const std::vector<std::string> coordinates = linear.coordinates;
+    const simulation::Excitation test = *excitation;
+    problem.expected_free_decay_start = [copy, coordinates, test](const Eigen::VectorXd& c,
+                                                                  const Eigen::VectorXd& d) {
+      for (size_t i = 0; i < coordinates.size(); ++i) {
+        copy->SetParameter("c_" + coordinates[i], c[static_cast<Eigen::Index>(i)]);
+        copy->SetParameter("d_" + coordinates[i], d[static_cast<Eigen::Index>(i)]);
+      }
+      return simulation::CalcFreeDecayStart(*copy, test);
+    };
   }
   Validate(problem);
   return problem;

@@ -183,7 +183,26 @@ void CalcMismatch(const CharacteristicProblem& problem, CharacteristicSolution& 
   double omega = 0;
   for (const Complex& lambda : problem.lambda) omega += std::abs(lambda);
   omega /= static_cast<double>(problem.lambda.size());
-  if (problem.expected_initial_q) {
+  if (problem.expected_free_decay_start) {
+    const simulation::FreeDecayStart start =
+        problem.expected_free_decay_start(solution.c, solution.d);
+    solution.expected_time_s = start.time_s;
+    solution.expected_initial_q = start.q;
+    solution.expected_u = start.u;
+    // The set's modes carried to the forcing's end.
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(start.q.size());
+    Eigen::VectorXd u = q;
+    for (size_t k = 0; k < problem.lambda.size(); ++k) {
+      const Complex lambda = problem.lambda[k];
+      const Complex a =
+          solution.amplitudes[static_cast<Eigen::Index>(k)] * std::exp(lambda * start.time_s);
+      q += 2 * (a * solution.shapes[k]).real();
+      u += 2 * (a * lambda * solution.shapes[k]).real();
+    }
+    const double size = std::hypot(start.q.norm(), start.u.norm() / omega);
+    solution.displacement_mismatch = (q - start.q).norm() / size;
+    solution.velocity_mismatch = (u - start.u).norm() / (omega * size);
+  } else if (problem.expected_initial_q) {
     solution.expected_initial_q = problem.expected_initial_q(solution.c, solution.d);
     const double size = solution.expected_initial_q.norm();
     solution.displacement_mismatch =

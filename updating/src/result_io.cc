@@ -115,6 +115,11 @@ nlohmann::json CharacteristicResultToJson(const CharacteristicResult& result) {
       if (set.expected_initial_q.size() > 0) {
         entry["expected_initial_q"] = PerName(result.coordinates, set.expected_initial_q);
       }
+      if (set.expected_u.size() > 0) {
+        // A forced test's: the state expected where its free decay starts.
+        entry["expected_time_s"] = set.expected_time_s;
+        entry["expected_u"] = PerName(result.coordinates, set.expected_u);
+      }
     }
     json["sets"].push_back(entry);
   }

@@ -37,4 +37,15 @@ struct SimulationResult {
 SimulationResult Simulate(const model::MechanicalModel& model, const Excitation& excitation,
                           const SimulationOptions& options, const SensorOptions& sensors);
 
+// The state where a test's free decay begins: for a free decay the excitation's initial
+// coordinates at rest at t = 0; for a forced test (an impulse, a burst) the coordinates and
+// speeds where the forcing ends, integrated from rest through it.
+struct FreeDecayStart {
+  double time_s = 0;
+  Eigen::VectorXd q;  // rad or m per coordinate
+  Eigen::VectorXd u;  // rad/s or m/s
+};
+FreeDecayStart CalcFreeDecayStart(const model::MechanicalModel& model, const Excitation& excitation,
+                                  const IntegratorOptions& integrator = {});
+
 }  // namespace mbid::simulation

@@ -12,6 +12,7 @@
 #include "mbid/common/measurement.h"
 #include "mbid/model/mechanical_model.h"
 #include "mbid/simulation/excitation.h"
+#include "mbid/simulation/simulate.h"
 
 namespace mbid::updating {
 
@@ -48,6 +49,11 @@ struct CharacteristicProblem {
   // initial velocity is checked.
   std::function<Eigen::VectorXd(const Eigen::VectorXd& c, const Eigen::VectorXd& d)>
       expected_initial_q;
+  // For a forced test (an impulse, a burst): where its free decay starts, coordinates and
+  // speeds at the forcing's end, as a function of a candidate set. Each set's state there
+  // (eq. 8's modes carried to that time) is compared with it.
+  std::function<simulation::FreeDecayStart(const Eigen::VectorXd& c, const Eigen::VectorXd& d)>
+      expected_free_decay_start;
 };
 
 // The first coordinate of `model` without a spring (no c_<coordinate> parameter), or "" when
@@ -115,9 +121,15 @@ struct CharacteristicSolution {
   bool fits_shapes = true;
   Eigen::VectorXd initial_q, initial_u;  // rad, rad/s
   Eigen::VectorXd expected_initial_q;    // rad, empty if not known
+  // A forced test's: where the free decay starts, and the expected speeds there
+  // (expected_initial_q then holds the coordinates there).
+  double expected_time_s = 0;
+  Eigen::VectorXd expected_u;
   // |q(0) - q_expected| / |q_expected| (NaN if not known), |q'(0)| / (omega |q_expected|) or,
-  // without an expected state, / (omega |q(0)|), omega the mean |lambda_k|; and their root sum
-  // of squares, by which the sets are ranked.
+  // without an expected state, / (omega |q(0)|), omega the mean |lambda_k|; for a forced test
+  // |q(T) - q_expected| / s and |q'(T) - u_expected| / (omega s) at the forcing's end T with
+  // s = sqrt(|q_expected|^2 + |u_expected / omega|^2); and their root sum of squares, by which
+  // the sets are ranked.
   double displacement_mismatch = 0;
   double velocity_mismatch = 0;
   double mismatch = 0;
