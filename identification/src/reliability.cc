@@ -16,10 +16,12 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   // millionth of the signal when the record is noiseless, means something in the record is not
   // in the modes (a start before the free decay, a nonlinearity, a missed mode).
   const Eigen::VectorXd& residual = estimate.fit.residual_variance;
+  Eigen::VectorXd ratios = Eigen::VectorXd::Constant(result->correlation.size(), 0.0);
   for (Eigen::Index c = 0; c < residual.size() && c < estimate.noise_std.size(); ++c) {
     const double rms = std::sqrt(record.decimated.col(c).squaredNorm() / record.decimated.rows());
     const double level = std::max(estimate.noise_std(c), 1e-6 * rms);
     const double ratio = std::sqrt(residual(c)) / level;
+    if (c < ratios.size()) ratios(c) = ratio;
     if (ratio > 3) {
       reasons.push_back(fmt::format(
           "the residual in channel {} is {:.3g} times the record's noise level: the modes do not "
@@ -29,11 +31,18 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   }
   for (Eigen::Index c = 0; c < result->correlation.size(); ++c) {
     if (!(result->correlation(c) >= options.min_correlation)) {
+      // A residual at the noise level is the noise: then the channel's signal is too weak for
+      // a higher K, not the modes wrong (the check above names a residual above it).
+      const std::string why =
+          ratios(c) > 0 && ratios(c) <= 3
+              ? fmt::format(
+                    "its residual is at the record's noise level ({:.3g} times): the "
+                    "channel has too little signal above its noise for a higher K",
+                    ratios(c))
+              : "the modes do not explain the record in the analysed band";
       reasons.push_back(fmt::format(
-          "K = {:.3f} in channel {} is below min_correlation {}: the modes do not explain the "
-          "record in the analysed band",
-          result->correlation(c), result->channels[static_cast<size_t>(c)],
-          options.min_correlation));
+          "K = {:.3f} in channel {} is below min_correlation {}: {}", result->correlation(c),
+          result->channels[static_cast<size_t>(c)], options.min_correlation, why));
     }
   }
   const double top_hz = std::min(record.max_frequency_hz, record.flat_frequency_hz);

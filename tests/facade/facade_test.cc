@@ -161,6 +161,36 @@ TEST(FacadeTest, AnOpenProfileMakesTheVerdictInconclusive) {
   EXPECT_TRUE(result.updated.parameters.at("c_alpha").determined);
 }
 
+// A channel whose noise alone keeps K below the threshold fails the verdict (the contract's
+// rule), and the reason says so; a model that cannot fit fails without that remark.
+TEST(FacadeTest, AFailureFromTooLittleSignalIsCalledSo) {
+  const std::string quick = "updating: {global_search: {enabled: false}}\n";
+  std::string noisy = ReferenceText(4, quick);
+  // 40 times the reference's noise: psi's re-simulation correlates at 0.85 (measured), its
+  // residual at the noise (0.000416 against 0.000423).
+  noisy.replace(noisy.find("noise_std_rad: 1.0e-05"), 22, "noise_std_rad: 4.0e-04");
+  const mbid::ValidationResult weak =
+      mbid::RunValidationCycle(mbid::LoadScenarioFromText(noisy, "noisy.yaml"));
+  EXPECT_EQ(weak.verdict, mbid::Verdict::kFailed);
+  ASSERT_FALSE(weak.reasons.empty());
+  EXPECT_EQ(weak.reasons[0].rfind("K(psi) = ", 0), 0u) << weak.reasons[0];
+  EXPECT_NE(weak.reasons[0].find("too little signal"), std::string::npos) << weak.reasons[0];
+  // c_alpha held 30 times below the truth: phi's K 0.91 with a residual far above the noise.
+  const mbid::ValidationResult wrong = mbid::RunValidationCycle(mbid::LoadScenarioFromText(
+      ReferenceText(2,
+                    "updating: {global_search: {enabled: false}, algebraic_start: false, "
+                    "bounds: {c_alpha: [1.0e6, 2.0e6]}, start: {c_alpha: 1.5e6}}\n"),
+      "wrong.yaml"));
+  EXPECT_EQ(wrong.verdict, mbid::Verdict::kFailed);
+  bool below = false;
+  for (const std::string& reason : wrong.reasons) {
+    if (reason.rfind("K(", 0) != 0) continue;
+    below = true;
+    EXPECT_EQ(reason.find("too little signal"), std::string::npos) << reason;
+  }
+  EXPECT_TRUE(below) << ::testing::PrintToString(wrong.reasons);
+}
+
 TEST(FacadeTest, TheCycleInMemoryPassesTheReferenceAndWritesNothing) {
   const fs::path cwd = fs::temp_directory_path() / "mbid_facade_cycle";
   fs::remove_all(cwd);

@@ -12,6 +12,12 @@
 #include "mbid/validation/two_route_update.h"
 
 namespace mbid::validation {
+namespace {
+
+// A residual rms within this factor of the noise is the noise (chi^2 per sample up to 1.44).
+constexpr double kNoiseLevelRatio = 1.2;
+
+}  // namespace
 
 void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
                  const simulation::Excitation& excitation, const RunSettings& settings,
@@ -58,9 +64,20 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
   test.reasons.clear();
   for (Eigen::Index c = 0; c < k.size(); ++c) {
     if (!(k(c) >= settings.min_correlation)) {
-      test.reasons.push_back(fmt::format("K({}) = {:.4f} is below the threshold {}",
-                                         fit.channels[static_cast<size_t>(c)], k(c),
-                                         settings.min_correlation));
+      const std::string& channel = fit.channels[static_cast<size_t>(c)];
+      std::string reason = fmt::format("K({}) = {:.4f} is below the threshold {}", channel, k(c),
+                                       settings.min_correlation);
+      // A re-simulation that leaves the record's noise and no more cannot correlate better:
+      // say so, so that the user sees the failure is the channel's (too little signal), not
+      // necessarily the model's.
+      if (c < fit.noise_std.size() && c < fit.residual_rms.size() &&
+          fit.residual_rms[c] <= kNoiseLevelRatio * fit.noise_std[c]) {
+        reason += fmt::format(
+            " (its residual, rms {:.3g}, is at the record's noise level, {:.3g}: the channel has "
+            "too little signal above its noise to reach the threshold)",
+            fit.residual_rms[c], fit.noise_std[c]);
+      }
+      test.reasons.push_back(reason);
     }
   }
   const bool correlates = k.size() > 0 && test.reasons.empty();
