@@ -112,7 +112,7 @@ int Main(int argc, char** argv) {
   std::vector<std::string> export_paths;
   simulate->add_option("--export", export_paths,
                        "Also write the measured record as FILE (repeatable): .uff/.unv UFF58 "
-                       "ASCII, .uffb UFF58 binary, .mat MATLAB v5");
+                       "ASCII, .uffb UFF58 binary, .mat MATLAB v5, .csv time and channels");
 
   std::string output_dir;
   CLI::App* run = app.add_subcommand(

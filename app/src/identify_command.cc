@@ -1,5 +1,6 @@
 #include <fmt/format.h>
 
+#include <cmath>
 #include <iostream>
 
 #include "mbid/app/commands.h"
@@ -8,6 +9,8 @@
 #include "mbid/common/json_io.h"
 #include "mbid/identification/identify.h"
 #include "mbid/records/records.h"
+#include "mbid/validation/identification_settings.h"
+#include "mbid/validation/scenario.h"
 
 namespace mbid::app {
 using validation::DescribeImport;
@@ -15,12 +18,37 @@ using validation::ImportReportToJson;
 using validation::MergeImportOptions;
 
 int RunIdentifyCommand(const std::string& data_path,
-                       const identification::IdentificationOptions& options,
+                       const identification::IdentificationOptions& given,
                        const std::string& output_path, const CommonOptions& common) {
-  options.Validate("command line");  // before reading a possibly large file
+  given.Validate("command line");  // before reading a possibly large file
+  CheckHdf5OutputName(output_path);
   records::ImportReport import;
   const Measurement measurement = records::ImportMeasurement(
       data_path, MergeImportOptions({}, common.import, nullptr), &import);
+  const std::string scenario =
+      data_path.size() > 3 && data_path.substr(data_path.size() - 3) == ".h5"
+          ? ReadScenarioYaml(data_path)
+          : std::string();
+  // A record mbid simulated carries its test: after a forcing (an impulse, a burst) the free
+  // decay starts where the forcing ends, as `mbid run` analyses it. The release detection cannot
+  // see a pulse at the record's very start; the user's --release or window still win.
+  identification::IdentificationOptions options = given;
+  if (!scenario.empty() && options.release == identification::ReleaseMode::kDetect &&
+      !std::isfinite(options.window_start_s)) {
+    try {
+      const validation::Scenario test = validation::LoadScenarioFromText(scenario, data_path);
+      if (test.has_excitation && test.excitation.CalcForcingEndTime() > 0) {
+        options = validation::FreeDecayOptions(options, test.excitation);
+        if (!common.quiet) {
+          std::cerr << fmt::format(
+              "mbid: {}: free decay after the {} that ends at {:.6g} s (the record's scenario)\n",
+              data_path, test.excitation.type_name(), test.excitation.CalcForcingEndTime());
+        }
+      }
+    } catch (const InputError&) {
+      // A scenario this version cannot read: the record is analysed as any other.
+    }
+  }
   if (!common.quiet) {
     std::cerr << fmt::format("mbid: {}: {}\n", data_path, DescribeImport(import));
     std::cerr << fmt::format("mbid: identifying {} ({} samples x {} channels, {} Hz, {})\n",
@@ -35,10 +63,6 @@ int RunIdentifyCommand(const std::string& data_path,
   if (!output_path.empty()) {
     file = std::make_unique<H5Writer>(output_path);
     file->WriteMeasurement(measurement);
-    const std::string scenario =
-        data_path.size() > 3 && data_path.substr(data_path.size() - 3) == ".h5"
-            ? ReadScenarioYaml(data_path)
-            : std::string();
     if (!scenario.empty()) file->WriteScenarioYaml(scenario);
     identification::WriteModalResult(*file, result);
   }
@@ -62,8 +86,11 @@ int RunIdentifyCommand(const std::string& data_path,
         result.method, result.model_order, result.effective_rank,
         result.decimation > 1 ? fmt::format(", decimation {}", result.decimation) : "",
         result.reliable ? "" : " -- UNRELIABLE, see the warnings");
-    std::cout << fmt::format("free decay from {:.6g} s ({})\n", result.release_time_s,
-                             result.release);
+    std::cout << fmt::format(
+        "free decay from {:.6g} s ({}){}\n", result.release_time_s, result.release,
+        result.start_time_s > result.release_time_s + 0.5 * result.sample_interval_s
+            ? fmt::format(", analysed from {:.6g} s", result.start_time_s)
+            : "");
     std::cout << fmt::format("{:>4} {:>13} {:>12} {:>16} {:>12} {:>13}\n", "mode", "frequency_hz",
                              "std_hz", "decay_rate_per_s", "std_per_s", "damping_ratio");
     for (size_t k = 0; k < result.modes.size(); ++k) {

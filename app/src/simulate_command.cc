@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "mbid/app/commands.h"
+#include "mbid/common/csv_io.h"
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/json_io.h"
@@ -22,7 +23,7 @@ using validation::WriteTruth;
 
 namespace {
 
-enum class ExportFormat { kUff, kUffBinary, kMat };
+enum class ExportFormat { kUff, kUffBinary, kMat, kCsv };
 
 // The format an `--export` file asks for by its extension (case-insensitive).
 ExportFormat ExportFormatOf(const std::string& path) {
@@ -36,10 +37,11 @@ ExportFormat ExportFormatOf(const std::string& path) {
   if (extension == ".uff" || extension == ".unv") return ExportFormat::kUff;
   if (extension == ".uffb") return ExportFormat::kUffBinary;
   if (extension == ".mat") return ExportFormat::kMat;
+  if (extension == ".csv") return ExportFormat::kCsv;
   throw InputError(
       "--export", path,
       extension.empty() ? "no file extension" : "unknown file extension '" + extension + "'",
-      ".uff or .unv (UFF58 ASCII), .uffb (UFF58b binary) or .mat (MATLAB v5)");
+      ".uff or .unv (UFF58 ASCII), .uffb (UFF58b binary), .mat (MATLAB v5) or .csv");
 }
 
 void Export(const Measurement& measured, const std::string& path) {
@@ -53,6 +55,9 @@ void Export(const Measurement& measured, const std::string& path) {
     case ExportFormat::kMat:
       records::WriteMat(measured, path);
       break;
+    case ExportFormat::kCsv:
+      WriteMeasurementCsv(measured, path);
+      break;
   }
 }
 
@@ -60,6 +65,7 @@ void Export(const Measurement& measured, const std::string& path) {
 
 int RunSimulateCommand(const std::string& scenario_path, const std::string& output_path,
                        const CommonOptions& common, const std::vector<std::string>& export_paths) {
+  CheckHdf5OutputName(output_path);
   for (const std::string& path : export_paths) ExportFormatOf(path);  // before the simulation
   const Scenario scenario = LoadScenario(scenario_path);
   const auto model = scenario.MakeModel();

@@ -10,6 +10,7 @@
 #include "command_test.h"
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/measurement.h"
+#include "mbid/records/records.h"
 #include "raw_table.h"
 
 namespace mbid::testing {
@@ -40,9 +41,10 @@ void ExpectSameRecord(const records::internal::RawTable& table, const Measuremen
 TEST_F(ExportTest, SimulateExportsUffAndMat) {
   const fs::path h5 = dir_ / "drop.h5";
   const fs::path uff = dir_ / "drop.uff", uffb = dir_ / "drop.uffb", mat = dir_ / "drop.mat";
+  const fs::path csv = dir_ / "drop.csv";
   const CommandResult result =
       Run("simulate " + kLoadDrop + " -o " + h5.string() + " --export " + uff.string() +
-          " --export " + uffb.string() + " --export " + mat.string());
+          " --export " + uffb.string() + " --export " + mat.string() + " --export " + csv.string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const Measurement m = ReadMeasurementH5(h5.string());
   // ASCII UFF58 prints 13 significant digits (4E20.12): within 5e-13 relative, 6e-13 with the
@@ -56,6 +58,36 @@ TEST_F(ExportTest, SimulateExportsUffAndMat) {
   const auto matlab = records::internal::ReadMat(mat.string());
   EXPECT_TRUE(matlab.si_by_contract);
   ExpectSameRecord(matlab, m, 0.0);  // uncompressed v5 doubles: exact
+  // mbid's CSV: every double in its shortest round-trip form, units and the exact interval in
+  // comments: imported, the same record to the bit.
+  const Measurement read = records::ImportMeasurement(csv.string());
+  EXPECT_EQ(read.channels, m.channels);
+  EXPECT_EQ(read.units, m.units);
+  EXPECT_EQ(read.sample_interval_s, m.sample_interval_s);
+  EXPECT_EQ(read.start_time_s, m.start_time_s);
+  EXPECT_TRUE(read.values == m.values);
+}
+
+// -o writes HDF5: a name that says another record format would be misread, by mbid itself
+// too. Refused before anything runs, for every command that writes one.
+TEST_F(ExportTest, AnHdf5OutputNamedAsAnotherFormatIsRefused) {
+  for (const std::string& name : {"drop.csv", "drop.MAT", "drop.uff"}) {
+    const fs::path out = dir_ / name;
+    const CommandResult result = Run("simulate " + kLoadDrop + " -o " + out.string());
+    EXPECT_EQ(result.exit_code, 2) << result.err;
+    EXPECT_EQ(result.err.rfind("mbid: error: -o:", 0), 0u) << result.err;
+    EXPECT_NE(result.err.find("-o writes HDF5"), std::string::npos) << result.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  const CommandResult update =
+      Run("update " + kLoadDrop + " " + kLoadDrop + " -o " + (dir_ / "up.csv").string());
+  EXPECT_EQ(update.exit_code, 2) << update.err;
+  EXPECT_NE(update.err.find("-o:"), std::string::npos) << update.err;
+  EXPECT_FALSE(fs::exists(dir_ / "up.csv"));
+  // Names without another format's extension are the user's choice.
+  const CommandResult plain =
+      Run("identify " + (dir_ / "missing.h5").string() + " -o " + (dir_ / "modes.out").string());
+  EXPECT_EQ(plain.err.find("-o writes HDF5"), std::string::npos) << plain.err;
 }
 
 TEST_F(ExportTest, UnknownExtensionFailsBeforeSimulating) {

@@ -17,12 +17,17 @@ struct CommonOptions {
   bool profile = false;  // --profile: profile-likelihood intervals (updating.profile.enabled)
 };
 
+// InputError (exit 2) when an HDF5 output's name (-o) has the extension of another record
+// format mbid reads (.csv, .txt, .uff, .mat, ...): that file would be misread. Other names pass.
+void CheckHdf5OutputName(const std::string& path);
+
 // `mbid modes SCENARIO [--json FILE]`: the linearized model and its exact modes.
 int RunModesCommand(const std::string& scenario_path, const CommonOptions& common);
 
 // `mbid simulate SCENARIO -o FILE.h5 [--json FILE] [--export FILE]...`: a synthetic
 // measurement from the model; each `--export` also writes the measured record for other tools,
-// by extension: .uff/.unv (UFF58 ASCII), .uffb (UFF58b binary), .mat (MATLAB v5).
+// by extension: .uff/.unv (UFF58 ASCII), .uffb (UFF58b binary), .mat (MATLAB v5), .csv (time
+// and channels, units in a comment: mbid's own CSV layout).
 int RunSimulateCommand(const std::string& scenario_path, const std::string& output_path,
                        const CommonOptions& common,
                        const std::vector<std::string>& export_paths = {});
