@@ -272,31 +272,31 @@ CharacteristicProblem MakeCharacteristicProblem(
     problem.d_reference[i] =
         d > 0 ? d : 0.1 * std::sqrt(problem.c_reference[i] * std::abs(linear.M(i, i)));
   }
-  if (excitation && excitation->CalcForcingEndTime() == 0.0) {
-    // A free decay from a known state at rest; a copy of the model carries each candidate set.
+  if (excitation) {
+    // A copy of the model carries each candidate set into the test's start: a free decay's
+    // known state at rest, or a forced test's state where the forcing ends.
     std::shared_ptr<model::MechanicalModel> copy = model.Clone();
     const std::vector<std::string> coordinates = linear.coordinates;
+    const auto carrying = [copy, coordinates](const Eigen::VectorXd& c,
+                                              const Eigen::VectorXd& d) -> model::MechanicalModel& {
+      for (size_t i = 0; i < coordinates.size(); ++i) {
+        copy->SetParameter("c_" + coordinates[i], c[static_cast<Eigen::Index>(i)]);
+        copy->SetParameter("d_" + coordinates[i], d[static_cast<Eigen::Index>(i)]);
+      }
+      return *copy;
+    };
     const simulation::Excitation test = *excitation;
-    problem.expected_initial_q = [copy, coordinates, test](const Eigen::VectorXd& c,
+    if (test.CalcForcingEndTime() == 0.0) {
+      problem.expected_initial_q = [carrying, test](const Eigen::VectorXd& c,
+                                                    const Eigen::VectorXd& d) {
+        return simulation::CalcInitialCoordinates(carrying(c, d), test);
+      };
+    } else {
+      problem.expected_free_decay_start = [carrying, test](const Eigen::VectorXd& c,
                                                            const Eigen::VectorXd& d) {
-      for (size_t i = 0; i < coordinates.size(); ++i) {
-        copy->SetParameter("c_" + coordinates[i], c[static_cast<Eigen::Index>(i)]);
-        copy->SetParameter("d_" + coordinates[i], d[static_cast<Eigen::Index>(i)]);
-      }
-      return simulation::CalcInitialCoordinates(*copy, test);
-    };
-  } else if (excitation) {
-    std::shared_ptr<model::MechanicalModel> copy = model.Clone();
-    const std::vector<std::string> coordinates = linear.coordinates;
-    const simulation::Excitation test = *excitation;
-    problem.expected_free_decay_start = [copy, coordinates, test](const Eigen::VectorXd& c,
-                                                                  const Eigen::VectorXd& d) {
-      for (size_t i = 0; i < coordinates.size(); ++i) {
-        copy->SetParameter("c_" + coordinates[i], c[static_cast<Eigen::Index>(i)]);
-        copy->SetParameter("d_" + coordinates[i], d[static_cast<Eigen::Index>(i)]);
-      }
-      return simulation::CalcFreeDecayStart(*copy, test);
-    };
+        return simulation::CalcFreeDecayStart(carrying(c, d), test);
+      };
+    }
   }
   Validate(problem);
   return problem;
