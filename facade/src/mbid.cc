@@ -10,6 +10,7 @@
 #include "mbid/identification/identify.h"
 #include "mbid/report/run_folder.h"
 #include "mbid/simulation/simulate.h"
+#include "mbid/validation/identification_settings.h"
 #include "mbid/validation/loaded_test.h"
 #include "mbid/validation/recorded_tests.h"
 
@@ -88,6 +89,14 @@ ModalResult Identify(const Measurement& record, const IdentificationOptions& opt
   // Identify checks the options itself; a record made in memory has not been checked yet.
   record.Validate("record");
   return identification::Identify(record, options, "record");
+}
+
+ModalResult IdentifyTest(const Measurement& record, const Scenario& test,
+                         const IdentificationOptions& options) {
+  if (!test.has_excitation || options.release != identification::ReleaseMode::kDetect) {
+    return mbid::Identify(record, options);
+  }
+  return mbid::Identify(record, validation::FreeDecayOptions(options, test.excitation));
 }
 
 UpdateResult Update(const Scenario& scenario, const std::vector<Measurement>& records) {

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -284,12 +285,15 @@ PYBIND11_MODULE(_mbid, m) {
       py::arg("path"), "Reads a record file (CSV, HDF5, MAT, UFF58, LVM), SI units.");
   m.def(
       "identify",
-      [](const mbid::Measurement& record, const IdentificationOptions& options) {
-        return mbid::Identify(record, options);
+      [](const mbid::Measurement& record, const IdentificationOptions& options,
+         const std::optional<mbid::Scenario>& scenario) {
+        return scenario ? mbid::IdentifyTest(record, *scenario, options)
+                        : mbid::Identify(record, options);
       },
       py::arg("record"), py::arg("options") = IdentificationOptions(),
-      py::call_guard<py::gil_scoped_release>(),
-      "Identifies the modes of a free-decay record (options: IdentificationOptions).");
+      py::arg("scenario") = py::none(), py::call_guard<py::gil_scoped_release>(),
+      "Identifies the modes of a free-decay record (options: IdentificationOptions); with the "
+      "scenario of its test, after an impulse or burst from where the forcing ends.");
   m.def(
       "identify_arrays",
       [](py::array_t<double, py::array::c_style | py::array::forcecast> time,

@@ -66,6 +66,13 @@ Measurement ReadRecord(const std::string& path, const records::ImportOptions& op
 // Identifies the modes of a free-decay record (from its release on, when the record shows one).
 ModalResult Identify(const Measurement& record, const IdentificationOptions& options = {});
 
+// The same for a record of `test`'s excitation (Simulate(test), or a measured record of that
+// test): after a forcing (an impulse, a burst) its free decay is analysed from where the forcing
+// ends, as RunValidationCycle does; a pulse at the record's very start is no release the record
+// could show. `options`' own release or window win.
+ModalResult IdentifyTest(const Measurement& record, const Scenario& test,
+                         const IdentificationOptions& options = {});
+
 // One tuned parameter.
 struct ParameterValue {
   double value = 0;
