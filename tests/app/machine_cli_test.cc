@@ -128,6 +128,33 @@ sensors: {sample_rate_hz: 200, channels: [a_roof], noise_std_mps2: 2.0e-3, seed:
   EXPECT_EQ(none.err.find("free decay after the impulse"), std::string::npos) << none.err;
 }
 
+// A load drop on a frame whose floors slide horizontally: the payload's weight acts along no
+// compliant coordinate, so the simulated test does not move the machine. Nothing to identify
+// (exit 3), and the message says why.
+TEST_F(MachineCliTest, ATestThatDoesNotMoveTheMachineSaysSo) {
+  const fs::path scenario = dir_ / "still.yaml";
+  std::ofstream(scenario) << R"(name: still
+model:
+  type: multibody
+  bodies:
+    f1: {parent: ground, joint: {type: prismatic, coordinates: [x1], axis: [1, 0, 0]}, mass_kg: 1000.0, inertia_kgm2: [100, 100, 100]}
+  springs:
+    x1: {stiffness_N_per_m: 1.0e6, damping_Ns_per_m: 200.0}
+  points: {roof: {body: f1, at_m: [0, 0, 0]}}
+  payload_point: roof
+  outputs: {a_roof: {type: acceleration, point: roof, direction: [1, 0, 0]}}
+excitation: {type: load_drop, payload_mass_kg: 500}
+simulation: {duration_s: 2}
+sensors: {sample_rate_hz: 100, channels: [a_roof], noise_std_mps2: 1.0e-3, seed: 1}
+)";
+  const CommandResult run = Run("run " + scenario.string() + " -o " + (dir_ / "run").string());
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_NE(run.err.find("no modes found"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("the simulated test barely moves the machine"), std::string::npos)
+      << run.err;
+  EXPECT_FALSE(fs::exists(dir_ / "run"));
+}
+
 // Finite but absurd values stop at load with exit 2 and one line, before anything allocates:
 // a mass that would overflow Simbody's inertia shift (refused at its key, above 1e9 kg), a record
 // of 8e12 samples, a record of 1.

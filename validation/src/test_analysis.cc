@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "mbid/common/error.h"
@@ -17,14 +18,43 @@ namespace {
 // A residual rms within this factor of the noise is the noise (chi^2 per sample up to 1.44).
 constexpr double kNoiseLevelRatio = 1.2;
 
+// Whether a simulated test's noise-free record stays within its noise (or 1e-12 SI where
+// noiseless) in every channel.
+bool BarelyMoves(const RunTest& test) {
+  if (!test.exact || test.exact->values.rows() != test.measured.values.rows() ||
+      test.exact->values.cols() != test.measured.values.cols()) {
+    return false;
+  }
+  const Eigen::MatrixXd& exact = test.exact->values;
+  for (Eigen::Index c = 0; c < exact.cols(); ++c) {
+    const double noise = std::sqrt((test.measured.values.col(c) - exact.col(c)).squaredNorm() /
+                                   static_cast<double>(exact.rows()));
+    if (exact.col(c).cwiseAbs().maxCoeff() > std::max(noise, 1e-12)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
                  const simulation::Excitation& excitation, const RunSettings& settings,
                  const std::function<void(const std::string&)>& say,
                  const std::function<void(const RunTest&)>& identified) {
-  test.identified = identification::Identify(
-      test.measured, FreeDecayOptions(settings.identification, excitation), test.origin);
+  try {
+    test.identified = identification::Identify(
+        test.measured, FreeDecayOptions(settings.identification, excitation), test.origin);
+  } catch (const NumericalError& error) {
+    // A simulated test that does not move the machine above its sensors' noise has nothing
+    // to identify: say why.
+    if (BarelyMoves(test)) {
+      throw NumericalError(error.stage(),
+                           error.reason() +
+                               " (the simulated test barely moves the machine: in every channel "
+                               "the noise-free signal stays below the sensor noise; does the "
+                               "excitation load a compliant coordinate?)");
+    }
+    throw;
+  }
   say(fmt::format("identified {} modes ({}), K = {:.3f}", test.identified.modes.size(),
                   test.identified.method, test.identified.correlation.minCoeff()));
   if (identified) identified(test);
