@@ -60,6 +60,10 @@ void* WaitForSignals(void*) {
 
 void InstallInterruptCleanup() {
   std::signal(SIGXFSZ, SIG_IGN);
+  // A reader of the progress or the JSON that went away (`mbid run ... 2>&1 | head`) must not
+  // end the run by SIGPIPE's default action, which would leave its staging folder and lose the
+  // results: the writes fail (EPIPE) and the run completes.
+  std::signal(SIGPIPE, SIG_IGN);
   sigemptyset(&watched_signals);
   int count = 0;
   for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {

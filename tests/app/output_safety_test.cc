@@ -294,6 +294,21 @@ TEST_F(OutputSafetyTest, SigintAtTheStartLeavesNoStagingFolder) {
   EXPECT_TRUE(Entries(work_).empty());
 }
 
+// `mbid run ... 2>&1 | true`: the progress's reader is gone at once. Before, SIGPIPE ended the
+// run and left its staging folder; now the writes fail and the results are written whole.
+TEST_F(OutputSafetyTest, AClosedProgressPipeNeitherKillsTheRunNorLeavesAStagingFolder) {
+  const fs::path out = work_ / "out";
+  const std::string command =
+      kMbid + " run " + Scenario().string() + " -o " + out.string() + " 2>&1 | true";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+  EXPECT_TRUE(StagingEntries(work_).empty());
+  for (const auto& entry : fs::directory_iterator(work_)) {
+    EXPECT_EQ(entry.path().filename().string().rfind(".out.tmp-", 0), std::string::npos)
+        << entry.path();
+  }
+}
+
 TEST_F(OutputSafetyTest, AbsurdWorkerCountIsInvalidInput) {
   const fs::path campaign = Write("c.yaml", "name: c\nbase: " + kReference + "\nsweep:\n" +
                                                 "  - grid:\n      simulation.duration_s: [1, 2]\n");
