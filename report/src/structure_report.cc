@@ -110,8 +110,15 @@ std::string StructureTable(const updating::StructureRanking& ranking) {
                          Cell(fit.prediction_error, "{:.4g}"));
   }
   for (const updating::StructureFit& fit : ranking.structures) {
-    if (!fit.skipped.empty())
+    if (!fit.skipped.empty()) {
       table += fmt::format("\n- {}: not ranked: {}\n", fit.name, fit.skipped);
+    } else if (fit.fit.termination != updating::UpdateResult::Termination::kConverged) {
+      // Its cost is where the fit stopped, not its minimum: an upper bound of what it can reach.
+      table += fmt::format(
+          "\n- {}: its fit stopped before converging ({} after {} iterations): its cost and "
+          "criteria are upper bounds, its rank may be too low\n",
+          fit.name, fit.fit.termination_name(), fit.fit.iterations);
+    }
   }
   return table;
 }
