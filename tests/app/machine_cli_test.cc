@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "command_test.h"
 
@@ -103,10 +104,11 @@ simulation: {duration_s: 6}
 sensors: {sample_rate_hz: 200, channels: [a_roof], noise_std_mps2: 2.0e-3, seed: 4}
 )";
   const fs::path record = dir_ / "frame.h5", modes = dir_ / "modes.json", found = dir_ / "id.json";
-  ASSERT_EQ(
-      Run("simulate " + scenario.string() + " -o " + record.string() + " --json " + modes.string())
-          .exit_code,
-      0);
+  const fs::path csv = dir_ / "frame.csv";
+  ASSERT_EQ(Run("simulate " + scenario.string() + " -o " + record.string() + " --json " +
+                modes.string() + " --export " + csv.string())
+                .exit_code,
+            0);
   const CommandResult identify = Run("identify " + record.string() + " --json " + found.string());
   ASSERT_EQ(identify.exit_code, 0) << identify.err;
   EXPECT_NE(identify.err.find("free decay after the impulse that ends at 0.01 s"),
@@ -126,6 +128,27 @@ sensors: {sample_rate_hz: 200, channels: [a_roof], noise_std_mps2: 2.0e-3, seed:
   const CommandResult none =
       Run("identify " + record.string() + " --release none --json " + found.string());
   EXPECT_EQ(none.err.find("free decay after the impulse"), std::string::npos) << none.err;
+
+  // The same record as a logger writes it: 0.5 s of pre-trigger at rest before the blow, no
+  // mark of mbid. The blow's start is found only to about a sample (0.5025 s here, measured),
+  // and half a sample ruined the fit: the user must give it.
+  std::istringstream exported(ReadText(csv));
+  std::ostringstream logger;
+  logger << "time,a_roof\n";
+  for (int j = 0; j < 100; ++j) logger << j * 0.005 << "," << (j % 2 ? 1e-3 : -1e-3) << "\n";
+  for (std::string line; std::getline(exported, line);) {
+    if (line.empty() || line[0] == '#' || line.rfind("time", 0) == 0) continue;
+    const size_t comma = line.find(',');
+    logger << std::stod(line.substr(0, comma)) + 0.5 << line.substr(comma) << "\n";
+  }
+  const fs::path triggered = dir_ / "logger.csv";
+  std::ofstream(triggered) << logger.str();
+  const CommandResult update = Run("update " + scenario.string() + " " + triggered.string() +
+                                   " --unit a_roof=m/s^2 --json " + (dir_ / "up.json").string());
+  EXPECT_EQ(update.exit_code, 2) << update.err;
+  EXPECT_NE(update.err.find("release_time_s: the record rests until about 0.5"), std::string::npos)
+      << update.err;
+  EXPECT_FALSE(fs::exists(dir_ / "up.json"));
 }
 
 // A load drop on a frame whose floors slide horizontally: the payload's weight acts along no

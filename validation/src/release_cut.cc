@@ -1,5 +1,7 @@
 #include "mbid/validation/release_cut.h"
 
+#include <fmt/format.h>
+
 #include "mbid/common/error.h"
 #include "mbid/identification/identify.h"
 #include "mbid/identification/release.h"
@@ -40,6 +42,21 @@ AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin
     return applied;
   } else if (excitation.CalcForcingEndTime() > 0) {
     applied.how = "forced test";
+    if (record->made_by_mbid()) return applied;  // starts at the excitation by construction
+    // A logger's pre-trigger before the blow: the onset of a force that rises from zero is found
+    // only to about a sample, and the pulse's timing must be known to a fraction of one (a
+    // half-sample error failed a shear frame's fit outright). Never guessed: the user says.
+    const identification::ReleaseDetection detection = identification::DetectRelease(*record);
+    if (detection.detected) {
+      throw InputError(origin, "release_time_s",
+                       fmt::format("the record rests until about {:.6g} s before it responds, and "
+                                   "for a forced test ({}) the forcing's start cannot be found "
+                                   "from the record to a fraction of a sample",
+                                   detection.release_time_s, excitation.type_name()),
+                       "the forcing's start in the record's time as the record entry's "
+                       "release_time_s (or --release-time-s), or release: none for a record "
+                       "that starts with the forcing");
+    }
     return applied;
   } else if (record->made_by_mbid()) {
     // mbid's own records start at the excitation by construction.
