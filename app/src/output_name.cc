@@ -1,8 +1,5 @@
 // The name of an HDF5 output (-o): one that says another record format is refused, so that no
 // HDF5 file ends up named .csv or .mat, which mbid itself would then read as that format.
-#include <algorithm>
-#include <cctype>
-
 #include "mbid/app/commands.h"
 #include "mbid/common/error.h"
 #include "mbid/records/records.h"
@@ -11,12 +8,7 @@ namespace mbid::app {
 
 void CheckHdf5OutputName(const std::string& path) {
   if (path.empty() || path == "-") return;
-  const size_t dot = path.rfind('.');
-  const size_t slash = path.rfind('/');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return;
-  std::string extension = path.substr(dot);
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  const std::string extension = records::LowerExtension(path);
   if (extension == ".h5" || extension == ".hdf5" || !records::IsSupportedFile(path)) return;
   throw InputError("-o", path,
                    "'" + extension + "' names another record format, and -o writes HDF5",

@@ -1,5 +1,3 @@
-#include <algorithm>
-#include <cctype>
 #include <iostream>
 #include <vector>
 
@@ -27,13 +25,7 @@ enum class ExportFormat { kUff, kUffBinary, kMat, kCsv };
 
 // The format an `--export` file asks for by its extension (case-insensitive).
 ExportFormat ExportFormatOf(const std::string& path) {
-  const size_t dot = path.rfind('.');
-  const size_t slash = path.rfind('/');
-  std::string extension = dot == std::string::npos || (slash != std::string::npos && dot < slash)
-                              ? ""
-                              : path.substr(dot);
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  const std::string extension = records::LowerExtension(path);
   if (extension == ".uff" || extension == ".unv") return ExportFormat::kUff;
   if (extension == ".uffb") return ExportFormat::kUffBinary;
   if (extension == ".mat") return ExportFormat::kMat;

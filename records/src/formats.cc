@@ -30,6 +30,8 @@ const std::vector<Format>& Formats() {
   return formats;
 }
 
+}  // namespace
+
 std::string LowerExtension(const std::string& path) {
   const size_t slash = path.find_last_of('/');
   const size_t dot = path.find_last_of('.');
@@ -39,8 +41,6 @@ std::string LowerExtension(const std::string& path) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return extension;
 }
-
-}  // namespace
 
 std::vector<std::string> SupportedExtensions() {
   std::vector<std::string> extensions;

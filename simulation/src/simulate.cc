@@ -43,13 +43,8 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   SimTK::State initial =
       simulated.MakeState(result.initial_q, Eigen::VectorXd::Zero(model.coordinate_count()));
   const Eigen::MatrixXd jacobian = internal::CalcNewtonJacobian(simulated, initial);
-  auto make_integrator = [&](const IntegratorOptions& integrator_options) {
-    CvodesIntegrator made(simulated.system(), integrator_options);
-    made.set_jacobian(jacobian);
-    made.set_state_derivative(simulated.MakeStateDerivative());
-    return made;
-  };
-  CvodesIntegrator integrator = make_integrator(forced ? forced_options : options.integrator);
+  CvodesIntegrator integrator =
+      internal::MakeIntegrator(simulated, forced ? forced_options : options.integrator, jacobian);
   integrator.Initialize(std::move(initial));
 
   Measurement exact;
@@ -69,7 +64,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
       // multistep history there.
       SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s, kUnrealized);
       before_restart = integrator.statistics();
-      integrator = make_integrator(options.integrator);
+      integrator = internal::MakeIntegrator(simulated, options.integrator, jacobian);
       integrator.Initialize(std::move(at_end));
       forcing_done = true;
     }
@@ -102,9 +97,8 @@ FreeDecayStart CalcFreeDecayStart(const model::MechanicalModel& model, const Exc
   SimTK::State initial = forced->MakeState(start.q, start.u);
   IntegratorOptions options = integrator;
   options.interpolate_outputs = false;  // stop exactly at the forcing's end
-  CvodesIntegrator cvodes(forced->system(), options);
-  cvodes.set_jacobian(internal::CalcNewtonJacobian(*forced, initial));
-  cvodes.set_state_derivative(forced->MakeStateDerivative());
+  CvodesIntegrator cvodes =
+      internal::MakeIntegrator(*forced, options, internal::CalcNewtonJacobian(*forced, initial));
   cvodes.Initialize(std::move(initial));
   const SimTK::State& end = cvodes.AdvanceTo(start.time_s, kUnrealized);
   for (Eigen::Index i = 0; i < start.q.size(); ++i) {

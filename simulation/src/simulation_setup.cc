@@ -92,4 +92,12 @@ Eigen::MatrixXd CalcNewtonJacobian(const model::MechanicalModel& model,
   return jacobian;
 }
 
+CvodesIntegrator MakeIntegrator(const model::MechanicalModel& model,
+                                const IntegratorOptions& options, const Eigen::MatrixXd& jacobian) {
+  CvodesIntegrator made(model.system(), options);
+  made.set_jacobian(jacobian);
+  made.set_state_derivative(model.MakeStateDerivative());
+  return made;
+}
+
 }  // namespace mbid::simulation::internal

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "mbid/model/mechanical_model.h"
+#include "mbid/simulation/cvodes_integrator.h"
 #include "mbid/simulation/excitation.h"
 #include "mbid/simulation/sensor.h"
 
@@ -36,6 +37,10 @@ std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalM
 // the state `initial` of `model` has Y = [q | u], as every MechanicalModel's has.
 Eigen::MatrixXd CalcNewtonJacobian(const model::MechanicalModel& model,
                                    const SimTK::State& initial);
+
+// CVODES on `model`'s state derivative with the Newton Jacobian `jacobian` (CalcNewtonJacobian).
+CvodesIntegrator MakeIntegrator(const model::MechanicalModel& model,
+                                const IntegratorOptions& options, const Eigen::MatrixXd& jacobian);
 
 // Where the samples of a simulation lie. Rows i = 0..skipped + count - 1 at Time(i); the first
 // `skipped` are visited (the integrator stops there as it would for a record from t = 0, so a

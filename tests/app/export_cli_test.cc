@@ -71,7 +71,7 @@ TEST_F(ExportTest, SimulateExportsUffAndMat) {
 // -o writes HDF5: a name that says another record format would be misread, by mbid itself
 // too. Refused before anything runs, for every command that writes one.
 TEST_F(ExportTest, AnHdf5OutputNamedAsAnotherFormatIsRefused) {
-  for (const std::string& name : {"drop.csv", "drop.MAT", "drop.uff"}) {
+  for (const char* name : {"drop.csv", "drop.MAT", "drop.uff"}) {
     const fs::path out = dir_ / name;
     const CommandResult result = Run("simulate " + kLoadDrop + " -o " + out.string());
     EXPECT_EQ(result.exit_code, 2) << result.err;

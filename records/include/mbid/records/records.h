@@ -52,6 +52,8 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
 // has one of them (case ignored).
 std::vector<std::string> SupportedExtensions();
 bool IsSupportedFile(const std::string& path);
+// The extension of `path`'s file name in lower case, with its dot (".csv"); "" if none.
+std::string LowerExtension(const std::string& path);
 
 // Writers for other tools. Both write atomically (a temporary name renamed when complete).
 void WriteUff58(const Measurement& measurement, const std::string& path, bool binary = false);
