@@ -80,6 +80,11 @@ std::vector<std::string> SplitFields(const std::string& line, char separator) {
   return fields;
 }
 
+bool FitRow(std::vector<std::string>* fields, size_t columns) {
+  if (fields->size() == columns + 1 && fields->back().empty()) fields->pop_back();
+  return fields->size() == columns;
+}
+
 CellKind ClassifyCell(const std::string& cell, char separator, double* value) {
   if (value != nullptr) *value = std::numeric_limits<double>::quiet_NaN();
   if (cell.empty() || cell == "NaN" || cell == "nan" || cell == "NAN") return CellKind::kGap;
@@ -94,6 +99,7 @@ CellKind ClassifyCell(const std::string& cell, char separator, double* value) {
   }
   Timestamp timestamp;
   if (ParseTimestamp(cell, &timestamp)) return CellKind::kTimestamp;
+  if (ParseDate(cell, &timestamp)) return CellKind::kDate;
   return CellKind::kText;
 }
 
@@ -112,13 +118,13 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
     for (size_t k = 0; k + 1 < content.size(); ++k) {
       const auto header = SplitFields(lines[content[k]].text, separator);
       if (header.size() < 2 || IsDataRow(header, separator)) continue;
-      const auto next = SplitFields(lines[content[k + 1]].text, separator);
-      if (next.size() != header.size()) continue;
+      auto next = SplitFields(lines[content[k + 1]].text, separator);
+      if (!FitRow(&next, header.size())) continue;
       int units_row = -1;
       if (!IsDataRow(next, separator)) {
         if (k + 2 >= content.size() || !IsUnitsRow(next)) continue;
-        const auto data = SplitFields(lines[content[k + 2]].text, separator);
-        if (data.size() != header.size() || !IsDataRow(data, separator)) continue;
+        auto data = SplitFields(lines[content[k + 2]].text, separator);
+        if (!FitRow(&data, header.size()) || !IsDataRow(data, separator)) continue;
         units_row = content[k + 1];
       }
       // The most fields wins ("a,b;c" is not a ';' file); ties go to the earlier separator.

@@ -20,12 +20,17 @@ std::vector<TextLine> SplitLines(const std::string& text, bool* bom, bool* crlf)
 // Fields of one line, trimmed and without surrounding double quotes ("a;b" stays one field).
 std::vector<std::string> SplitFields(const std::string& line, char separator);
 
-enum class CellKind { kNumber, kGap, kTimestamp, kText };
+// Whether a row of `fields` fits a header of `columns` fields: as many, or one more that is
+// empty (a separator at the line's end, which spreadsheets and many loggers write); that one
+// is dropped.
+bool FitRow(std::vector<std::string>* fields, size_t columns);
+
+enum class CellKind { kNumber, kGap, kTimestamp, kDate, kText };
 
 // A data cell: a decimal number (with a decimal comma where the separator is not ',', and
-// thousands separators: number_marks.h), a gap (empty, NaN, nan), an ISO 8601 timestamp, or
-// text. `value` is set for numbers (NaN for gaps): with a decimal comma when the cell reads so
-// (the reader decides a cell that reads both ways by the file's decimal mark).
+// thousands separators: number_marks.h), a gap (empty, NaN, nan), a timestamp or a date alone
+// (iso_time.h), or text. `value` is set for numbers (NaN for gaps): with a decimal comma when the
+// cell reads so (the reader decides a cell that reads both ways by the file's decimal mark).
 CellKind ClassifyCell(const std::string& cell, char separator, double* value = nullptr);
 
 struct CsvDialect {

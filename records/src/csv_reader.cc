@@ -143,6 +143,7 @@ RawTable ReadCsv(const std::string& path) {
   std::vector<std::string> unit_cells(header_cells.size());
   if (dialect.units_row >= 0) {
     unit_cells = SplitFields(lines[static_cast<size_t>(dialect.units_row)].text, separator);
+    FitRow(&unit_cells, header_cells.size());
   }
   const auto cell_field = [&](int line, size_t c) {
     return fmt::format("line {}, column {}", line, c + 1);
@@ -181,17 +182,34 @@ RawTable ReadCsv(const std::string& path) {
     }
   }
 
+  const int first_row = (dialect.units_row >= 0 ? dialect.units_row : dialect.header) + 1;
+  // Else the first column of timestamps ("Date/Time", "Datum Uhrzeit"): no channel holds them.
+  // A column of dates alone completes a time of day ("Date;Time" loggers).
+  int date_column = -1;
+  for (size_t i = static_cast<size_t>(first_row); i < lines.size(); ++i) {
+    if (IsCommentOrBlank(lines[i].text)) continue;
+    const std::vector<std::string> fields = SplitFields(lines[i].text, separator);
+    for (size_t c = 0; c < fields.size() && c < columns.size(); ++c) {
+      const CellKind kind = ClassifyCell(fields[c], separator);
+      if (time_column < 0 && kind == CellKind::kTimestamp) time_column = static_cast<int>(c);
+      if (date_column < 0 && kind == CellKind::kDate) date_column = static_cast<int>(c);
+    }
+    break;
+  }
+
   // Rows.
   Metadata metadata;
   RawTable table;
   table.columns.resize(columns.size());
   bool timestamps = false;
   Timestamp first_timestamp;
+  std::string first_text;
+  std::int64_t day_offset = 0, last_seconds = 0;
   int time_place = std::numeric_limits<int>::max();
   int timestamp_decimals = 0;
-  const int first_row = (dialect.units_row >= 0 ? dialect.units_row : dialect.header) + 1;
   const MarkEvidence decimal = FindDecimalMark(lines, first_row, separator);
   bool thousands = false;
+  std::vector<bool> written(columns.size(), false);  // a cell of the column holds text
   for (size_t i = 0; i < lines.size(); ++i) {
     const TextLine& line = lines[i];
     if (IsCommentOrBlank(line.text)) {
@@ -199,26 +217,55 @@ RawTable ReadCsv(const std::string& path) {
       continue;
     }
     if (static_cast<int>(i) < first_row) continue;  // preamble, header, units row
-    const std::vector<std::string> fields = SplitFields(line.text, separator);
-    if (fields.size() != columns.size()) {
+    std::vector<std::string> fields = SplitFields(line.text, separator);
+    if (!FitRow(&fields, columns.size())) {
       throw InputError(
           path, LineField(line.number), fmt::format("{} fields", fields.size()),
           fmt::format("{} fields as in the header (line {})", columns.size(), header_line));
     }
     const bool first = table.sample_lines.empty();
+    Timestamp date;
+    if (date_column >= 0 && !ParseDate(fields[static_cast<size_t>(date_column)], &date)) {
+      throw InputError(path, cell_field(line.number, static_cast<size_t>(date_column)),
+                       "'" + fields[static_cast<size_t>(date_column)] + "' is not a date",
+                       "a date as in the first row (2026-03-01, 2026/03/01 or 01.03.2026)");
+    }
     for (size_t c = 0; c < fields.size(); ++c) {
       double value = 0;
+      if (static_cast<int>(c) == date_column) {
+        table.columns[c].values.push_back(std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
       const CellKind kind = ClassifyCell(fields[c], separator, &value);
+      if (!mbid::internal::Trim(fields[c]).empty()) written[c] = true;
       const std::string where = fmt::format("{} ({})", cell_field(line.number, c),
                                             columns[c].name.empty() ? "unnamed" : columns[c].name);
       if (static_cast<int>(c) == time_column && first) timestamps = kind == CellKind::kTimestamp;
       if (static_cast<int>(c) == time_column && timestamps) {
         Timestamp timestamp;
-        if (!ParseTimestamp(fields[c], &timestamp)) {
-          throw InputError(path, where, "'" + fields[c] + "' is not a timestamp",
-                           "an ISO 8601 timestamp as in the first row (2026-03-01T12:00:00.125)");
+        const bool parsed = ParseTimestamp(fields[c], &timestamp);
+        if (parsed && !timestamp.has_date && date_column >= 0) {
+          timestamp.seconds += date.seconds;
+          timestamp.has_date = true;
         }
-        if (first) first_timestamp = timestamp;
+        if (!parsed || (!first && timestamp.has_date != first_timestamp.has_date)) {
+          throw InputError(
+              path, where, "'" + fields[c] + "' is not a timestamp as in the first row",
+              fmt::format("a {} as in the first row ('{}')",
+                          !first && !first_timestamp.has_date ? "time of day" : "date and time",
+                          first_text));
+        }
+        if (first) {
+          first_timestamp = timestamp;
+          first_text = fields[c];
+        }
+        // A time of day alone runs past midnight into the next day.
+        timestamp.seconds += day_offset;
+        if (!timestamp.has_date && !first && timestamp.seconds < last_seconds - 43200) {
+          day_offset += 86400;
+          timestamp.seconds += 86400;
+        }
+        last_seconds = timestamp.seconds;
         timestamp_decimals = std::max(timestamp_decimals, timestamp.decimals);
         value = SecondsBetween(first_timestamp, timestamp);
       } else if (kind == CellKind::kNumber) {
@@ -239,6 +286,20 @@ RawTable ReadCsv(const std::string& path) {
     }
     table.sample_lines.push_back(line.number);
   }
+  // A separator at every line's end (spreadsheets, many loggers) makes a column without name,
+  // unit or any value: not a channel, so it is dropped rather than refused as unnamed.
+  int empty_columns = 0;
+  std::vector<size_t> file_column(columns.size());  // for messages after dropping
+  for (size_t c = 0; c < columns.size(); ++c) file_column[c] = c;
+  for (size_t c = columns.size(); c-- > 0;) {
+    const bool unused = columns[c].name.empty() && columns[c].unit.empty() && !written[c];
+    if (static_cast<int>(c) != date_column && !unused) continue;
+    if (static_cast<int>(c) != date_column) ++empty_columns;
+    if (static_cast<int>(c) < time_column) --time_column;
+    columns.erase(columns.begin() + static_cast<std::ptrdiff_t>(c));
+    table.columns.erase(table.columns.begin() + static_cast<std::ptrdiff_t>(c));
+    file_column.erase(file_column.begin() + static_cast<std::ptrdiff_t>(c));
+  }
 
   // mbid's own CSV: ',' and a first column named exactly `time`; channels without a unit are
   // SI by contract (docs/file-formats.md).
@@ -246,6 +307,11 @@ RawTable ReadCsv(const std::string& path) {
                          header_cells.front() == "time";
   table.format = table.si_by_contract ? "mbid-csv" : "csv";
   table.dialect = dialect.Describe(decimal.mark == DecimalMark::kComma, thousands);
+  if (date_column >= 0) table.dialect += fmt::format(", dates in column {}", date_column + 1);
+  if (empty_columns > 0) {
+    table.dialect +=
+        fmt::format(", {} empty column{} ignored", empty_columns, empty_columns == 1 ? "" : "s");
+  }
   table.source = metadata.source;
   if (metadata.units_line > 0) {
     // "# units: s,rad,rad" may include the time column; "rad,rad" lists the channels.
@@ -286,7 +352,7 @@ RawTable ReadCsv(const std::string& path) {
   for (size_t c = 0; c < columns.size(); ++c) {
     table.columns[c].name = columns[c].name;
     table.columns[c].unit = columns[c].unit;
-    table.columns[c].where = fmt::format("column {}", c + 1);
+    table.columns[c].where = fmt::format("column {}", file_column[c] + 1);
   }
   if (time_column >= 0) {
     RawColumn time = std::move(table.columns[static_cast<size_t>(time_column)]);

@@ -34,20 +34,52 @@ std::int64_t DaysFromCivil(std::int64_t y, int m, int d) {
   return era * 146097 + doe - 719468;
 }
 
+// The date: "2026-03-01", "2026/03/01" or day first "01.03.2026"; false when `text` does not
+// start with one.
+bool ReadDate(const std::string& text, size_t* at, int* year, int* month, int* day) {
+  size_t start = *at;
+  if (ReadDigits(text, at, 4, year) && *at < text.size() &&
+      (text[*at] == '-' || text[*at] == '/')) {
+    const char separator = text[(*at)++];
+    return ReadDigits(text, at, 2, month) && Expect(text, at, separator) &&
+           ReadDigits(text, at, 2, day);
+  }
+  *at = start;
+  return ReadDigits(text, at, 2, day) && Expect(text, at, '.') && ReadDigits(text, at, 2, month) &&
+         Expect(text, at, '.') && ReadDigits(text, at, 4, year);
+}
+
 }  // namespace
+
+bool ParseDate(const std::string& text, Timestamp* date) {
+  size_t at = 0;
+  int year = 0, month = 0, day = 0;
+  if (!ReadDate(text, &at, &year, &month, &day) || at != text.size() || month < 1 || month > 12 ||
+      day < 1 || day > 31) {
+    return false;
+  }
+  *date = Timestamp{};
+  date->seconds = DaysFromCivil(year, month, day) * 86400;
+  return true;
+}
 
 bool ParseTimestamp(const std::string& text, Timestamp* timestamp) {
   size_t at = 0;
-  int year = 0, month = 0, day = 0, hour = 0, minute = 0, second = 0;
-  if (!ReadDigits(text, &at, 4, &year) || !Expect(text, &at, '-') ||
-      !ReadDigits(text, &at, 2, &month) || !Expect(text, &at, '-') ||
-      !ReadDigits(text, &at, 2, &day)) {
-    return false;
+  int year = 1970, month = 1, day = 1, hour = 0, minute = 0, second = 0;
+  const bool has_date = ReadDate(text, &at, &year, &month, &day);
+  if (has_date) {
+    if (at >= text.size() || (text[at] != 'T' && text[at] != ' ')) return false;
+    ++at;
+  } else {
+    at = 0;
+    year = 1970, month = 1, day = 1;  // a failed ReadDate may have set some
   }
-  if (at >= text.size() || (text[at] != 'T' && text[at] != ' ')) return false;
-  ++at;
-  if (!ReadDigits(text, &at, 2, &hour) || !Expect(text, &at, ':') ||
-      !ReadDigits(text, &at, 2, &minute) || !Expect(text, &at, ':') ||
+  // The hour may have one digit ("9:05:00") where no date precedes it.
+  if (!ReadDigits(text, &at, 2, &hour)) {
+    at = 0;
+    if (has_date || !ReadDigits(text, &at, 1, &hour)) return false;
+  }
+  if (!Expect(text, &at, ':') || !ReadDigits(text, &at, 2, &minute) || !Expect(text, &at, ':') ||
       !ReadDigits(text, &at, 2, &second)) {
     return false;
   }
@@ -79,6 +111,7 @@ bool ParseTimestamp(const std::string& text, Timestamp* timestamp) {
       DaysFromCivil(year, month, day) * 86400 + hour * 3600 + minute * 60 + second - offset_s;
   timestamp->fraction = fraction;
   timestamp->decimals = decimals;
+  timestamp->has_date = has_date;
   return true;
 }
 

@@ -25,7 +25,7 @@ TEST(IsoTimeTest, ParsesTheForms) {
 
 TEST(IsoTimeTest, RefusesOtherTexts) {
   Timestamp t;
-  for (const char* text : {"2026-03-01", "12:00:00", "2026-13-01T00:00:00", "2026-03-01T12:00",
+  for (const char* text : {"2026-03-01", "12:00", "2026-13-01T00:00:00", "2026-03-01T12:00",
                            "2026-03-01T12:00:00.", "2026-03-01T12:00:00 junk", "0.125"}) {
     EXPECT_FALSE(ParseTimestamp(text, &t)) << text;
   }

@@ -1,0 +1,164 @@
+// Layouts spreadsheets and loggers write around the numbers: a separator at every line's end,
+// dates day first, a date column beside a time of day, a time of day that passes midnight.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "iso_time.h"
+#include "logger_export.h"
+#include "mbid/common/error.h"
+#include "mbid/records/records.h"
+#include "test_util.h"
+
+namespace mbid::records {
+namespace {
+
+using mbid::testing::Decay;
+using mbid::testing::MakeExport;
+using mbid::testing::Print;
+using mbid::testing::TempDir;
+using mbid::testing::WriteText;
+using ::testing::HasSubstr;
+
+constexpr double kDegree = M_PI / 180;
+
+// 9 printed digits: error <= 5e-9 of amplitude + offset (as import_test.cc).
+void ExpectDecayRead(const Measurement& m, int c, const Decay& decay, double factor) {
+  const Eigen::VectorXd t = m.CalcTime();
+  for (Eigen::Index j = 0; j < m.samples(); ++j) {
+    ASSERT_NEAR(m.values(j, c), decay(t[j]) * factor,
+                1e-8 * (std::abs(decay.amplitude) + std::abs(decay.offset)) * factor)
+        << "sample " << j;
+  }
+}
+
+// "hh:mm:ss,mmm" of second-of-day s (s < 86400), as German loggers print it.
+std::string PrintTimeOfDay(double s) {
+  const int ms = static_cast<int>(std::lround(s * 1000));
+  return fmt::format("{:02d}:{:02d}:{:02d},{:03d}", ms / 3600000, ms / 60000 % 60, ms / 1000 % 60,
+                     ms % 1000);
+}
+
+TEST(DateAndLayoutTest, ASeparatorAtEveryLineEndIsNoColumn) {
+  TempDir dir;
+  const Decay psi;
+  // Header and rows both end with ';' (a spreadsheet's export, after Excel's "sep=;" line).
+  const std::string both = dir.File("both.csv");
+  WriteText(both, MakeExport("sep=;\nTime [s];psi [deg];\n", 201, [&](int j) {
+              return fmt::format("{};{};", Print(j * 0.01, true), Print(psi(j * 0.01), true));
+            }));
+  ImportReport report;
+  Measurement m = ImportMeasurement(both, {}, &report);
+  EXPECT_EQ(m.channels, std::vector<std::string>{"psi"});
+  EXPECT_THAT(report.dialect, HasSubstr("1 empty column ignored"));
+  ExpectDecayRead(m, 0, psi, kDegree);
+  // Only the rows end with ',' (some loggers): the header still finds them.
+  const std::string rows = dir.File("rows.csv");
+  WriteText(rows, MakeExport("Time [s],psi [deg]\n", 201, [&](int j) {
+              return fmt::format("{},{},", Print(j * 0.01), Print(psi(j * 0.01)));
+            }));
+  m = ImportMeasurement(rows);
+  EXPECT_EQ(m.channels, std::vector<std::string>{"psi"});
+  ExpectDecayRead(m, 0, psi, kDegree);
+  // A column with a name stays a channel even when it is all gaps: refused as gaps, not dropped.
+  const std::string named = dir.File("named.csv");
+  WriteText(named, MakeExport("Time [s],psi [deg],spare [deg]\n", 201, [&](int j) {
+              return fmt::format("{},{},", Print(j * 0.01), Print(psi(j * 0.01)));
+            }));
+  try {
+    ImportMeasurement(named);
+    ADD_FAILURE() << "a named column of gaps was dropped";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("column 3"));
+    EXPECT_THAT(e.what(), HasSubstr("gap"));
+  }
+}
+
+TEST(DateAndLayoutTest, DateColumnBesideATimeOfDayAcrossMidnight) {
+  TempDir dir;
+  const std::string path = dir.File("dates.csv");
+  const Decay psi;
+  // 10 s at 100 Hz from 23:59:55 on 28 Nov: the date turns at row 500.
+  WriteText(path, MakeExport("Datum;Uhrzeit;psi [deg]\n", 1001, [&](int j) {
+              const double s = 86395.0 + j * 0.01;
+              const int day = s < 86400 ? 28 : 29;
+              return fmt::format("{:02d}.11.2026;{};{}", day, PrintTimeOfDay(std::fmod(s, 86400.0)),
+                                 Print(psi(j * 0.01), true));
+            }));
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, {}, &report);
+  EXPECT_EQ(m.channels, std::vector<std::string>{"psi"});  // neither date nor time is a channel
+  EXPECT_THAT(report.dialect, HasSubstr("dates in column 1"));
+  EXPECT_EQ(m.samples(), 1001);
+  EXPECT_EQ(m.start_time_s, 0.0);                 // seconds from the first sample
+  EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-15);  // whole seconds subtracted first: exact
+  ExpectDecayRead(m, 0, psi, kDegree);
+  // The same times without the date column: the day is carried over midnight.
+  const std::string alone = dir.File("alone.csv");
+  WriteText(alone, MakeExport("Uhrzeit;psi [deg]\n", 1001, [&](int j) {
+              const double s = 86395.0 + j * 0.01;
+              return fmt::format("{};{}", PrintTimeOfDay(std::fmod(s, 86400.0)),
+                                 Print(psi(j * 0.01), true));
+            }));
+  const Measurement m2 = ImportMeasurement(alone);
+  EXPECT_NEAR(m2.sample_interval_s, 0.01, 1e-15);
+  ExpectDecayRead(m2, 0, psi, kDegree);
+}
+
+TEST(DateAndLayoutTest, DayFirstDateAndTimeInOneCell) {
+  TempDir dir;
+  const std::string path = dir.File("de.csv");
+  const Decay psi;
+  WriteText(path, MakeExport("Date/Time;psi [deg]\n", 301, [&](int j) {
+              return fmt::format("01.03.2026 {};{}", PrintTimeOfDay(43200.0 + j * 0.01),
+                                 Print(psi(j * 0.01), true));
+            }));
+  const Measurement m = ImportMeasurement(path);
+  EXPECT_EQ(m.channels, std::vector<std::string>{"psi"});
+  EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-15);
+  ExpectDecayRead(m, 0, psi, kDegree);
+  // A row whose time lost its date is refused naming its line.
+  const std::string mixed = dir.File("mixed.csv");
+  WriteText(mixed,
+            "Date/Time;psi [deg]\n01.03.2026 12:00:00,000;1\n"
+            "01.03.2026 12:00:00,010;1\n12:00:00,020;1\n");
+  try {
+    ImportMeasurement(mixed);
+    ADD_FAILURE() << "a time without its date was read";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("line 4"));
+    EXPECT_THAT(e.what(), HasSubstr("date and time as in the first row"));
+  }
+}
+
+TEST(DateAndLayoutTest, DatesAndTimesOfDayParse) {
+  using internal::ParseDate;
+  using internal::ParseTimestamp;
+  using internal::SecondsBetween;
+  using internal::Timestamp;
+  Timestamp iso, slash, dotted, date;
+  ASSERT_TRUE(ParseTimestamp("2026-03-01 12:00:00.5", &iso));
+  ASSERT_TRUE(ParseTimestamp("2026/03/01 12:00:00,5", &slash));
+  ASSERT_TRUE(ParseTimestamp("01.03.2026 12:00:00", &dotted));  // day first
+  EXPECT_DOUBLE_EQ(SecondsBetween(iso, slash), 0.0);
+  EXPECT_DOUBLE_EQ(SecondsBetween(dotted, iso), 0.5);
+  ASSERT_TRUE(ParseDate("01.03.2026", &date));
+  EXPECT_EQ(iso.seconds - date.seconds, 12 * 3600);
+  Timestamp morning;
+  ASSERT_TRUE(ParseTimestamp("9:05:00.25", &morning));  // one-digit hour, no date
+  EXPECT_FALSE(morning.has_date);
+  EXPECT_EQ(morning.seconds, 9 * 3600 + 5 * 60);
+  EXPECT_EQ(morning.decimals, 2);
+  Timestamp t;
+  // Month-first dates with '/' are ambiguous (03/01/2026) and not read; nor are impossible ones.
+  for (const char* text : {"03/01/2026 12:00:00", "32.01.2026 12:00:00", "01.13.2026", "24:00:00",
+                           "12:60:00", "1.3.2026 12:00:00", "9:05"}) {
+    EXPECT_FALSE(ParseTimestamp(text, &t)) << text;
+  }
+  EXPECT_FALSE(ParseDate("01.13.2026", &t));
+}
+
+}  // namespace
+}  // namespace mbid::records
