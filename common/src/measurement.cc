@@ -99,6 +99,50 @@ void Measurement::Validate(const std::string& origin) const {
   }
 }
 
+namespace {
+
+// A grid of interval `tau` printed to `resolution` has steps within `resolution` of tau (each
+// time rounded or truncated by less than it). A dropped sample makes a step near 2 tau: found
+// here when tau > 2 resolution, and where it is not, a step that long is refused as undecidable
+// rather than read as a clock off its rate (the least-squares grid absorbs a dropped sample then).
+void CheckPrintedSteps(const Eigen::VectorXd& time_s, const std::string& origin,
+                       const std::function<std::string(Eigen::Index)>& field_of_sample,
+                       double resolution, double tau) {
+  const Eigen::Index n = time_s.size();
+  // The fitted tau is off by about resolution / n; the last digit's parse by 1e-6 of it.
+  const double slack = resolution * (1e-6 + 4.0 / static_cast<double>(n - 1));
+  for (Eigen::Index j = 1; j < n; ++j) {
+    const double step = time_s[j] - time_s[j - 1];
+    if (std::abs(step - tau) > resolution + slack) {
+      throw InputError(
+          origin, field_of_sample(j),
+          fmt::format("non-uniform time: step {:.9g} s from sample {} to {} where the grid's "
+                      "interval is {:.9g} s (a dropped or repeated sample?)",
+                      step, j - 1, j, tau),
+          fmt::format("uniform sampling (steps within the printed resolution {:g} s of the "
+                      "interval)",
+                      resolution));
+    }
+  }
+  Eigen::Index longest = 1;
+  for (Eigen::Index j = 2; j < n; ++j) {
+    if (time_s[j] - time_s[j - 1] > time_s[longest] - time_s[longest - 1]) longest = j;
+  }
+  const double step = time_s[longest] - time_s[longest - 1];
+  if (tau < 2 * resolution && step >= 2 * tau - resolution) {
+    throw InputError(
+        origin, field_of_sample(longest),
+        fmt::format("step {:.9g} s from sample {} to {} may be a dropped sample or the "
+                    "rounding of a {:.9g} s interval: the time column, printed to {:g} s, "
+                    "cannot tell",
+                    step, longest - 1, longest, tau, resolution),
+        "times printed with more digits, or the record's sample rate stated (`sample_rate_hz` in "
+        "its record entry, --sample-rate-hz)");
+  }
+}
+
+}  // namespace
+
 double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin,
                         const std::function<std::string(Eigen::Index)>& field_of_sample,
                         double printed_resolution_s, double* fitted_start_s) {
@@ -149,6 +193,7 @@ double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin
     }
     // Rounding to the printed digit moves a time by half its place value; allow the whole.
     if (b > 0 && worst <= printed_resolution_s) {
+      CheckPrintedSteps(time_s, origin, field_of_sample, printed_resolution_s, b);
       if (fitted_start_s != nullptr) *fitted_start_s = a;
       return b;
     }

@@ -121,6 +121,54 @@ std::string SampleField(const RawTable& table, const std::string& where, Eigen::
 }
 
 // Sets the measurement's start time and interval from the file's time base (in seconds).
+// A time column printed to `resolution` with a rate the user states: every time must lie within
+// that resolution of one grid j / rate (the spread of t_j - j / rate is under one place value
+// when each time is rounded or truncated), so that a dropped sample is found even where the
+// column alone could not tell it from a clock off its rate (CheckUniformTime).
+void StatedRateGrid(const Eigen::VectorXd& time, const std::string& path, const RawTable& table,
+                    double rate_hz, double resolution, Measurement* m, ImportReport* report) {
+  const double tau = 1.0 / rate_hz;
+  const Eigen::ArrayXd offset =
+      time.array() - tau * Eigen::ArrayXd::LinSpaced(time.size(), 0, time.size() - 1);
+  const double low = offset.minCoeff(), high = offset.maxCoeff();
+  const double tolerance = 1e-6 * resolution + 1e-12 * time.cwiseAbs().maxCoeff();  // the parse
+  // Samples at the bottom and top of the spread; where the spread is the whole place value, the
+  // times are rounding ties, which interleave along a grid, while a dropped (repeated) sample
+  // puts all of one side before the other.
+  Eigen::Index first_low = -1, last_low = -1, first_high = -1, last_high = -1;
+  for (Eigen::Index j = 0; j < offset.size(); ++j) {
+    if (offset[j] <= low + tolerance) {
+      if (first_low < 0) first_low = j;
+      last_low = j;
+    }
+    if (offset[j] >= high - tolerance) {
+      if (first_high < 0) first_high = j;
+      last_high = j;
+    }
+  }
+  const bool beyond = high - low > resolution + tolerance;
+  const bool ties = high - low >= resolution - tolerance;
+  const bool apart = last_low < first_high || last_high < first_low;
+  if (beyond || (ties && apart)) {
+    const Eigen::Index j = last_low < first_high   ? first_high
+                           : last_high < first_low ? first_low
+                                                   : std::max(first_high, first_low);
+    throw InputError(path, SampleField(table, "", j),
+                     fmt::format("the time column is off the grid of the stated {} Hz by {:.3g} s "
+                                 "from sample {} on (a dropped or repeated sample, or another "
+                                 "rate?)",
+                                 rate_hz, high - low, j),
+                     fmt::format("times within their printed resolution {:g} s of j / {} Hz",
+                                 resolution, rate_hz));
+  }
+  m->start_time_s = offset.mean();
+  m->sample_interval_s = tau;
+  report->conversions.push_back(
+      fmt::format("time: samples at j / {} Hz (the time column agrees within its printed "
+                  "resolution {:g} s)",
+                  rate_hz, resolution));
+}
+
 void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOptions& options,
                   const std::string& user_time_unit, Measurement* m, ImportReport* report) {
   if (table.time.empty() && table.interval <= 0) {
@@ -161,6 +209,13 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
   for (size_t j = 0; j < table.time.size(); ++j) {
     time[static_cast<Eigen::Index>(j)] =
         to_s.identity() ? table.time[j] : to_s.scale * table.time[j] + to_s.offset;
+  }
+  if (options.sample_rate_hz > 0 && table.printed_resolution > 0 &&
+      (time.array().isFinite().all()) && time.size() > 1 &&
+      ((time.tail(time.size() - 1) - time.head(time.size() - 1)).array() > 0).all()) {
+    StatedRateGrid(time, path, table, options.sample_rate_hz, table.printed_resolution * to_s.scale,
+                   m, report);
+    return;
   }
   double start = 0;
   const double tau = CheckUniformTime(

@@ -1,10 +1,13 @@
 // Measurement: time grid, channel lookup, validation and the uniform-time check.
 #include "mbid/common/measurement.h"
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "test_util.h"
 
@@ -91,6 +94,37 @@ TEST(CheckUniformTimeTest, RejectsDeviationAboveOnePpmOfAStep) {
   const InputError e = CatchInputError([&] { CheckUniformTime(t, "x", field); });
   EXPECT_THAT(e.field(), ::testing::AnyOf("sample 5", "sample 6"));  // either step touching 5
   EXPECT_THAT(e.problem(), HasSubstr("non-uniform"));
+}
+
+// Times j * tau printed to `digits` decimals (as loggers write them), with sample `drop` left out.
+Eigen::VectorXd PrintedTimes(int n, double tau, int digits, int drop = -1) {
+  std::vector<double> times;
+  for (int j = 0; j < n + (drop >= 0 ? 1 : 0); ++j) {
+    if (j != drop) times.push_back(std::stod(fmt::format("{:.{}f}", j * tau, digits)));
+  }
+  return Eigen::Map<Eigen::VectorXd>(times.data(), static_cast<Eigen::Index>(times.size()));
+}
+
+TEST(CheckUniformTimeTest, ADroppedSampleInACoarselyPrintedColumnIsNeverAClockRate) {
+  const auto field = [](Eigen::Index j) { return "sample " + std::to_string(j); };
+  // 100 Hz printed to 0.01 s without sample 300: the least-squares grid (99.82 Hz) lies within
+  // the printed digit of every time, but a step of 2 tau is as likely a dropped sample.
+  InputError e =
+      CatchInputError([&] { CheckUniformTime(PrintedTimes(800, 0.01, 2, 300), "x", field, 0.01); });
+  EXPECT_EQ(e.field(), "sample 300");
+  EXPECT_THAT(e.problem(), HasSubstr("may be a dropped sample"));
+  // 80 Hz printed to 0.01 s has steps 0.01 and 0.02: the same ambiguity, said so.
+  e = CatchInputError([&] { CheckUniformTime(PrintedTimes(640, 1.0 / 80, 2), "x", field, 0.01); });
+  EXPECT_THAT(e.problem(), HasSubstr("cannot tell"));
+  // 512 Hz printed to 1 ms: steps 1 or 2 ms, a dropped sample would make 3 or 4 ms.
+  const double tau = CheckUniformTime(PrintedTimes(4096, 1.0 / 512, 3), "x", field, 1e-3);
+  EXPECT_NEAR(tau, 1.0 / 512, 1e-3 / 4096);  // least squares: about resolution / n
+  e = CatchInputError(
+      [&] { CheckUniformTime(PrintedTimes(4096, 1.0 / 512, 3, 1000), "x", field, 1e-3); });
+  EXPECT_THAT(e.problem(), HasSubstr("non-uniform"));
+  // 30 Hz to 1 ms (tau 33 place values): a dropped sample is far off any grid.
+  EXPECT_NEAR(CheckUniformTime(PrintedTimes(240, 1.0 / 30, 3), "x", field, 1e-3), 1.0 / 30, 1e-6);
+  EXPECT_THROW(CheckUniformTime(PrintedTimes(240, 1.0 / 30, 3, 100), "x", field, 1e-3), InputError);
 }
 
 }  // namespace

@@ -160,5 +160,41 @@ TEST(DateAndLayoutTest, DatesAndTimesOfDayParse) {
   EXPECT_FALSE(ParseDate("01.13.2026", &t));
 }
 
+TEST(DateAndLayoutTest, AStatedRateSettlesACoarselyPrintedTimeColumn) {
+  TempDir dir;
+  const Decay psi;
+  // 80 Hz printed to 0.01 s: the column alone cannot tell its 0.02 s steps from dropped samples
+  // (common/measurement_test.cc); with the rate stated, every time lies within 0.01 s of j / 80.
+  const std::string path = dir.File("coarse.csv");
+  WriteText(path, MakeExport("t [s],psi [deg]\n", 640, [&](int j) {
+              return fmt::format("{:.2f},{}", j / 80.0, Print(psi(j / 80.0)));
+            }));
+  EXPECT_THROW(ImportMeasurement(path), InputError);
+  ImportOptions options;
+  options.sample_rate_hz = 80;
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, options, &report);
+  EXPECT_EQ(m.sample_interval_s, 1.0 / 80);
+  EXPECT_NEAR(m.start_time_s, 0.0, 0.005);  // within half the printed digit
+  ExpectDecayRead(m, 0, psi, kDegree);
+  // 100 Hz printed to 0.01 s with sample 300 missing: the stated rate finds it.
+  const std::string dropped = dir.File("dropped.csv");
+  WriteText(dropped, MakeExport("t [s],psi [deg]\n", 800, [&](int j) {
+              const int k = j < 300 ? j : j + 1;
+              return fmt::format("{:.2f},{}", k / 100.0, Print(psi(k / 100.0)));
+            }));
+  options.sample_rate_hz = 100;
+  try {
+    ImportMeasurement(dropped, options);
+    ADD_FAILURE() << "a dropped sample was read as uniform";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("line 302"));  // header + 300 samples before it
+    EXPECT_THAT(e.what(), HasSubstr("dropped or repeated sample"));
+  }
+  // A stated rate that is not the column's is refused too.
+  options.sample_rate_hz = 81;
+  EXPECT_THROW(ImportMeasurement(path, options), InputError);
+}
+
 }  // namespace
 }  // namespace mbid::records
