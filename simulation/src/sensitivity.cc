@@ -51,6 +51,85 @@ Eigen::MatrixXd CalcInitialStateSensitivity(const model::MechanicalModel& model,
   return dq0;
 }
 
+// The outputs' Jacobians at `state` by central differences: dy/dY over q (and u, when an output
+// is a rate) and, for accelerations, dy/dp over the model parameters.
+void CalcOutputJacobians(const model::MechanicalModel& simulated, const SimTK::State& state,
+                         const std::vector<double>& p, const std::vector<double>& scale,
+                         const std::vector<std::string>& model_parameters, int highest_order,
+                         SimTK::State* scratch, Eigen::MatrixXd* dy_dY, Eigen::MatrixXd* dy_dp) {
+  const int n = state.getNQ();
+  for (int i = 0; i < dy_dY->cols(); ++i) {
+    for (int sign : {1, -1}) {
+      scratch->updQ() = state.getQ();
+      if (highest_order > 0) scratch->updU() = state.getU();
+      if (i < n) {
+        scratch->updQ()[i] += sign * kOutputStep_rad;
+      } else {
+        scratch->updU()[i - n] += sign * kOutputStep_rad;
+      }
+      const Eigen::VectorXd y_step = simulated.CalcOutputs(*scratch);
+      if (sign > 0) {
+        dy_dY->col(i) = y_step;
+      } else {
+        dy_dY->col(i) = (dy_dY->col(i) - y_step) / (2 * kOutputStep_rad);
+      }
+    }
+  }
+  if (highest_order < 2) return;
+  // Forces are affine in stiffness and damping: central differences are exact to roundoff.
+  scratch->updQ() = state.getQ();
+  scratch->updU() = state.getU();
+  for (int k = 0; k < static_cast<int>(model_parameters.size()); ++k) {
+    const double step = 1e-6 * scale[k];
+    simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k] + step);
+    const Eigen::VectorXd up = simulated.CalcOutputs(*scratch);
+    simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k] - step);
+    dy_dp->col(k) = (up - simulated.CalcOutputs(*scratch)) / (2 * step);
+    simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k]);
+  }
+}
+
+// dy/dtheta_k directly, by central differences along (s_k, e_k) in (Y, p): the state moves by
+// at most kOutputStep_rad in any coordinate (as CalcOutputJacobians' steps, so the same
+// truncation and roundoff) and a model parameter by at most 1e-6 of its scale.
+void CalcDirectionalOutputDerivatives(const model::MechanicalModel& simulated,
+                                      const SimTK::State& state, const Eigen::MatrixXd& s,
+                                      const std::vector<double>& p,
+                                      const std::vector<double>& scale,
+                                      const std::vector<std::string>& model_parameters,
+                                      int highest_order, SimTK::State* scratch,
+                                      Eigen::MatrixXd* dy_dtheta) {
+  const int n = state.getNQ();
+  const int rows = highest_order > 0 ? 2 * n : n;  // the part of Y the outputs read
+  const int model_count = static_cast<int>(model_parameters.size());
+  for (int k = 0; k < static_cast<int>(s.cols()); ++k) {
+    const bool moves_parameter = highest_order == 2 && k < model_count;
+    const double largest = s.col(k).head(rows).cwiseAbs().maxCoeff();
+    double h = largest > 0 ? kOutputStep_rad / largest : 0.0;
+    if (moves_parameter) h = h > 0 ? std::min(h, 1e-6 * scale[k]) : 1e-6 * scale[k];
+    if (!(h > 0)) {
+      dy_dtheta->col(k).setZero();  // neither state nor parameter moves the outputs
+      continue;
+    }
+    Eigen::VectorXd plus;
+    for (int sign : {1, -1}) {
+      for (int i = 0; i < n; ++i) {
+        scratch->updQ()[i] = state.getQ()[i] + sign * h * s(i, k);
+        if (highest_order > 0) scratch->updU()[i] = state.getU()[i] + sign * h * s(n + i, k);
+      }
+      if (moves_parameter) {
+        simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k] + sign * h);
+      }
+      if (sign > 0) {
+        plus = simulated.CalcOutputs(*scratch);
+      } else {
+        dy_dtheta->col(k) = (plus - simulated.CalcOutputs(*scratch)) / (2 * h);
+      }
+    }
+    if (moves_parameter) simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k]);
+  }
+}
+
 }  // namespace
 
 SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
@@ -174,6 +253,11 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   SimTK::State scratch = simulated.MakeState(result.initial_q, zero);
   Eigen::MatrixXd dy_dY(simulated.output_count(), jacobian_columns);
   Eigen::MatrixXd dy_dp = Eigen::MatrixXd::Zero(simulated.output_count(), model_count);
+  // dy/dtheta_k = dy/dY s_k + dy/dp_k takes 2 outputs per coordinate (and per parameter, for
+  // accelerations) by the Jacobians, or 2 per sensitivity along s_k: the fewer wins.
+  const int by_jacobians = 2 * jacobian_columns + (highest_order == 2 ? 2 * model_count : 0);
+  const bool directional = 2 * count < by_jacobians;
+  Eigen::MatrixXd dy_dtheta = Eigen::MatrixXd::Zero(simulated.output_count(), count);
   bool forcing_done = !(forcing_end_s > 0);
   for (int row = 0; row < grid.skipped + grid.count; ++row) {
     const double t = grid.Time(row);
@@ -194,44 +278,23 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
     const Eigen::VectorXd y = simulated.CalcOutputs(state);
     Eigen::VectorXd q(n);
     for (int i = 0; i < n; ++i) q[i] = state.getQ()[i];
-    scratch.setTime(state.getTime());
-    for (int i = 0; i < jacobian_columns; ++i) {
-      for (int sign : {1, -1}) {
-        scratch.updQ() = state.getQ();
-        if (highest_order > 0) scratch.updU() = state.getU();
-        if (i < n) {
-          scratch.updQ()[i] += sign * kOutputStep_rad;
-        } else {
-          scratch.updU()[i - n] += sign * kOutputStep_rad;
-        }
-        const Eigen::VectorXd y_step = simulated.CalcOutputs(scratch);
-        if (sign > 0) {
-          dy_dY.col(i) = y_step;
-        } else {
-          dy_dY.col(i) = (dy_dY.col(i) - y_step) / (2 * kOutputStep_rad);
-        }
-      }
-    }
-    if (highest_order == 2) {
-      // Forces are affine in stiffness and damping: central differences are exact to roundoff.
-      scratch.updQ() = state.getQ();
-      scratch.updU() = state.getU();
-      for (int k = 0; k < model_count; ++k) {
-        const double step = 1e-6 * scale[k];
-        simulated.ApplyParameterToState(scratch, model_parameters[k], p[k] + step);
-        const Eigen::VectorXd up = simulated.CalcOutputs(scratch);
-        simulated.ApplyParameterToState(scratch, model_parameters[k], p[k] - step);
-        dy_dp.col(k) = (up - simulated.CalcOutputs(scratch)) / (2 * step);
-        simulated.ApplyParameterToState(scratch, model_parameters[k], p[k]);
-      }
-    }
     const Eigen::MatrixXd& s = integrator.sensitivities();
+    scratch.setTime(state.getTime());
+    if (directional) {
+      CalcDirectionalOutputDerivatives(simulated, state, s, p, scale, model_parameters,
+                                       highest_order, &scratch, &dy_dtheta);
+    } else {
+      CalcOutputJacobians(simulated, state, p, scale, model_parameters, highest_order, &scratch,
+                          &dy_dY, &dy_dp);
+    }
     for (int c = 0; c < channel_count; ++c) {
       const ChannelSource& source = sources[c];
       exact.values(j, c) = source.is_output ? y[source.index] : q[source.index];
       for (int k = 0; k < count; ++k) {
         double value = s(source.index, k);
-        if (source.is_output) {
+        if (source.is_output && directional) {
+          value = dy_dtheta(source.index, k);
+        } else if (source.is_output) {
           value = dy_dY.row(source.index).dot(s.col(k).head(jacobian_columns));
           if (k < model_count) value += dy_dp(source.index, k);
         }
