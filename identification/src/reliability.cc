@@ -5,12 +5,21 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mbid/common/clipping.h"
+
 namespace mbid::identification {
 
 // Reasons the data do not support the result (ModalResult::reliable).
 void AssessReliability(const AnalysisRecord& record, const IdentificationOptions& options,
                        const Estimate& estimate, ModalResult* result) {
   std::vector<std::string>& reasons = result->reasons;
+  for (Eigen::Index c = 0; c < record.values.cols(); ++c) {
+    if (const std::optional<Clipping> clipping = FindClipping(record.values.col(c))) {
+      reasons.push_back(ClippingReason(record.channels[static_cast<size_t>(c)],
+                                       record.units[static_cast<size_t>(c)], *clipping) +
+                        ", and no mode fitted to the flattened peaks is to be trusted");
+    }
+  }
   // The fit's residual against the record's own noise level: a record the modes explain leaves
   // noise (ratio about 1; coloured noise a little more). 3 x the noise, or a residual above a
   // millionth of the signal when the record is noiseless, means something in the record is not

@@ -25,6 +25,11 @@ constexpr double kInitialStateStep = 1e-4;
 // 1 m, so the truncation error h^2 ~ 1e-12 and the roundoff 1e-16 / h ~ 1e-10 stay far below
 // the sensitivities' tolerance.
 constexpr double kOutputStep_rad = 1e-6;
+// Largest step (rad or m, and relative in a parameter) along a sensitivity direction: larger than
+// kOutputStep_rad because a direction that moves one coordinate much reaches the weakly coupled
+// outputs by little, whose roundoff 1e-16 |y| / h is then a larger part of their derivative;
+// the truncation h^2 ~ 1e-8 of a 1 rad scale is still far below the sensitivities' tolerance.
+constexpr double kDirectionalStep = 1e-4;
 
 // dq(0)/dp for each model parameter, by central differences on a clone.
 Eigen::MatrixXd CalcInitialStateSensitivity(const model::MechanicalModel& model,
@@ -90,8 +95,8 @@ void CalcOutputJacobians(const model::MechanicalModel& simulated, const SimTK::S
 }
 
 // dy/dtheta_k directly, by central differences along (s_k, e_k) in (Y, p): the state moves by
-// at most kOutputStep_rad in any coordinate (as CalcOutputJacobians' steps, so the same
-// truncation and roundoff) and a model parameter by at most 1e-6 of its scale.
+// at most kDirectionalStep in any coordinate and a model parameter by at most that much of its
+// scale (the forces are affine in it).
 void CalcDirectionalOutputDerivatives(const model::MechanicalModel& simulated,
                                       const SimTK::State& state, const Eigen::MatrixXd& s,
                                       const std::vector<double>& p,
@@ -105,8 +110,10 @@ void CalcDirectionalOutputDerivatives(const model::MechanicalModel& simulated,
   for (int k = 0; k < static_cast<int>(s.cols()); ++k) {
     const bool moves_parameter = highest_order == 2 && k < model_count;
     const double largest = s.col(k).head(rows).cwiseAbs().maxCoeff();
-    double h = largest > 0 ? kOutputStep_rad / largest : 0.0;
-    if (moves_parameter) h = h > 0 ? std::min(h, 1e-6 * scale[k]) : 1e-6 * scale[k];
+    double h = largest > 0 ? kDirectionalStep / largest : 0.0;
+    if (moves_parameter) {
+      h = h > 0 ? std::min(h, kDirectionalStep * scale[k]) : kDirectionalStep * scale[k];
+    }
     if (!(h > 0)) {
       dy_dtheta->col(k).setZero();  // neither state nor parameter moves the outputs
       continue;

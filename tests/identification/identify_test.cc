@@ -95,6 +95,28 @@ TEST(IdentifyTest, ANoiseLimitedCorrelationIsCalledSo) {
   EXPECT_EQ(result.reasons[0].find("do not explain"), std::string::npos) << result.reasons[0];
 }
 
+TEST(IdentifyTest, AClippedChannelMakesTheResultUnreliable) {
+  // 1.5 Hz at 5 % damping, 40 dB: reliable as recorded. Held at 60 % of its first peak (a
+  // logger at the end of its range), the flattened peaks bring modes of their own.
+  SignalSpec spec;
+  spec.channels = {"x"};
+  spec.sample_interval_s = 0.01;
+  spec.samples = 800;
+  spec.modes = {{1.5, 0.47, {1.0}, {0.0}}};
+  const Eigen::MatrixXd clean = Synthesize(spec);
+  std::mt19937_64 rng(11);
+  const Eigen::MatrixXd noisy = testing::AddNoise(clean, testing::NoiseStd(clean, 40.0), &rng);
+  const ModalResult as_recorded = Identify(MakeRecord(spec, noisy), {});
+  EXPECT_TRUE(as_recorded.reliable) << ::testing::PrintToString(as_recorded.reasons);
+  const double rail = 0.6 * noisy.maxCoeff();
+  const ModalResult clipped = Identify(MakeRecord(spec, noisy.cwiseMin(rail)), {});
+  EXPECT_FALSE(clipped.reliable);
+  ASSERT_FALSE(clipped.reasons.empty());
+  EXPECT_NE(clipped.reasons[0].find("channel x stays at its largest value"), std::string::npos)
+      << clipped.reasons[0];
+  EXPECT_NE(clipped.reasons[0].find("(clipped)"), std::string::npos) << clipped.reasons[0];
+}
+
 TEST(IdentifyTest, NoiselessPaperMethodFindsThePoles) {
   // The paper's method on the same record: with the effective rank at the signal order (7 =
   // 2 x 3 modes + the constant) the minimum-norm prediction puts the extra roots inside the unit

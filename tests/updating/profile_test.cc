@@ -191,5 +191,28 @@ TEST(ProfileTest, RejectsBadOptions) {
   }
 }
 
+TEST(ProfileTest, AClippedRecordDeterminesNothing) {
+  // The release with 1e-4 rad noise determines c and d (AgreesWithTheFisherInterval... above).
+  // Held at 60 % of its first peak, as a logger at the end of its range records it: the fit may
+  // still look good, but its peaks are not measurements, and the result says so.
+  Release release(1e-4);
+  const UpdateOptions options = release.Options();
+  Measurement& record = release.test.record;
+  const double rail = 0.6 * record.values.maxCoeff();
+  record.values = record.values.cwiseMin(rail);
+  const UpdateResult result = UpdateModel(*release.truth, {release.test}, options);
+  EXPECT_FALSE(result.credible);
+  EXPECT_FALSE(result.explains_records);
+  for (const ParameterEstimate& p : result.parameters) {
+    EXPECT_FALSE(p.determined) << p.name;
+    EXPECT_NE(p.why_undetermined.find("channel angle of test release is clipped"),
+              std::string::npos)
+        << p.why_undetermined;
+  }
+  ASSERT_FALSE(result.credibility.empty());
+  EXPECT_NE(result.credibility.back().find("stays at its largest value"), std::string::npos)
+      << result.credibility.back();
+}
+
 }  // namespace
 }  // namespace mbid::updating

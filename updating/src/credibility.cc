@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "distributions.h"
+#include "mbid/common/clipping.h"
 #include "statistics.h"
 
 namespace mbid::updating {
@@ -106,8 +107,29 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
         "the noise was estimated from this fit's own residual: a misfit cannot be told from "
         "noise except by the residual's whiteness");
   }
-  result.credible = !misfit && !structured && result.std_inflation <= kNoticeableExcess;
-  result.explains_records = from_records && !misfit && !structured;
+  // A clipped channel holds its peaks at the rail: the fit takes the held samples as measured,
+  // so the estimates lean towards a smaller motion there, whatever the residual says.
+  std::string clipped;
+  for (size_t t = 0; t < tests.size(); ++t) {
+    const Measurement& record = tests[t].record;
+    for (int c = 0; c < record.channel_count(); ++c) {
+      const std::optional<Clipping> clipping = FindClipping(record.values.col(c));
+      if (!clipping) continue;
+      result.credibility.push_back(
+          fmt::format("test {}: {}; the fit takes the held samples as measured values, so no "
+                      "parameter is determined by it",
+                      result.tests[t].name,
+                      ClippingReason(record.channels[static_cast<size_t>(c)],
+                                     record.units[static_cast<size_t>(c)], *clipping)));
+      if (clipped.empty()) {
+        clipped = fmt::format("channel {} of test {} is clipped",
+                              record.channels[static_cast<size_t>(c)], result.tests[t].name);
+      }
+    }
+  }
+  result.credible =
+      !misfit && !structured && clipped.empty() && result.std_inflation <= kNoticeableExcess;
+  result.explains_records = from_records && !misfit && !structured && clipped.empty();
 
   result.undetermined.clear();
   for (ParameterEstimate& p : result.parameters) {
@@ -121,7 +143,10 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
         p.interval_upper = p.value + 2 * p.std * result.std_inflation;
       }
     }
-    if (misfit && p.test.empty()) {
+    if (!clipped.empty() && p.test.empty()) {
+      p.determined = false;
+      p.why_undetermined = clipped + " (the sensor or logger at the end of its range)";
+    } else if (misfit && p.test.empty()) {
       p.determined = false;
       p.why_undetermined = "the fit does not explain the records (chi^2/dof too large)";
     } else if (structured && p.test.empty()) {
