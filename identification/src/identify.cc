@@ -42,8 +42,16 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   }
 
   // FindOptionProblem has checked that the method is registered.
-  Estimate estimate = FindMethod(options.method.name())->estimate(record, options);
-  AddEstimate(record, options, &estimate, &result);
+  Estimate estimate;
+  try {
+    estimate = FindMethod(options.method.name())->estimate(record, options);
+    AddEstimate(record, options, &estimate, &result);
+  } catch (const NumericalError& e) {
+    // A clipped or glitched record is the likelier cause than the method: say so.
+    std::string reason = e.reason();
+    for (const std::string& fault : RecordFaults(record)) reason += "; " + fault;
+    throw NumericalError(e.stage(), reason);
+  }
   if (from_rest) {
     // The whole decay knows the release better than its first samples (release.h).
     result.release_time_s = RefineReleaseFromModes(result, result.release_time_s);

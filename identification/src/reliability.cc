@@ -6,20 +6,36 @@
 #include <cmath>
 
 #include "mbid/common/clipping.h"
+#include "mbid/common/outliers.h"
 
 namespace mbid::identification {
+
+std::vector<std::string> RecordFaults(const AnalysisRecord& record) {
+  std::vector<std::string> faults;
+  for (Eigen::Index c = 0; c < record.values.cols(); ++c) {
+    if (const std::optional<Clipping> clipping = FindClipping(record.values.col(c))) {
+      faults.push_back(ClippingReason(record.channels[static_cast<size_t>(c)],
+                                      record.units[static_cast<size_t>(c)], *clipping) +
+                       ", and no mode fitted to the flattened peaks is to be trusted");
+      continue;  // the rail's edges would read as jumps too
+    }
+    const std::vector<Outlier> outliers = FindOutliers(record.values.col(c));
+    if (!outliers.empty()) {
+      faults.push_back(OutlierReason(record.channels[static_cast<size_t>(c)], outliers,
+                                     record.sample_interval_s, record.start_time_s) +
+                       "; the modes do not describe it (blank such samples and fill them: "
+                       "fill_gaps: linear)");
+    }
+  }
+  return faults;
+}
 
 // Reasons the data do not support the result (ModalResult::reliable).
 void AssessReliability(const AnalysisRecord& record, const IdentificationOptions& options,
                        const Estimate& estimate, ModalResult* result) {
   std::vector<std::string>& reasons = result->reasons;
-  for (Eigen::Index c = 0; c < record.values.cols(); ++c) {
-    if (const std::optional<Clipping> clipping = FindClipping(record.values.col(c))) {
-      reasons.push_back(ClippingReason(record.channels[static_cast<size_t>(c)],
-                                       record.units[static_cast<size_t>(c)], *clipping) +
-                        ", and no mode fitted to the flattened peaks is to be trusted");
-    }
-  }
+  const std::vector<std::string> faults = RecordFaults(record);
+  reasons.insert(reasons.end(), faults.begin(), faults.end());
   // The fit's residual against the record's own noise level: a record the modes explain leaves
   // noise (ratio about 1; coloured noise a little more). 3 x the noise, or a residual above a
   // millionth of the signal when the record is noiseless, means something in the record is not

@@ -117,6 +117,36 @@ TEST(IdentifyTest, AClippedChannelMakesTheResultUnreliable) {
   EXPECT_NE(clipped.reasons[0].find("(clipped)"), std::string::npos) << clipped.reasons[0];
 }
 
+TEST(IdentifyTest, AGlitchMakesTheResultUnreliable) {
+  // The record of AClippedChannel... (reliable as recorded) with one sample half the release
+  // amplitude off, as an electrical glitch makes it: the reason names its time.
+  SignalSpec spec;
+  spec.channels = {"x"};
+  spec.sample_interval_s = 0.01;
+  spec.samples = 800;
+  spec.modes = {{1.5, 0.47, {1.0}, {0.0}}};
+  const Eigen::MatrixXd clean = Synthesize(spec);
+  std::mt19937_64 rng(11);
+  Eigen::MatrixXd noisy = testing::AddNoise(clean, testing::NoiseStd(clean, 40.0), &rng);
+  noisy(300, 0) += 0.5;
+  const ModalResult result = Identify(MakeRecord(spec, noisy), {});
+  EXPECT_FALSE(result.reliable);
+  ASSERT_FALSE(result.reasons.empty());
+  EXPECT_NE(result.reasons[0].find("channel x jumps off its course at 3 s ("), std::string::npos)
+      << result.reasons[0];
+  // 20 times the release amplitude: no mode survives the refinement, and the failure says why.
+  noisy(300, 0) += 19.5;
+  try {
+    Identify(MakeRecord(spec, noisy), {});
+    ADD_FAILURE() << "modes from a record that is mostly one glitch";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("no modes found"), std::string::npos) << e.what();
+    // (The release detection takes the jump for the release: the window starts there.)
+    EXPECT_NE(std::string(e.what()).find("channel x jumps off its course at 3"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(IdentifyTest, NoiselessPaperMethodFindsThePoles) {
   // The paper's method on the same record: with the effective rank at the signal order (7 =
   // 2 x 3 modes + the constant) the minimum-norm prediction puts the extra roots inside the unit

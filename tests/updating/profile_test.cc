@@ -214,5 +214,20 @@ TEST(ProfileTest, AClippedRecordDeterminesNothing) {
       << result.credibility.back();
 }
 
+TEST(ProfileTest, AGlitchInTheRecordDeterminesNothing) {
+  // One sample of the release (0.01 rad) off by 5e-3 rad, 50 times the noise: the fit bends
+  // towards it, and the result names it.
+  Release release(1e-4);
+  release.test.record.values(120, 0) += 5e-3;
+  const UpdateResult result = UpdateModel(*release.truth, {release.test}, release.Options());
+  EXPECT_FALSE(result.credible);
+  for (const ParameterEstimate& p : result.parameters) {
+    EXPECT_FALSE(p.determined) << p.name;
+    EXPECT_NE(p.why_undetermined.find("channel angle of test release jumps off its course"),
+              std::string::npos)
+        << p.why_undetermined;
+  }
+}
+
 }  // namespace
 }  // namespace mbid::updating

@@ -8,6 +8,7 @@
 
 #include "distributions.h"
 #include "mbid/common/clipping.h"
+#include "mbid/common/outliers.h"
 #include "statistics.h"
 
 namespace mbid::updating {
@@ -107,29 +108,36 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
         "the noise was estimated from this fit's own residual: a misfit cannot be told from "
         "noise except by the residual's whiteness");
   }
-  // A clipped channel holds its peaks at the rail: the fit takes the held samples as measured,
-  // so the estimates lean towards a smaller motion there, whatever the residual says.
-  std::string clipped;
+  // A clipped channel holds its peaks at the rail, a glitch jumps off the motion: the fit takes
+  // such samples as measured and leans towards them, whatever the residual says.
+  std::string faulty;
   for (size_t t = 0; t < tests.size(); ++t) {
     const Measurement& record = tests[t].record;
     for (int c = 0; c < record.channel_count(); ++c) {
-      const std::optional<Clipping> clipping = FindClipping(record.values.col(c));
-      if (!clipping) continue;
+      const std::string& channel = record.channels[static_cast<size_t>(c)];
+      std::string fault, what;
+      if (const std::optional<Clipping> clipping = FindClipping(record.values.col(c))) {
+        fault = ClippingReason(channel, record.units[static_cast<size_t>(c)], *clipping);
+        what = "is clipped (the sensor or logger at the end of its range)";
+      } else if (const std::vector<Outlier> outliers = FindOutliers(record.values.col(c));
+                 !outliers.empty()) {
+        fault = OutlierReason(channel, outliers, record.sample_interval_s, record.start_time_s);
+        what = "jumps off its course (a glitch or a knock)";
+      } else {
+        continue;
+      }
       result.credibility.push_back(
-          fmt::format("test {}: {}; the fit takes the held samples as measured values, so no "
+          fmt::format("test {}: {}; the fit takes those samples as measured values, so no "
                       "parameter is determined by it",
-                      result.tests[t].name,
-                      ClippingReason(record.channels[static_cast<size_t>(c)],
-                                     record.units[static_cast<size_t>(c)], *clipping)));
-      if (clipped.empty()) {
-        clipped = fmt::format("channel {} of test {} is clipped",
-                              record.channels[static_cast<size_t>(c)], result.tests[t].name);
+                      result.tests[t].name, fault));
+      if (faulty.empty()) {
+        faulty = fmt::format("channel {} of test {} {}", channel, result.tests[t].name, what);
       }
     }
   }
   result.credible =
-      !misfit && !structured && clipped.empty() && result.std_inflation <= kNoticeableExcess;
-  result.explains_records = from_records && !misfit && !structured && clipped.empty();
+      !misfit && !structured && faulty.empty() && result.std_inflation <= kNoticeableExcess;
+  result.explains_records = from_records && !misfit && !structured && faulty.empty();
 
   result.undetermined.clear();
   for (ParameterEstimate& p : result.parameters) {
@@ -143,9 +151,9 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
         p.interval_upper = p.value + 2 * p.std * result.std_inflation;
       }
     }
-    if (!clipped.empty() && p.test.empty()) {
+    if (!faulty.empty() && p.test.empty()) {
       p.determined = false;
-      p.why_undetermined = clipped + " (the sensor or logger at the end of its range)";
+      p.why_undetermined = faulty;
     } else if (misfit && p.test.empty()) {
       p.determined = false;
       p.why_undetermined = "the fit does not explain the records (chi^2/dof too large)";
