@@ -49,7 +49,8 @@ bool LooksLikeUnitSuffix(const std::string& suffix) {
     size_t end = suffix.find('_', start);
     if (end == std::string::npos) end = suffix.size();
     const size_t length = end - start;
-    if (length == 0 || length > 4) return false;
+    // Unit words are short (s, m, kg, deg, mps2, per); rad/s is the one of five letters.
+    if (length == 0 || (length > 4 && suffix.compare(start, length, "radps") != 0)) return false;
     start = end + 1;
   }
   return true;

@@ -118,6 +118,20 @@ TEST(YamlReaderBadInputTest, MassWithoutUnitNamesTheUnit) {
   EXPECT_EQ(e.expected(), "'mass_kg'");
 }
 
+TEST(YamlReaderBadInputTest, EveryUnitOfAKeyIsNamed) {
+  // The sensors' noise comes in five units; rad/s ("radps") is the only five-letter unit word.
+  const YamlReader sensors =
+      YamlReader::FromString("sensors:\n  noise_std: 1\n", kSource).Child("sensors");
+  const InputError e = CatchInputError([&] {
+    sensors.ExpectMap({"noise_std_rad", "noise_std_m", "noise_std_mps", "noise_std_mps2",
+                       "noise_std_radps", "seed"});
+  });
+  EXPECT_EQ(e.problem(), "key 'noise_std' has no unit");
+  EXPECT_EQ(e.expected(),
+            "'noise_std_rad' or 'noise_std_m' or 'noise_std_mps' or 'noise_std_mps2' or "
+            "'noise_std_radps'");
+}
+
 TEST(YamlReaderBadInputTest, NumberWithUnitTextIsWrongType) {
   const YamlReader base = Base("mass_kg: 10 t");
   const InputError e = CatchInputError([&] { base.PositiveDouble("mass_kg"); });

@@ -147,6 +147,31 @@ TEST(IdentifyTest, AGlitchMakesTheResultUnreliable) {
   }
 }
 
+TEST(IdentifyTest, AModeSeenByOneChannelOfFourIsFound) {
+  // An aerial platform's load drop (6 coordinates): its 1.08 Hz slew mode shows in the
+  // turret's gyro alone, 12 % above the 0.96 Hz luffing mode that all four channels see. In the
+  // summed Hankel matrix it brings one channel's energy against four channels' noise and stays
+  // under the signal order; the gyro's residual (5 times its noise) is searched alone.
+  SignalSpec spec;
+  spec.channels = {"incl", "acc_y", "acc_z", "gyro"};
+  spec.sample_interval_s = 0.005;  // 200 Hz, 6 s
+  spec.samples = 1201;
+  spec.modes = {{0.9595, 0.109, {1.0, 1.0, 1.0, 1.0}, {0.0, 0.1, 0.2, 0.3}},
+                {1.0805, 0.159, {0.0, 0.0, 0.0, 0.35}, {0.0, 0.0, 0.0, 1.0}},
+                {6.697, 4.43, {0.1, 0.3, 0.3, 0.0}, {0.0, 0.5, 1.0, 0.0}}};
+  const Eigen::MatrixXd clean = Synthesize(spec);
+  std::mt19937_64 rng(5);
+  Eigen::VectorXd noise(4);
+  noise << 1e-3, 5e-3, 5e-3, 0.03;  // 60, 46, 46 and 30 dB below the release amplitude
+  const ModalResult result = Identify(MakeRecord(spec, testing::AddNoise(clean, noise, &rng)), {});
+  ASSERT_EQ(result.modes.size(), 3u);
+  EXPECT_TRUE(result.reliable) << ::testing::PrintToString(result.reasons);
+  // Within 3 standard deviations of the truth (the gyro at 30 dB).
+  EXPECT_NEAR(result.modes[1].frequency_hz, 1.0805, 3 * result.modes[1].std_frequency_hz);
+  EXPECT_NEAR(result.modes[1].decay_rate_per_s, 0.159, 3 * result.modes[1].std_decay_rate_per_s);
+  EXPECT_NEAR(result.modes[0].decay_rate_per_s, 0.109, 3 * result.modes[0].std_decay_rate_per_s);
+}
+
 TEST(IdentifyTest, NoiselessPaperMethodFindsThePoles) {
   // The paper's method on the same record: with the effective rank at the signal order (7 =
   // 2 x 3 modes + the constant) the minimum-norm prediction puts the extra roots inside the unit

@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <map>
 
 #include "estimate.h"
@@ -161,6 +163,82 @@ class Refiner {
   Eigen::VectorXd weights_;
 };
 
+// On a noiseless record every mode is "significant": a mode must also carry more than round-off
+// of the record's amplitude.
+bool CarriesAmplitude(const Estimate& estimate) {
+  const double largest = estimate.fit.coefficients.cwiseAbs().maxCoeff();
+  for (size_t k = 0; k < estimate.lambda.size(); ++k) {
+    const double peak = estimate.fit.coefficients.middleRows(2 * static_cast<Eigen::Index>(k), 2)
+                            .cwiseAbs()
+                            .maxCoeff();
+    if (!(peak > 1e-6 * largest)) return false;
+  }
+  return true;
+}
+
+// A mode that lives in few of many channels brings its energy to one channel but the noise of
+// all to the summed Hankel matrix, and may stay under the signal order there (a machine's slew
+// mode seen by its gyro alone beside three channels that barely see it). Where a channel's
+// residual stays above 3 times its noise (as AssessReliability flags it), that residual alone is
+// searched at its own signal order: its poles, stable across orders, that the estimate lacks join
+// the estimate's, and the refit with more significant modes is kept.
+void AddModesFromSingleChannels(const AnalysisRecord& record, const IdentificationOptions& options,
+                                int columns, int max_order, const Eigen::VectorXd& noise_std,
+                                const std::function<void(Estimate*)>& refine, Estimate* estimate) {
+  const Eigen::MatrixXd& values = record.decimated;
+  if (values.cols() < 2) return;
+  int added = 0;
+  for (Eigen::Index c = 0; c < values.cols(); ++c) {
+    const Eigen::VectorXd& residual = estimate->fit.residual_variance;
+    if (c >= residual.size() || c >= noise_std.size()) break;
+    const double rms = std::sqrt(values.col(c).squaredNorm() / static_cast<double>(values.rows()));
+    if (!(std::sqrt(residual(c)) > 3 * std::max(noise_std(c), 1e-6 * rms))) continue;
+    // The channel's residual: the modes found no longer hide the one it lacks.
+    const Eigen::VectorXd left =
+        values.col(c) - estimate->fit.reconstruction.col(c).head(values.rows());
+    const HankelSvd single(left, columns, max_order);
+    const int order = single.CountSignal(options.hankel.noise_floor_factor,
+                                         options.hankel.min_relative_singular_value, max_order);
+    if (order == 0) continue;
+    PolesByOrder poles_at(single, record.decimated_interval_s);
+    Estimate trial;
+    trial.model_order = estimate->model_order;
+    trial.effective_rank = estimate->effective_rank;
+    trial.lambda = estimate->lambda;
+    for (const auto& lambda : poles_at.At(order)) {
+      if (!IsCandidate(lambda, record, options) ||
+          HasMatch(lambda, estimate->lambda, options.hankel.stability_tolerance)) {
+        continue;
+      }
+      bool stable = true;
+      for (int k = 1; k <= options.hankel.stability_orders && order + 2 * k < columns - 1; ++k) {
+        stable = stable &&
+                 HasMatch(lambda, poles_at.At(order + 2 * k), options.hankel.stability_tolerance);
+      }
+      if (stable) trial.lambda.push_back(lambda);
+    }
+    if (trial.lambda.size() == estimate->lambda.size()) continue;
+    try {
+      refine(&trial);
+      SelectSignificant(record, options, &trial, refine);
+    } catch (const NumericalError&) {
+      continue;
+    }
+    if (trial.lambda.size() <= estimate->lambda.size() || !CarriesAmplitude(trial)) continue;
+    added += static_cast<int>(trial.lambda.size() - estimate->lambda.size());
+    trial.iterations += estimate->iterations;
+    trial.warnings = std::move(estimate->warnings);
+    trial.stabilization = std::move(estimate->stabilization);
+    *estimate = std::move(trial);
+  }
+  if (added > 0) {
+    estimate->warnings.push_back(fmt::format(
+        "{} more significant mode(s) found in single channels whose residual the other modes "
+        "left above the noise",
+        added));
+  }
+}
+
 // HankelOptions::extra_orders: restarts from every pole at the orders above the signal order;
 // a start that ends with more significant modes replaces the estimate.
 void AddModesFromHigherOrders(const AnalysisRecord& record, const IdentificationOptions& options,
@@ -183,18 +261,7 @@ void AddModesFromHigherOrders(const AnalysisRecord& record, const Identification
     } catch (const NumericalError&) {
       continue;  // nothing significant from this start: the estimate stands
     }
-    if (trial.lambda.size() <= estimate->lambda.size()) continue;
-    // On a noiseless record every mode is "significant": a mode must also carry more than
-    // round-off of the record's amplitude.
-    const double largest = trial.fit.coefficients.cwiseAbs().maxCoeff();
-    bool real_modes = true;
-    for (size_t k = 0; k < trial.lambda.size(); ++k) {
-      const double peak = trial.fit.coefficients.middleRows(2 * static_cast<Eigen::Index>(k), 2)
-                              .cwiseAbs()
-                              .maxCoeff();
-      real_modes = real_modes && peak > 1e-6 * largest;
-    }
-    if (!real_modes) continue;
+    if (trial.lambda.size() <= estimate->lambda.size() || !CarriesAmplitude(trial)) continue;
     added += static_cast<int>(trial.lambda.size() - estimate->lambda.size());
     trial.iterations += estimate->iterations;
     trial.stabilization = std::move(estimate->stabilization);
@@ -244,6 +311,10 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
   SelectSignificant(record, options, &estimate, refine);
   if (options.drop_insignificant && options.hankel.extra_orders > 0) {
     AddModesFromHigherOrders(record, options, order, columns, poles_at, refine, &estimate);
+  }
+  if (options.drop_insignificant) {
+    AddModesFromSingleChannels(record, options, columns, max_order, hankel.channel_noise_std(),
+                               refine, &estimate);
   }
   if (estimate.termination == "failure") {
     throw NumericalError("Ceres",
