@@ -1,4 +1,5 @@
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <memory>
@@ -20,6 +21,9 @@ std::shared_ptr<const identification::ModalResult> RunIdentifyStep(const StepInp
 
   nlohmann::ordered_json& row = outcome.row;
   row["identified.modes"] = result->modes.size();
+  // A sweep read column by column must not take an unsupported mode for a measured one.
+  row["identified.reliable"] = result->reliable;
+  row["identified.reasons"] = fmt::format("{}", fmt::join(result->reasons, " | "));
   for (size_t c = 0; c < result->channels.size(); ++c) {
     row["identified.correlation." + result->channels[c]] =
         Number(result->correlation[static_cast<Eigen::Index>(c)]);

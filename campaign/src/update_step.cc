@@ -55,6 +55,7 @@ void RunUpdateStep(const StepInput& input, CaseOutcome& outcome) {
   row["updated.cost_initial"] = Number(result->initial_cost);
   row["updated.cost_final"] = Number(result->final_cost);
   row["updated.rank"] = result->rank;
+  row["updated.credible"] = result->credible;
   for (const updating::ParameterEstimate& parameter : result->parameters) {
     const std::string name = "updated." + parameter.name;
     row[name] = Number(parameter.value);

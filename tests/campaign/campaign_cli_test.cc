@@ -72,6 +72,9 @@ TEST_F(CampaignCliTest, OneAndTwoWorkersGiveTheSameFileBitForBit) {
   const std::string csv = ReadText(dir_ / "one" / "summary.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7);
   EXPECT_NE(csv.find("identified.mode1.frequency_hz"), std::string::npos);
+  // Whether the data support each case's modes, beside them (docs/campaigns.md).
+  EXPECT_NE(csv.find("identified.modes,identified.reliable,identified.reasons,"), std::string::npos)
+      << csv.substr(0, csv.find('\n'));
   // The two 95 deg cases failed with their reason, and only they.
   EXPECT_NE(csv.find("case_0004,4,invalid_input,scenario,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("case_0005,5,invalid_input,scenario,"), std::string::npos) << csv;
