@@ -95,17 +95,27 @@ TEST(IdentifyTest, ANoiseLimitedCorrelationIsCalledSo) {
   EXPECT_EQ(result.reasons[0].find("do not explain"), std::string::npos) << result.reasons[0];
 }
 
-TEST(IdentifyTest, AClippedChannelMakesTheResultUnreliable) {
-  // 1.5 Hz at 5 % damping, 40 dB: reliable as recorded. Held at 60 % of its first peak (a
-  // logger at the end of its range), the flattened peaks bring modes of their own.
+// One channel x: 1.5 Hz at 5 % damping, 8 s at 100 Hz, 40 dB (seeded): reliable as recorded.
+SignalSpec OneDecaySpec() {
   SignalSpec spec;
   spec.channels = {"x"};
   spec.sample_interval_s = 0.01;
   spec.samples = 800;
   spec.modes = {{1.5, 0.47, {1.0}, {0.0}}};
-  const Eigen::MatrixXd clean = Synthesize(spec);
+  return spec;
+}
+
+Eigen::MatrixXd OneDecay() {
+  const Eigen::MatrixXd clean = Synthesize(OneDecaySpec());
   std::mt19937_64 rng(11);
-  const Eigen::MatrixXd noisy = testing::AddNoise(clean, testing::NoiseStd(clean, 40.0), &rng);
+  return testing::AddNoise(clean, testing::NoiseStd(clean, 40.0), &rng);
+}
+
+TEST(IdentifyTest, AClippedChannelMakesTheResultUnreliable) {
+  // OneDecay() held at 60 % of its first peak (a logger at the end of its range): the
+  // flattened peaks bring modes of their own.
+  const SignalSpec spec = OneDecaySpec();
+  const Eigen::MatrixXd noisy = OneDecay();
   const ModalResult as_recorded = Identify(MakeRecord(spec, noisy), {});
   EXPECT_TRUE(as_recorded.reliable) << ::testing::PrintToString(as_recorded.reasons);
   const double rail = 0.6 * noisy.maxCoeff();
@@ -118,16 +128,10 @@ TEST(IdentifyTest, AClippedChannelMakesTheResultUnreliable) {
 }
 
 TEST(IdentifyTest, AGlitchMakesTheResultUnreliable) {
-  // The record of AClippedChannel... (reliable as recorded) with one sample half the release
-  // amplitude off, as an electrical glitch makes it: the reason names its time.
-  SignalSpec spec;
-  spec.channels = {"x"};
-  spec.sample_interval_s = 0.01;
-  spec.samples = 800;
-  spec.modes = {{1.5, 0.47, {1.0}, {0.0}}};
-  const Eigen::MatrixXd clean = Synthesize(spec);
-  std::mt19937_64 rng(11);
-  Eigen::MatrixXd noisy = testing::AddNoise(clean, testing::NoiseStd(clean, 40.0), &rng);
+  // OneDecay() (reliable as recorded) with one sample half the release amplitude off, as an
+  // electrical glitch makes it: the reason names its time.
+  const SignalSpec spec = OneDecaySpec();
+  Eigen::MatrixXd noisy = OneDecay();
   noisy(300, 0) += 0.5;
   const ModalResult result = Identify(MakeRecord(spec, noisy), {});
   EXPECT_FALSE(result.reliable);
