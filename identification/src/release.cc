@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "mbid/common/error.h"
+#include "mbid/common/outliers.h"
 #include "mbid/identification/modal_result.h"
 
 namespace mbid::identification {
@@ -110,11 +111,47 @@ double FindOnset(const OnsetFit& fit, int early, double* cost) {
 
 }  // namespace
 
+namespace {
+
+// Median |second difference| over samples [begin, end) of `y` (0 when empty).
+double MedianBend(const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Index begin,
+                  Eigen::Index end) {
+  std::vector<double> bends;
+  for (Eigen::Index j = std::max<Eigen::Index>(1, begin); j < std::min(end, y.size() - 1); ++j) {
+    bends.push_back(std::abs(y[j + 1] - 2 * y[j] + y[j - 1]));
+  }
+  if (bends.empty()) return 0;
+  std::nth_element(bends.begin(), bends.begin() + bends.size() / 2, bends.end());
+  return bends[bends.size() / 2];
+}
+
+// The record with its glitches bridged (outliers.h): a sample that jumps off a channel's course
+// and back (its neighbours agree to a quarter of its jump) while the course goes on alike after
+// it (the spread of the 16 samples after within 3 times that of the 16 before) is no release;
+// a release's jump to a new level, and an impact that sets the structure ringing, stay.
+Eigen::MatrixXd BridgeGlitches(const Eigen::MatrixXd& y) {
+  Eigen::MatrixXd bridged = y;
+  for (Eigen::Index c = 0; c < y.cols(); ++c) {
+    for (const Outlier& outlier : FindOutliers(y.col(c))) {
+      const Eigen::Index j = outlier.sample;
+      if (j < 1 || j + 1 >= y.rows()) continue;
+      const double before = MedianBend(y.col(c), j - 17, j - 1);
+      const double after = MedianBend(y.col(c), j + 2, j + 18);
+      const double middle = 0.5 * (y(j - 1, c) + y(j + 1, c));
+      const bool returns = std::abs(y(j + 1, c) - y(j - 1, c)) <= 0.25 * std::abs(y(j, c) - middle);
+      if (returns && after <= 3 * before) bridged(j, c) = middle;
+    }
+  }
+  return bridged;
+}
+
+}  // namespace
+
 ReleaseDetection DetectRelease(const Measurement& record) {
   ReleaseDetection detection;
   detection.release_time_s = record.start_time_s;
   detection.description = "the record starts in the free decay (no segment at rest before it)";
-  const Eigen::MatrixXd& y = record.values;
+  const Eigen::MatrixXd y = BridgeGlitches(record.values);
   const int n = static_cast<int>(y.rows());
   const Eigen::Index m = y.cols();
   if (n < 8 || m == 0) return detection;

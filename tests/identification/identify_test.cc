@@ -138,15 +138,25 @@ TEST(IdentifyTest, AGlitchMakesTheResultUnreliable) {
   ASSERT_FALSE(result.reasons.empty());
   EXPECT_NE(result.reasons[0].find("channel x jumps off its course at 3 s ("), std::string::npos)
       << result.reasons[0];
-  // 20 times the release amplitude: no mode survives the refinement, and the failure says why.
+  // 20 times the release amplitude: still no release (the record starts in the decay), and the
+  // glitch is named.
   noisy(300, 0) += 19.5;
+  const ModalResult large = Identify(MakeRecord(spec, noisy), {});
+  EXPECT_EQ(large.release_time_s, 0.0);
+  EXPECT_FALSE(large.reliable);
+  ASSERT_FALSE(large.reasons.empty());
+  EXPECT_NE(large.reasons[0].find("channel x jumps off its course at 3 s ("), std::string::npos)
+      << large.reasons[0];
+  // Noise alone but for a glitch: when nothing survives, the failure names the glitch.
+  Eigen::MatrixXd noise = OneDecay() - Synthesize(spec);
+  noise(300, 0) += 0.5;
   try {
-    Identify(MakeRecord(spec, noisy), {});
-    ADD_FAILURE() << "modes from a record that is mostly one glitch";
+    const ModalResult none = Identify(MakeRecord(spec, noise), {});
+    EXPECT_FALSE(none.reliable);  // if a mode is fitted to it, it is not believed
   } catch (const NumericalError& e) {
     EXPECT_NE(std::string(e.what()).find("no modes found"), std::string::npos) << e.what();
-    // (The release detection takes the jump for the release: the window starts there.)
-    EXPECT_NE(std::string(e.what()).find("channel x jumps off its course at 3"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("channel x jumps off its course at 3 s"),
+              std::string::npos)
         << e.what();
   }
 }

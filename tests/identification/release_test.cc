@@ -96,6 +96,28 @@ TEST(ReleaseTest, RecordStartingInTheDecayHasNoRestSegment) {
   EXPECT_EQ(found.release_time_s, 0.0);
 }
 
+// A glitch (one sample 10 times the deflection off, an electrical spike) is no release: not in
+// the rest before the true one, nor in a record that starts in the decay. The acceleration's
+// release, a jump that sets the structure ringing, is still found to half a sample.
+TEST(ReleaseTest, AGlitchIsNoRelease) {
+  const Release test;
+  Measurement before = test.Record("rad", 3);
+  before.values(60, 0) += 0.1;  // 0.6 s, in the rest before 1.2345 s
+  const ReleaseDetection found = DetectRelease(before);
+  EXPECT_TRUE(found.detected);
+  EXPECT_NEAR(found.release_time_s, test.release_s, 1.2 * test.interval_s);
+  Release decay = test;
+  decay.release_s = 0;
+  Measurement in_decay = decay.Record("rad", 3);
+  in_decay.values(300, 0) += 0.1;
+  EXPECT_FALSE(DetectRelease(in_decay).detected);
+  Measurement acceleration = test.Record("rad/s^2", 3);
+  acceleration.values(60, 0) += 10 * acceleration.values.col(0).cwiseAbs().maxCoeff();
+  const ReleaseDetection jump = DetectRelease(acceleration);
+  EXPECT_TRUE(jump.detected);
+  EXPECT_NEAR(jump.release_time_s, test.release_s, 0.5 * test.interval_s);
+}
+
 // The benchmark: 0.5 s of zeros before the response of four modes (1.8, 2.5, 10 and
 // 16 Hz) gave three wrong modes and exit 0. With the release found, the four come back; with
 // the zeros analysed (--release none) the result is flagged unreliable.
