@@ -14,14 +14,20 @@
 namespace mbid::records::internal {
 namespace {
 
+// A row of values; a logger's status or event column may put text among them, so a row with
+// text is data when it holds at least 2 values and more values than text cells (a header's
+// names are text, a preamble line "Device;XYZ-200;Serial;12345" has one number).
 bool IsDataRow(const std::vector<std::string>& fields, char separator) {
-  bool any_value = false;
+  int values = 0, texts = 0;
   for (const std::string& cell : fields) {
     const CellKind kind = ClassifyCell(cell, separator);
-    if (kind == CellKind::kText) return false;
-    any_value = any_value || kind != CellKind::kGap;
+    if (kind == CellKind::kText) {
+      ++texts;
+    } else if (kind != CellKind::kGap) {
+      ++values;
+    }
   }
-  return any_value;
+  return values > 0 && (texts == 0 || (values >= 2 && values > texts));
 }
 
 bool IsUnitsRow(const std::vector<std::string>& fields) {

@@ -197,6 +197,27 @@ RawTable ReadCsv(const std::string& path) {
     break;
   }
 
+  // Columns of text, no number in any row (a logger's status or event marks): not channels.
+  std::vector<std::string> text_of(columns.size());
+  {
+    std::vector<bool> has_value(columns.size(), false);
+    for (size_t i = static_cast<size_t>(first_row); i < lines.size(); ++i) {
+      if (IsCommentOrBlank(lines[i].text)) continue;
+      std::vector<std::string> fields = SplitFields(lines[i].text, separator);
+      if (!FitRow(&fields, columns.size())) continue;  // refused with its line below
+      for (size_t c = 0; c < fields.size(); ++c) {
+        const CellKind kind = ClassifyCell(fields[c], separator);
+        if (kind == CellKind::kText && text_of[c].empty()) {
+          text_of[c] = fmt::format("'{}' at line {}", fields[c], lines[i].number);
+        }
+        if (kind != CellKind::kText && kind != CellKind::kGap) has_value[c] = true;
+      }
+    }
+    for (size_t c = 0; c < columns.size(); ++c) {
+      if (has_value[c] || static_cast<int>(c) == time_column) text_of[c].clear();
+    }
+  }
+
   // Rows.
   Metadata metadata;
   RawTable table;
@@ -232,8 +253,9 @@ RawTable ReadCsv(const std::string& path) {
     }
     for (size_t c = 0; c < fields.size(); ++c) {
       double value = 0;
-      if (static_cast<int>(c) == date_column) {
+      if (static_cast<int>(c) == date_column || !text_of[c].empty()) {
         table.columns[c].values.push_back(std::numeric_limits<double>::quiet_NaN());
+        written[c] = written[c] || !text_of[c].empty();
         continue;
       }
       const CellKind kind = ClassifyCell(fields[c], separator, &value);
@@ -308,6 +330,15 @@ RawTable ReadCsv(const std::string& path) {
   table.format = table.si_by_contract ? "mbid-csv" : "csv";
   table.dialect = dialect.Describe(decimal.mark == DecimalMark::kComma, thousands);
   if (date_column >= 0) table.dialect += fmt::format(", dates in column {}", date_column + 1);
+  for (size_t c = 0; c < text_of.size(); ++c) {
+    if (!text_of[c].empty()) {
+      table.dialect +=
+          fmt::format(", text in column {}{}, no channel", c + 1,
+                      columns.size() > 0 && c < header_cells.size() && !header_cells[c].empty()
+                          ? " (" + header_cells[c] + ")"
+                          : "");
+    }
+  }
   if (empty_columns > 0) {
     table.dialect +=
         fmt::format(", {} empty column{} ignored", empty_columns, empty_columns == 1 ? "" : "s");
@@ -353,6 +384,7 @@ RawTable ReadCsv(const std::string& path) {
     table.columns[c].name = columns[c].name;
     table.columns[c].unit = columns[c].unit;
     table.columns[c].where = fmt::format("column {}", file_column[c] + 1);
+    table.columns[c].text = text_of[file_column[c]];
   }
   if (time_column >= 0) {
     RawColumn time = std::move(table.columns[static_cast<size_t>(time_column)]);

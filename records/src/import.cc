@@ -51,6 +51,7 @@ std::vector<Selected> SelectColumns(const RawTable& table, const std::string& pa
   std::vector<Selected> selected;
   if (options.channel_columns.empty()) {
     for (const RawColumn& column : table.columns) {
+      if (!column.text.empty()) continue;  // status or event marks, no channel
       if (column.name.empty()) {
         throw InputError(path, column.where, "the column has no name",
                          "a name in the header, or a mapping `channels: {NAME: COLUMN}`");
@@ -73,6 +74,11 @@ std::vector<Selected> SelectColumns(const RawTable& table, const std::string& pa
       throw InputError(path, "channels." + channel,
                        is_time ? fmt::format("'{}' is the time column", spec)
                                : fmt::format("no column '{}' in the file", spec),
+                       ColumnList(table));
+    }
+    if (!found->text.empty()) {
+      throw InputError(path, "channels." + channel,
+                       fmt::format("{} holds text ({}), no number", Describe(*found), found->text),
                        ColumnList(table));
     }
     selected.push_back({channel, found, found->unit});
@@ -189,7 +195,7 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
   if (unit.empty() && (table.time_name == "time" || table.si_by_contract)) unit = "s";
   const std::string field = table.time_name.empty()
                                 ? table.time_where
-                                : Describe({table.time_name, "", table.time_where, {}});
+                                : Describe({table.time_name, "", table.time_where, {}, {}});
   if (unit.empty()) {
     throw InputError(path, field, fmt::format("the time column '{}' has no unit", table.time_name),
                      fmt::format("a unit: a header '{0} [ms]' or '{0}_ms', a units row, or "

@@ -15,6 +15,9 @@ struct RawColumn {
   std::string unit;            // as in the file ("deg", "m/s^2"); "" when the file states none
   std::string where;           // for messages: "column 3", "dataset 2 (line 40)", "variable theta"
   std::vector<double> values;  // one per sample; NaN marks a gap (empty or NaN cell)
+  // A column of text, no number in it (a logger's status or event marks): "" for a column of
+  // numbers, else its first text cell and where it is ("'OK' at line 2"). Not a channel.
+  std::string text;
 };
 
 struct RawTable {

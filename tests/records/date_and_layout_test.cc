@@ -196,5 +196,43 @@ TEST(DateAndLayoutTest, AStatedRateSettlesACoarselyPrintedTimeColumn) {
   EXPECT_THROW(ImportMeasurement(path, options), InputError);
 }
 
+TEST(DateAndLayoutTest, AColumnOfTextIsNoChannel) {
+  TempDir dir;
+  const Decay psi;
+  // A logger's status column ("OK", "MARK" every second) between two channels.
+  const std::string path = dir.File("status.csv");
+  WriteText(path, MakeExport("Time [s];psi [deg];Status;phi [deg]\n", 301, [&](int j) {
+              return fmt::format("{};{};{};{}", Print(j * 0.01, true), Print(psi(j * 0.01), true),
+                                 j % 100 == 0 ? "MARK" : "OK", Print(psi(j * 0.01), true));
+            }));
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, {}, &report);
+  EXPECT_EQ(m.channels, (std::vector<std::string>{"psi", "phi"}));
+  EXPECT_THAT(report.dialect, HasSubstr("text in column 3 (Status), no channel"));
+  ExpectDecayRead(m, 1, psi, kDegree);
+  // Asked for as a channel, it is refused naming its text.
+  ImportOptions options;
+  options.channel_columns = {{"x", "Status"}};
+  try {
+    ImportMeasurement(path, options);
+    ADD_FAILURE() << "a text column became a channel";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("holds text ('MARK' at line 2)"));
+  }
+  // A column of numbers with one stray word is still refused at that cell.
+  const std::string stray = dir.File("stray.csv");
+  WriteText(stray, MakeExport("Time [s];psi [deg];phi [deg]\n", 301, [&](int j) {
+              return fmt::format("{};{};{}", Print(j * 0.01, true), Print(psi(j * 0.01), true),
+                                 j == 150 ? "ERR" : Print(psi(j * 0.01), true));
+            }));
+  try {
+    ImportMeasurement(stray);
+    ADD_FAILURE() << "a stray word in a column of numbers was read";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("line 152, column 3"));
+    EXPECT_THAT(e.what(), HasSubstr("'ERR' is not a number"));
+  }
+}
+
 }  // namespace
 }  // namespace mbid::records
