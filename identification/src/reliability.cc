@@ -5,27 +5,22 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mbid/common/clipping.h"
-#include "mbid/common/outliers.h"
+#include "mbid/common/channel_fault.h"
 
 namespace mbid::identification {
 
 std::vector<std::string> RecordFaults(const AnalysisRecord& record) {
   std::vector<std::string> faults;
   for (Eigen::Index c = 0; c < record.values.cols(); ++c) {
-    if (const std::optional<Clipping> clipping = FindClipping(record.values.col(c))) {
-      faults.push_back(ClippingReason(record.channels[static_cast<size_t>(c)],
-                                      record.units[static_cast<size_t>(c)], *clipping) +
-                       ", and no mode fitted to the flattened peaks is to be trusted");
-      continue;  // the rail's edges would read as jumps too
-    }
-    const std::vector<Outlier> outliers = FindOutliers(record.values.col(c));
-    if (!outliers.empty()) {
-      faults.push_back(OutlierReason(record.channels[static_cast<size_t>(c)], outliers,
-                                     record.sample_interval_s, record.start_time_s) +
-                       "; the modes do not describe it (blank such samples and fill them: "
-                       "fill_gaps: linear)");
-    }
+    const std::optional<ChannelFault> fault = FindChannelFault(
+        record.values.col(c), record.channels[static_cast<size_t>(c)],
+        record.units[static_cast<size_t>(c)], record.sample_interval_s, record.start_time_s);
+    if (!fault) continue;
+    faults.push_back(fault->reason +
+                     (fault->kind == ChannelFault::Kind::kClipped
+                          ? ", and no mode fitted to the flattened peaks is to be trusted"
+                          : "; the modes do not describe it (blank such samples and fill them: "
+                            "fill_gaps: linear)"));
   }
   return faults;
 }

@@ -7,8 +7,7 @@
 #include <cmath>
 
 #include "distributions.h"
-#include "mbid/common/clipping.h"
-#include "mbid/common/outliers.h"
+#include "mbid/common/channel_fault.h"
 #include "statistics.h"
 
 namespace mbid::updating {
@@ -24,22 +23,6 @@ constexpr double kNoticeableExcess = 1.2;
 // off. Wrong minima of the reference load drop (design model 25-35% off, 4.5-10 s) ended at
 // 1.15-1.34, the true ones at 0.97-0.99.
 constexpr double kStructuredExcess = 1.05;
-
-// The glitches of a record the fit does not model: a hammer blow or burst makes the record jump
-// while the forcing acts, as the simulation does too (a sample or two of margin for the pulse's
-// edges between samples).
-std::vector<Outlier> AfterForcing(std::vector<Outlier> outliers, const Measurement& record,
-                                  const TestRecord& test) {
-  const double end_s = test.excitation.CalcForcingEndTime() + 2 * record.sample_interval_s;
-  outliers.erase(std::remove_if(outliers.begin(), outliers.end(),
-                                [&](const Outlier& o) {
-                                  return record.start_time_s + static_cast<double>(o.sample) *
-                                                                   record.sample_interval_s <=
-                                         end_s;
-                                }),
-                 outliers.end());
-  return outliers;
-}
 
 }  // namespace
 
@@ -131,18 +114,17 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
     const Measurement& record = tests[t].record;
     for (int c = 0; c < record.channel_count(); ++c) {
       const std::string& channel = record.channels[static_cast<size_t>(c)];
-      std::string fault, what;
-      if (const std::optional<Clipping> clipping = FindClipping(record.values.col(c))) {
-        fault = ClippingReason(channel, record.units[static_cast<size_t>(c)], *clipping);
-        what = "is clipped (the sensor or logger at the end of its range)";
-      } else if (const std::vector<Outlier> outliers =
-                     AfterForcing(FindOutliers(record.values.col(c)), record, tests[t]);
-                 !outliers.empty()) {
-        fault = OutlierReason(channel, outliers, record.sample_interval_s, record.start_time_s);
-        what = "jumps off its course (a glitch or a knock)";
-      } else {
-        continue;
-      }
+      // While a hammer blow or burst acts (and 2 samples of its edges), the record jumps as the
+      // simulation does.
+      const std::optional<ChannelFault> found =
+          FindChannelFault(record.values.col(c), channel, record.units[static_cast<size_t>(c)],
+                           record.sample_interval_s, record.start_time_s,
+                           tests[t].excitation.CalcForcingEndTime() + 2 * record.sample_interval_s);
+      if (!found) continue;
+      const std::string& fault = found->reason;
+      const char* what = found->kind == ChannelFault::Kind::kClipped
+                             ? "is clipped (the sensor or logger at the end of its range)"
+                             : "jumps off its course (a glitch or a knock)";
       result.credibility.push_back(
           fmt::format("test {}: {}; the fit takes those samples as measured values, so no "
                       "parameter is determined by it",
