@@ -109,10 +109,6 @@ double FindOnset(const OnsetFit& fit, int early, double* cost) {
   return t0;
 }
 
-}  // namespace
-
-namespace {
-
 // Median |second difference| over samples [begin, end) of `y` (0 when empty).
 double MedianBend(const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Index begin,
                   Eigen::Index end) {

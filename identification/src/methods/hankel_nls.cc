@@ -52,6 +52,18 @@ bool IsCandidate(std::complex<double> lambda, const AnalysisRecord& record,
   return lambda.imag() > 0 && !at_nyquist && PassesFilter(lambda, options, record.max_frequency_hz);
 }
 
+// Whether `lambda`, a pole at `order`, reappears at each of the next stability_orders orders
+// (those the Hankel matrix's columns allow).
+bool IsStable(std::complex<double> lambda, int order, int columns,
+              const IdentificationOptions& options, PolesByOrder& poles_at) {
+  for (int s = 1; s <= options.hankel.stability_orders; ++s) {
+    const int higher = order + 2 * s;
+    if (higher >= columns - 1) break;
+    if (!HasMatch(lambda, poles_at.At(higher), options.hankel.stability_tolerance)) return false;
+  }
+  return true;
+}
+
 // Candidates: upper-half poles at the signal order inside the step-5 limits, below the Nyquist
 // frequency and stable across the next orders.
 void AddStableCandidates(const AnalysisRecord& record, const IdentificationOptions& options,
@@ -60,13 +72,7 @@ void AddStableCandidates(const AnalysisRecord& record, const IdentificationOptio
   int unstable = 0;
   for (const auto& lambda : poles) {
     if (!IsCandidate(lambda, record, options)) continue;
-    bool stable = true;
-    for (int s = 1; s <= options.hankel.stability_orders; ++s) {
-      const int higher = order + 2 * s;
-      if (higher >= columns - 1) break;
-      stable = stable && HasMatch(lambda, poles_at.At(higher), options.hankel.stability_tolerance);
-    }
-    if (stable) {
+    if (IsStable(lambda, order, columns, options, poles_at)) {
       estimate->lambda.push_back(lambda);
     } else {
       ++unstable;
@@ -176,6 +182,26 @@ bool CarriesAmplitude(const Estimate& estimate) {
   return true;
 }
 
+// Refines `trial` (the estimate's modes and more) and tests it for significance; when it keeps
+// more significant modes, all carrying amplitude, it replaces the estimate. Returns how many
+// modes it added (0: the estimate stands).
+int KeepIfMoreModes(const AnalysisRecord& record, const IdentificationOptions& options,
+                    const std::function<void(Estimate*)>& refine, Estimate trial,
+                    Estimate* estimate) {
+  try {
+    refine(&trial);
+    SelectSignificant(record, options, &trial, refine);
+  } catch (const NumericalError&) {
+    return 0;  // nothing significant from this start: the estimate stands
+  }
+  if (trial.lambda.size() <= estimate->lambda.size() || !CarriesAmplitude(trial)) return 0;
+  const int added = static_cast<int>(trial.lambda.size() - estimate->lambda.size());
+  trial.iterations += estimate->iterations;
+  trial.stabilization = std::move(estimate->stabilization);
+  *estimate = std::move(trial);
+  return added;
+}
+
 // A mode that lives in few of many channels brings its energy to one channel but the noise of
 // all to the summed Hankel matrix, and may stay under the signal order there (a machine's slew
 // mode seen by its gyro alone beside three channels that barely see it). Where a channel's
@@ -202,6 +228,7 @@ void AddModesFromSingleChannels(const AnalysisRecord& record, const Identificati
     if (order == 0) continue;
     PolesByOrder poles_at(single, record.decimated_interval_s);
     Estimate trial;
+    trial.warnings = estimate->warnings;
     trial.model_order = estimate->model_order;
     trial.effective_rank = estimate->effective_rank;
     trial.lambda = estimate->lambda;
@@ -210,26 +237,10 @@ void AddModesFromSingleChannels(const AnalysisRecord& record, const Identificati
           HasMatch(lambda, estimate->lambda, options.hankel.stability_tolerance)) {
         continue;
       }
-      bool stable = true;
-      for (int k = 1; k <= options.hankel.stability_orders && order + 2 * k < columns - 1; ++k) {
-        stable = stable &&
-                 HasMatch(lambda, poles_at.At(order + 2 * k), options.hankel.stability_tolerance);
-      }
-      if (stable) trial.lambda.push_back(lambda);
+      if (IsStable(lambda, order, columns, options, poles_at)) trial.lambda.push_back(lambda);
     }
     if (trial.lambda.size() == estimate->lambda.size()) continue;
-    try {
-      refine(&trial);
-      SelectSignificant(record, options, &trial, refine);
-    } catch (const NumericalError&) {
-      continue;
-    }
-    if (trial.lambda.size() <= estimate->lambda.size() || !CarriesAmplitude(trial)) continue;
-    added += static_cast<int>(trial.lambda.size() - estimate->lambda.size());
-    trial.iterations += estimate->iterations;
-    trial.warnings = std::move(estimate->warnings);
-    trial.stabilization = std::move(estimate->stabilization);
-    *estimate = std::move(trial);
+    added += KeepIfMoreModes(record, options, refine, std::move(trial), estimate);
   }
   if (added > 0) {
     estimate->warnings.push_back(fmt::format(
@@ -255,17 +266,7 @@ void AddModesFromHigherOrders(const AnalysisRecord& record, const Identification
       if (IsCandidate(lambda, record, options)) trial.lambda.push_back(lambda);
     }
     if (trial.lambda.size() <= estimate->lambda.size()) continue;
-    try {
-      refine(&trial);
-      SelectSignificant(record, options, &trial, refine);
-    } catch (const NumericalError&) {
-      continue;  // nothing significant from this start: the estimate stands
-    }
-    if (trial.lambda.size() <= estimate->lambda.size() || !CarriesAmplitude(trial)) continue;
-    added += static_cast<int>(trial.lambda.size() - estimate->lambda.size());
-    trial.iterations += estimate->iterations;
-    trial.stabilization = std::move(estimate->stabilization);
-    *estimate = std::move(trial);
+    added += KeepIfMoreModes(record, options, refine, std::move(trial), estimate);
   }
   if (added > 0) {
     estimate->warnings.push_back(fmt::format(
