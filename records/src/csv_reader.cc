@@ -197,28 +197,18 @@ RawTable ReadCsv(const std::string& path) {
     break;
   }
 
-  // Columns of text, no number in any row (a logger's status or event marks): not channels.
-  std::vector<std::string> text_of(columns.size());
-  {
-    std::vector<bool> has_value(columns.size(), false);
-    for (size_t i = static_cast<size_t>(first_row); i < lines.size(); ++i) {
-      if (IsCommentOrBlank(lines[i].text)) continue;
-      std::vector<std::string> fields = SplitFields(lines[i].text, separator);
-      if (!FitRow(&fields, columns.size())) continue;  // refused with its line below
-      for (size_t c = 0; c < fields.size(); ++c) {
-        const CellKind kind = ClassifyCell(fields[c], separator);
-        if (kind == CellKind::kText && text_of[c].empty()) {
-          text_of[c] = fmt::format("'{}' at line {}", fields[c], lines[i].number);
-        }
-        if (kind != CellKind::kText && kind != CellKind::kGap) has_value[c] = true;
-      }
-    }
-    for (size_t c = 0; c < columns.size(); ++c) {
-      if (has_value[c] || static_cast<int>(c) == time_column) text_of[c].clear();
-    }
-  }
-
-  // Rows.
+  // Rows. A column of text, no number in any row (a logger's status or event marks), is no
+  // channel: its first text is kept until a number in the column makes it an error.
+  struct FirstText {
+    std::string cell, where;
+    int line = 0;
+  };
+  std::vector<FirstText> text_in(columns.size());
+  std::vector<bool> has_value(columns.size(), false);
+  const auto not_a_number = [&path](const std::string& cell, const std::string& where) {
+    return InputError(path, where, "'" + cell + "' is not a number",
+                      "a decimal number, or an empty cell or NaN for a gap");
+  };
   Metadata metadata;
   RawTable table;
   table.columns.resize(columns.size());
@@ -253,9 +243,8 @@ RawTable ReadCsv(const std::string& path) {
     }
     for (size_t c = 0; c < fields.size(); ++c) {
       double value = 0;
-      if (static_cast<int>(c) == date_column || !text_of[c].empty()) {
+      if (static_cast<int>(c) == date_column) {
         table.columns[c].values.push_back(std::numeric_limits<double>::quiet_NaN());
-        written[c] = written[c] || !text_of[c].empty();
         continue;
       }
       const CellKind kind = ClassifyCell(fields[c], separator, &value);
@@ -300,9 +289,14 @@ RawTable ReadCsv(const std::string& path) {
           time_place = std::min(
               time_place, PrintedPlace(fields[c], decimal.mark == DecimalMark::kComma ? ',' : '.'));
         }
+      } else if (kind == CellKind::kText && static_cast<int>(c) != time_column && !has_value[c]) {
+        if (text_in[c].cell.empty()) text_in[c] = {fields[c], where, line.number};
       } else if (kind != CellKind::kGap) {
-        throw InputError(path, where, "'" + fields[c] + "' is not a number",
-                         "a decimal number, or an empty cell or NaN for a gap");
+        throw not_a_number(fields[c], where);
+      }
+      if (kind != CellKind::kText && kind != CellKind::kGap) {
+        if (!text_in[c].cell.empty()) throw not_a_number(text_in[c].cell, text_in[c].where);
+        has_value[c] = true;
       }
       table.columns[c].values.push_back(value);
     }
@@ -330,13 +324,10 @@ RawTable ReadCsv(const std::string& path) {
   table.format = table.si_by_contract ? "mbid-csv" : "csv";
   table.dialect = dialect.Describe(decimal.mark == DecimalMark::kComma, thousands);
   if (date_column >= 0) table.dialect += fmt::format(", dates in column {}", date_column + 1);
-  for (size_t c = 0; c < text_of.size(); ++c) {
-    if (!text_of[c].empty()) {
-      table.dialect +=
-          fmt::format(", text in column {}{}, no channel", c + 1,
-                      columns.size() > 0 && c < header_cells.size() && !header_cells[c].empty()
-                          ? " (" + header_cells[c] + ")"
-                          : "");
+  for (size_t c = 0; c < text_in.size(); ++c) {
+    if (!text_in[c].cell.empty()) {
+      table.dialect += fmt::format(", text in column {}{}, no channel", c + 1,
+                                   header_cells[c].empty() ? "" : " (" + header_cells[c] + ")");
     }
   }
   if (empty_columns > 0) {
@@ -384,7 +375,10 @@ RawTable ReadCsv(const std::string& path) {
     table.columns[c].name = columns[c].name;
     table.columns[c].unit = columns[c].unit;
     table.columns[c].where = fmt::format("column {}", file_column[c] + 1);
-    table.columns[c].text = text_of[file_column[c]];
+    const FirstText& marks = text_in[file_column[c]];
+    if (!marks.cell.empty()) {
+      table.columns[c].text = fmt::format("'{}' at line {}", marks.cell, marks.line);
+    }
   }
   if (time_column >= 0) {
     RawColumn time = std::move(table.columns[static_cast<size_t>(time_column)]);
