@@ -95,10 +95,11 @@ int RunIdentifyCommand(const std::string& data_path,
                              "std_hz", "decay_rate_per_s", "std_per_s", "damping_ratio");
     for (size_t k = 0; k < result.modes.size(); ++k) {
       const identification::IdentifiedMode& mode = result.modes[k];
-      std::cout << fmt::format("{:>4} {:>13.6f} {:>12.2e} {:>16.6f} {:>12.2e} {:>13.6f}{}\n", k + 1,
-                               mode.frequency_hz, mode.std_frequency_hz, mode.decay_rate_per_s,
-                               mode.std_decay_rate_per_s, mode.damping_ratio,
-                               mode.significant ? "" : "  (not significant)");
+      std::cout << fmt::format(
+          "{:>4} {:>13.6f} {:>12.2e} {:>16.6f} {:>12.2e} {:>13.6f}{}{}\n", k + 1, mode.frequency_hz,
+          mode.std_frequency_hz, mode.decay_rate_per_s, mode.std_decay_rate_per_s,
+          mode.damping_ratio, mode.significant ? "" : "  (not significant)",
+          mode.combination.empty() ? "" : "  (combination tone " + mode.combination + ")");
     }
     for (size_t c = 0; c < static_cast<size_t>(result.drift_per_s.size()); ++c) {
       std::cout << fmt::format("linear drift removed from {}: {:.4g} {}/s\n", result.channels[c],

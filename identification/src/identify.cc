@@ -3,6 +3,7 @@
 // (reliability.h).
 #include "mbid/identification/identify.h"
 
+#include "combination_tones.h"
 #include "estimate.h"
 #include "free_decay.h"
 #include "internal.h"
@@ -56,6 +57,7 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
     // The whole decay knows the release better than its first samples (release.h).
     result.release_time_s = RefineReleaseFromModes(result, result.release_time_s);
   }
+  MarkCombinationTones(&result);
   AssessReliability(record, options, estimate, &result);
   return result;
 }

@@ -64,6 +64,7 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
     m["std_decay_rate_per_s"] = NumberOrNull(mode.std_decay_rate_per_s);
     m["significance"] = NumberOrNull(mode.significance);
     m["significant"] = mode.significant;
+    if (!mode.combination.empty()) m["combination"] = mode.combination;
     if (mode.backbone) {
       const Backbone& b = *mode.backbone;
       m["backbone"] = {{"time_s", b.time_s},
@@ -206,6 +207,9 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result, const std::st
   write_mode_vector("significance", "1", [](const IdentifiedMode& m) { return m.significance; });
   write_mode_vector("significant", "1",
                     [](const IdentifiedMode& m) { return m.significant ? 1.0 : 0.0; });
+  std::vector<std::string> combination;
+  for (const IdentifiedMode& mode : result.modes) combination.push_back(mode.combination);
+  writer.WriteStrings(modes, "combination", combination);
   for (size_t c = 0; c < result.channels.size(); ++c) {
     const std::string& channel = result.channels[c];
     writer.WriteVector(modes + "/amplitude", channel,

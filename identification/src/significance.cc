@@ -49,16 +49,20 @@ Eigen::VectorXd CalcSignificance(const AmplitudeFit& fit) {
   return significance;
 }
 
-double CalcSignificanceThreshold(int samples, int channels, double false_alarm) {
-  const double target = std::log(false_alarm / (10.0 * std::max(samples, 1)));
+double CalcChiSquareThreshold(int m, double probability) {
+  const double target = std::log(probability);
   // The survival function decreases in x: bisection.
   double low = 0;
   double high = 1e4;
   for (int i = 0; i < 200; ++i) {
     const double mid = 0.5 * (low + high);
-    (LogChiSquareSurvival(mid, channels) > target ? low : high) = mid;
+    (LogChiSquareSurvival(mid, m) > target ? low : high) = mid;
   }
   return 0.5 * (low + high);
+}
+
+double CalcSignificanceThreshold(int samples, int channels, double false_alarm) {
+  return CalcChiSquareThreshold(channels, false_alarm / (10.0 * std::max(samples, 1)));
 }
 
 }  // namespace mbid::identification

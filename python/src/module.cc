@@ -210,6 +210,7 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readonly("std_decay_rate_per_s",
                     &mbid::identification::IdentifiedMode::std_decay_rate_per_s)
       .def_readonly("significant", &mbid::identification::IdentifiedMode::significant)
+      .def_readonly("combination", &mbid::identification::IdentifiedMode::combination)
       .def_property_readonly(
           "amplitude",
           [](const mbid::identification::IdentifiedMode& mode) { return ToArray(mode.amplitude); })

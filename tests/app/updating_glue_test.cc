@@ -56,6 +56,21 @@ TEST(UpdatingGlueTest, RouteOneRunsOnTheMainModesAndNamesTheOthers) {
     EXPECT_NEAR(chosen.c[static_cast<Eigen::Index>(i)], c, 1e-6 * c) << i;
   }
 
+  // A combination tone is never a main mode, however strong: the 6 Hz mode made 1000 times
+  // stronger displaces the weakest (the third), and as a tone nothing.
+  identified.modes[4].amplitude *= 1e3;
+  EXPECT_EQ(SelectMainModes(identified, 4), (std::vector<size_t>{0, 1, 3, 4}));
+  identified.modes[4].combination = "f2 + f3";
+  EXPECT_EQ(SelectMainModes(identified, 4), (std::vector<size_t>{0, 1, 2, 3}));
+  // Without the fourth mode the tone leaves 3 modes for 4 coordinates: no Route 1.
+  identified.modes.erase(identified.modes.begin() + 3);
+  EXPECT_EQ(
+      SolveAlgebraicRoute(*crane.model, identified, record, crane.excitation, settings, &note),
+      nullptr);
+  EXPECT_NE(note.find("3 identified modes (besides combination tones) for 4 coordinates"),
+            std::string::npos)
+      << note;
+
   // Fewer modes than coordinates: no Route 1, and the reason.
   identified.modes.resize(3);
   EXPECT_EQ(

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <numeric>
 #include <vector>
 
 namespace mbid::validation {
@@ -30,8 +29,11 @@ std::vector<size_t> SelectMainModes(const identification::ModalResult& identifie
       energy[k] += mode.amplitude[c] * mode.amplitude[c] * duration / (noise * noise);
     }
   }
-  std::vector<size_t> order(identified.modes.size());
-  std::iota(order.begin(), order.end(), 0);
+  // A combination tone is no mode of the structure: eq. 7 must not take it as one.
+  std::vector<size_t> order;
+  for (size_t k = 0; k < identified.modes.size(); ++k) {
+    if (identified.modes[k].combination.empty()) order.push_back(k);
+  }
   std::stable_sort(order.begin(), order.end(),
                    [&energy](size_t a, size_t b) { return energy[a] > energy[b]; });
   order.resize(std::min(count, order.size()));
@@ -54,11 +56,13 @@ std::shared_ptr<const updating::CharacteristicResult> SolveAlgebraicRoute(
         fmt::format("coordinate '{}' has no spring (eq. 7 needs one on every coordinate)", free);
     return nullptr;
   }
-  if (identified.modes.size() < n) {
-    *note = fmt::format("{} identified modes for {} coordinates", identified.modes.size(), n);
+  std::vector<size_t> main = SelectMainModes(identified, n);
+  if (main.size() < n) {
+    *note =
+        fmt::format("{} identified modes{} for {} coordinates", main.size(),
+                    main.size() < identified.modes.size() ? " (besides combination tones)" : "", n);
     return nullptr;
   }
-  std::vector<size_t> main = SelectMainModes(identified, n);
   if (identified.modes.size() > n) {
     std::vector<std::string> left_out;
     for (size_t k = 0; k < identified.modes.size(); ++k) {

@@ -3,16 +3,19 @@
 // amplitudes.
 #include <fmt/format.h>
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
 
 #include "estimate.h"
+#include "internal.h"
 #include "mbid/common/error.h"
 #include "mbid/identification/hankel_svd.h"
 #include "mbid/identification/modal_fit.h"
 #include "mbid/identification/refinement.h"
+#include "mbid/identification/significance.h"
 #include "methods/method.h"
 #include "mode_selection.h"
 
@@ -183,11 +186,12 @@ bool CarriesAmplitude(const Estimate& estimate) {
 }
 
 // Refines `trial` (the estimate's modes and more) and tests it for significance; when it keeps
-// more significant modes, all carrying amplitude, it replaces the estimate. Returns how many
-// modes it added (0: the estimate stands).
+// more significant modes, all carrying amplitude (and passes `accept`, if given), it replaces the
+// estimate. Returns how many modes it added (0: the estimate stands).
 int KeepIfMoreModes(const AnalysisRecord& record, const IdentificationOptions& options,
                     const std::function<void(Estimate*)>& refine, Estimate trial,
-                    Estimate* estimate) {
+                    Estimate* estimate,
+                    const std::function<bool(const Estimate&)>& accept = nullptr) {
   try {
     refine(&trial);
     SelectSignificant(record, options, &trial, refine);
@@ -195,9 +199,12 @@ int KeepIfMoreModes(const AnalysisRecord& record, const IdentificationOptions& o
     return 0;  // nothing significant from this start: the estimate stands
   }
   if (trial.lambda.size() <= estimate->lambda.size() || !CarriesAmplitude(trial)) return 0;
+  if (accept && !accept(trial)) return 0;
   const int added = static_cast<int>(trial.lambda.size() - estimate->lambda.size());
   trial.iterations += estimate->iterations;
   trial.stabilization = std::move(estimate->stabilization);
+  trial.noise_std =
+      estimate->noise_std;  // the record's, not the trial's: AssessReliability's level
   *estimate = std::move(trial);
   return added;
 }
@@ -246,6 +253,92 @@ void AddModesFromSingleChannels(const AnalysisRecord& record, const Identificati
     estimate->warnings.push_back(fmt::format(
         "{} more significant mode(s) found in single channels whose residual the other modes "
         "left above the noise",
+        added));
+  }
+}
+
+// The score of "mode k hides a second one": two poles lambda +- delta whose shapes differ add,
+// beside the one mode's term, the Taylor terms t e^(lambda t) and t^2 e^(lambda t) with their
+// own amplitude per channel, which one shared pole cannot absorb. Their least-squares reduction
+// of each channel's residual over its residual variance, summed over channels, is chi-square
+// with 4 degrees of freedom per channel when the one mode is all there is.
+double CloseModeScore(const AnalysisRecord& record, const Estimate& estimate,
+                      const Eigen::HouseholderQR<Eigen::MatrixXd>& model_qr,
+                      const Eigen::MatrixXd& residual, const Eigen::VectorXd& variance, size_t k) {
+  const Eigen::Index samples = residual.rows();
+  Eigen::MatrixXd terms(samples, 4);
+  ForEachModeSample(estimate.lambda[k], record.decimated_interval_s, 0, static_cast<int>(samples),
+                    [&](int j, std::complex<double> z) {
+                      const double t = static_cast<double>(j) / static_cast<double>(samples);
+                      terms.row(j) << t * z.real(), -t * z.imag(), t * t * z.real(),
+                          -t * t * z.imag();
+                    });
+  // Only the terms' part outside the modes' basis reduces the residual (orthogonal to it).
+  const Eigen::Index p = model_qr.matrixQR().cols();
+  const Eigen::MatrixXd rotated = model_qr.householderQ().transpose() * terms;
+  const Eigen::Matrix4d outside =
+      rotated.bottomRows(samples - p).transpose() * rotated.bottomRows(samples - p);
+  const Eigen::MatrixXd projections = terms.transpose() * residual;
+  const Eigen::Matrix4d inverse = outside.completeOrthogonalDecomposition().pseudoInverse();
+  double score = 0;
+  for (Eigen::Index c = 0; c < residual.cols(); ++c) {
+    score += projections.col(c).dot(inverse * projections.col(c)) / variance(c);
+  }
+  return score;
+}
+
+// Two modes closer than their bandwidths (a platform's boom modes 7.8 and 8.5 Hz at 11 and 15 %
+// damping) can pass the signal order as one, refined to a frequency between them with a small
+// standard deviation and a residual at the noise level. Where a mode's CloseModeScore is
+// significant (significance_false_alarm per mode), it is split into lambda +- i delta, delta
+// half its decay rate (at least 1 % of its frequency), and the refit is kept when it has more
+// significant modes, two of them inside the bandwidth of the one (1.5 decay rates from its
+// pole): a refit that moves a pole far off has found something else (a heavily damped pole
+// fitting coloured noise of the decimation filter on a 500 Hz crane record), not a pair.
+void SplitCloseModes(const AnalysisRecord& record, const IdentificationOptions& options,
+                     const std::function<void(Estimate*)>& refine, Estimate* estimate) {
+  const Eigen::MatrixXd& values = record.decimated;
+  const Eigen::Index samples = values.rows();
+  const double threshold =
+      CalcChiSquareThreshold(2 * static_cast<int>(values.cols()), options.significance_false_alarm);
+  int added = 0;
+  const size_t modes = estimate->lambda.size();
+  for (size_t k = 0; k < modes && k < estimate->lambda.size(); ++k) {
+    Eigen::MatrixXd basis;
+    FillDampedSinusoidBasis(estimate->lambda, record.decimated_interval_s,
+                            options.offset == OffsetRemoval::kFit, static_cast<int>(samples),
+                            &basis);
+    if (basis.cols() + 4 >= samples) return;
+    const Eigen::HouseholderQR<Eigen::MatrixXd> model_qr(basis);
+    const Eigen::MatrixXd residual = values - estimate->fit.reconstruction.topRows(samples);
+    // A noiseless record's round-off is no second mode: the level at least 1e-6 of the RMS,
+    // as AssessReliability's.
+    Eigen::VectorXd variance = estimate->fit.residual_variance;
+    for (Eigen::Index c = 0; c < variance.size(); ++c) {
+      variance(c) = std::max(variance(c), 1e-12 * values.col(c).squaredNorm() / samples);
+    }
+    if (CloseModeScore(record, *estimate, model_qr, residual, variance, k) <= threshold) continue;
+    Estimate trial;
+    trial.warnings = estimate->warnings;
+    trial.model_order = estimate->model_order;
+    trial.effective_rank = estimate->effective_rank;
+    trial.lambda = estimate->lambda;
+    const std::complex<double> lambda = estimate->lambda[k];
+    const std::complex<double> delta(0, 0.5 * std::max(-lambda.real(), 0.01 * lambda.imag()));
+    trial.lambda[k] = lambda + delta;
+    trial.lambda.push_back(lambda - delta);
+    const double radius = 1.5 * std::max(-lambda.real(), 0.01 * lambda.imag());
+    const auto is_pair = [lambda, radius](const Estimate& split) {
+      return std::count_if(split.lambda.begin(), split.lambda.end(), [&](std::complex<double> l) {
+               return std::abs(l - lambda) <= radius;
+             }) >= 2;
+    };
+    added += KeepIfMoreModes(record, options, refine, std::move(trial), estimate, is_pair);
+  }
+  if (added > 0) {
+    estimate->warnings.push_back(fmt::format(
+        "{} more significant mode(s) found by splitting modes whose residual holds a second, "
+        "close one",
         added));
   }
 }
@@ -316,6 +409,7 @@ Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOpt
   if (options.drop_insignificant) {
     AddModesFromSingleChannels(record, options, columns, max_order, hankel.channel_noise_std(),
                                refine, &estimate);
+    SplitCloseModes(record, options, refine, &estimate);
   }
   if (estimate.termination == "failure") {
     throw NumericalError("Ceres",

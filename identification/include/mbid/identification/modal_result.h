@@ -38,6 +38,9 @@ struct IdentifiedMode {
   // For a mode whose frequency drifts with amplitude (close poles merged into it): its
   // frequency and damping ratio against amplitude (backbone.h).
   std::optional<Backbone> backbone;
+  // Non-empty for a combination tone of two other modes ("f1 + f3", "2 f1", "f3 - f1", 1-based
+  // in `modes`): their poles' sum (combination_tones.cc), no mode of the structure.
+  std::string combination;
 
   // Fills the derived quantities from lambda.
   void SetPole(std::complex<double> pole);

@@ -24,4 +24,8 @@ Eigen::VectorXd CalcSignificance(const AmplitudeFit& fit);
 // 53 for 2 x 1e6.
 double CalcSignificanceThreshold(int samples, int channels, double false_alarm);
 
+// x with P(chi-square(2 m) > x) = probability: a single test's threshold, without the
+// Bonferroni factor of CalcSignificanceThreshold.
+double CalcChiSquareThreshold(int m, double probability);
+
 }  // namespace mbid::identification

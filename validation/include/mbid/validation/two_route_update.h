@@ -17,7 +17,8 @@
 namespace mbid::validation {
 
 // The indices (ascending) of the `count` identified modes of largest energy in the record: the
-// paper's "main" modes, which it chose among all it found for eq. 7.
+// paper's "main" modes, which it chose among all it found for eq. 7. Combination tones are never
+// main modes (fewer than `count` indices when too few modes are left).
 std::vector<size_t> SelectMainModes(const identification::ModalResult& identified, size_t count);
 
 // Route 1 (method.md, eqs. 6-8) from the identified poles of `record`, when the settings ask for

@@ -1,0 +1,78 @@
+// Combination tones (combination_tones.cc): a component at the sum of two modes' poles is marked
+// as such, a mode that only shares a frequency with a sum is not.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <string>
+
+#include "mbid/identification/identify.h"
+#include "signals.h"
+
+namespace mbid::identification {
+namespace {
+
+using testing::MakeRecord;
+using testing::SignalSpec;
+using testing::Synthesize;
+
+// An excavator arm's load drop (100 Hz, 6 s, two inclinometers, two accelerometer axes): modes
+// 3.04 and 7.42 Hz, and what the accelerometers' centripetal terms add, a component at their
+// sum 10.46 Hz decaying at the sum of their decay rates 1.22 + 3.50 = 4.72 1/s, 1 % of the
+// modes' size (15 times the noise).
+SignalSpec ArmWithTone(double tone_decay_per_s) {
+  SignalSpec spec;
+  spec.channels = {"boom", "stick", "acc_z", "acc_y"};
+  spec.sample_interval_s = 0.01;
+  spec.samples = 601;
+  spec.modes = {{3.0407, 1.2215, {0.3, 0.4, 1.0, 2.0}, {0.0, 0.2, 0.4, 0.6}},
+                {7.4157, 3.5092, {0.2, 0.6, 1.5, 0.1}, {0.5, 0.0, -1.0, 2.0}},
+                {10.4564, tone_decay_per_s, {0.0, 0.0, 0.03, 0.03}, {0.0, 0.0, 1.0, -1.0}}};
+  return spec;
+}
+
+ModalResult IdentifyArm(const SignalSpec& spec, int seed) {
+  std::mt19937_64 rng(seed);
+  const Eigen::VectorXd noise = Eigen::Vector4d(2e-3, 2e-3, 2e-3, 2e-3);
+  return Identify(MakeRecord(spec, testing::AddNoise(Synthesize(spec), noise, &rng)), {});
+}
+
+TEST(CombinationTonesTest, AComponentAtTheSumOfTwoPolesIsATone) {
+  for (int seed = 1; seed <= 3; ++seed) {
+    const ModalResult result = IdentifyArm(ArmWithTone(1.2215 + 3.5092), seed);
+    ASSERT_EQ(result.modes.size(), 3u) << "seed " << seed;
+    EXPECT_TRUE(result.modes[0].combination.empty());
+    EXPECT_TRUE(result.modes[1].combination.empty());
+    EXPECT_EQ(result.modes[2].combination, "f1 + f2") << "seed " << seed;
+    EXPECT_TRUE(std::any_of(result.warnings.begin(), result.warnings.end(),
+                            [](const std::string& w) {
+                              return w.find("Hz is a combination tone (f1 + f2)") !=
+                                     std::string::npos;
+                            }))
+        << ::testing::PrintToString(result.warnings);
+    // A tone is no reason to distrust the modes.
+    EXPECT_TRUE(result.reliable) << ::testing::PrintToString(result.reasons);
+  }
+}
+
+TEST(CombinationTonesTest, AModeAtASumFrequencyWithItsOwnDecayIsAMode) {
+  // The same component decaying at 1.0 1/s, a quarter of the sum's: a mode of its own (a tone's
+  // decay is its parents' sum, whatever its frequency).
+  for (int seed = 1; seed <= 3; ++seed) {
+    const ModalResult result = IdentifyArm(ArmWithTone(1.0), seed);
+    ASSERT_EQ(result.modes.size(), 3u) << "seed " << seed;
+    for (const IdentifiedMode& mode : result.modes) EXPECT_TRUE(mode.combination.empty());
+  }
+}
+
+TEST(CombinationTonesTest, AHarmonicIsATone) {
+  // A component at twice the first mode's pole (a quadratic term of one mode): "2 f1".
+  SignalSpec spec = ArmWithTone(0);
+  spec.modes[2] = {2 * 3.0407, 2 * 1.2215, {0.0, 0.0, 0.03, 0.03}, {0.0, 0.0, 0.5, 0.5}};
+  const ModalResult result = IdentifyArm(spec, 1);
+  ASSERT_EQ(result.modes.size(), 3u);
+  EXPECT_EQ(result.modes[1].combination, "2 f1");  // 6.08 Hz, between the two modes
+}
+
+}  // namespace
+}  // namespace mbid::identification
