@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <optional>
 
 #include "estimate.h"
 #include "internal.h"
@@ -185,6 +186,16 @@ bool CarriesAmplitude(const Estimate& estimate) {
   return true;
 }
 
+// A trial estimate that starts from `estimate`'s poles and keeps its warnings and orders.
+Estimate TrialFrom(const Estimate& estimate) {
+  Estimate trial;
+  trial.warnings = estimate.warnings;
+  trial.model_order = estimate.model_order;
+  trial.effective_rank = estimate.effective_rank;
+  trial.lambda = estimate.lambda;
+  return trial;
+}
+
 // Refines `trial` (the estimate's modes and more) and tests it for significance; when it keeps
 // more significant modes, all carrying amplitude (and passes `accept`, if given), it replaces the
 // estimate. Returns how many modes it added (0: the estimate stands).
@@ -194,6 +205,8 @@ int KeepIfMoreModes(const AnalysisRecord& record, const IdentificationOptions& o
                     const std::function<bool(const Estimate&)>& accept = nullptr) {
   try {
     refine(&trial);
+    // A refit that `accept` refuses is not tested for significance (its drops refit again).
+    if (accept && !accept(trial)) return 0;
     SelectSignificant(record, options, &trial, refine);
   } catch (const NumericalError&) {
     return 0;  // nothing significant from this start: the estimate stands
@@ -234,11 +247,7 @@ void AddModesFromSingleChannels(const AnalysisRecord& record, const Identificati
                                          options.hankel.min_relative_singular_value, max_order);
     if (order == 0) continue;
     PolesByOrder poles_at(single, record.decimated_interval_s);
-    Estimate trial;
-    trial.warnings = estimate->warnings;
-    trial.model_order = estimate->model_order;
-    trial.effective_rank = estimate->effective_rank;
-    trial.lambda = estimate->lambda;
+    Estimate trial = TrialFrom(*estimate);
     for (const auto& lambda : poles_at.At(order)) {
       if (!IsCandidate(lambda, record, options) ||
           HasMatch(lambda, estimate->lambda, options.hankel.stability_tolerance)) {
@@ -303,26 +312,28 @@ void SplitCloseModes(const AnalysisRecord& record, const IdentificationOptions& 
       CalcChiSquareThreshold(2 * static_cast<int>(values.cols()), options.significance_false_alarm);
   int added = 0;
   const size_t modes = estimate->lambda.size();
+  // The modes' basis, its QR and the residual: once, and again after a kept split.
+  std::optional<Eigen::HouseholderQR<Eigen::MatrixXd>> model_qr;
+  Eigen::MatrixXd residual;
+  Eigen::VectorXd variance;
   for (size_t k = 0; k < modes && k < estimate->lambda.size(); ++k) {
-    Eigen::MatrixXd basis;
-    FillDampedSinusoidBasis(estimate->lambda, record.decimated_interval_s,
-                            options.offset == OffsetRemoval::kFit, static_cast<int>(samples),
-                            &basis);
-    if (basis.cols() + 4 >= samples) return;
-    const Eigen::HouseholderQR<Eigen::MatrixXd> model_qr(basis);
-    const Eigen::MatrixXd residual = values - estimate->fit.reconstruction.topRows(samples);
-    // A noiseless record's round-off is no second mode: the level at least 1e-6 of the RMS,
-    // as AssessReliability's.
-    Eigen::VectorXd variance = estimate->fit.residual_variance;
-    for (Eigen::Index c = 0; c < variance.size(); ++c) {
-      variance(c) = std::max(variance(c), 1e-12 * values.col(c).squaredNorm() / samples);
+    if (!model_qr) {
+      Eigen::MatrixXd basis;
+      FillDampedSinusoidBasis(estimate->lambda, record.decimated_interval_s,
+                              options.offset == OffsetRemoval::kFit, static_cast<int>(samples),
+                              &basis);
+      if (basis.cols() + 4 >= samples) return;
+      model_qr.emplace(basis);
+      residual = values - estimate->fit.reconstruction.topRows(samples);
+      // A noiseless record's round-off is no second mode: the level at least 1e-6 of the RMS,
+      // as AssessReliability's.
+      variance = estimate->fit.residual_variance;
+      for (Eigen::Index c = 0; c < variance.size(); ++c) {
+        variance(c) = std::max(variance(c), 1e-12 * values.col(c).squaredNorm() / samples);
+      }
     }
-    if (CloseModeScore(record, *estimate, model_qr, residual, variance, k) <= threshold) continue;
-    Estimate trial;
-    trial.warnings = estimate->warnings;
-    trial.model_order = estimate->model_order;
-    trial.effective_rank = estimate->effective_rank;
-    trial.lambda = estimate->lambda;
+    if (CloseModeScore(record, *estimate, *model_qr, residual, variance, k) <= threshold) continue;
+    Estimate trial = TrialFrom(*estimate);
     const std::complex<double> lambda = estimate->lambda[k];
     const std::complex<double> delta(0, 0.5 * std::max(-lambda.real(), 0.01 * lambda.imag()));
     trial.lambda[k] = lambda + delta;
@@ -333,7 +344,9 @@ void SplitCloseModes(const AnalysisRecord& record, const IdentificationOptions& 
                return std::abs(l - lambda) <= radius;
              }) >= 2;
     };
-    added += KeepIfMoreModes(record, options, refine, std::move(trial), estimate, is_pair);
+    const int split = KeepIfMoreModes(record, options, refine, std::move(trial), estimate, is_pair);
+    if (split > 0) model_qr.reset();
+    added += split;
   }
   if (added > 0) {
     estimate->warnings.push_back(fmt::format(
