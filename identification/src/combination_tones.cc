@@ -17,7 +17,7 @@ namespace {
 // Frequency within 3 standard deviations plus 0.2 % (the tone's pole is refined beside its
 // parents and shifted by their errors); decay within 3 standard deviations plus 25 % (a weak
 // tone's decay is the least determined of its quantities: 21 % off on the excavator arm). Only
-// where those 3 standard deviations are narrow (3 % of the frequency, half the decay) does a
+// where those 3 standard deviations are narrow (6 % of the frequency, the decay itself) does a
 // match tell a sum from a coincidence: a mode known to +- 0.8 Hz matches some sum of any others.
 bool Matches(const IdentifiedMode& tone, double frequency_hz, double decay_per_s,
              double variance_frequency, double variance_decay) {
@@ -25,7 +25,7 @@ bool Matches(const IdentifiedMode& tone, double frequency_hz, double decay_per_s
       3 * std::sqrt(variance_frequency + tone.std_frequency_hz * tone.std_frequency_hz);
   const double spread_decay =
       3 * std::sqrt(variance_decay + tone.std_decay_rate_per_s * tone.std_decay_rate_per_s);
-  if (!(spread_frequency <= 0.03 * tone.frequency_hz && spread_decay <= 0.5 * decay_per_s)) {
+  if (!(spread_frequency <= 0.06 * tone.frequency_hz && spread_decay <= decay_per_s)) {
     return false;
   }
   return std::abs(tone.frequency_hz - frequency_hz) <=
@@ -79,9 +79,10 @@ void MarkCombinationTones(ModalResult* result) {
     }
     if (!tone.combination.empty()) {
       result->warnings.push_back(fmt::format(
-          "the mode at {:.4g} Hz is a combination tone ({}): the sum of those modes' poles "
-          "in frequency and decay, weaker than both; a quadratic nonlinearity (centripetal "
-          "accelerations, joint geometry) makes it, not a mode of the structure",
+          "the mode at {:.4g} Hz is a combination tone ({}): it matches the sum of those modes' "
+          "poles in frequency and decay and is weaker than both; a quadratic nonlinearity "
+          "(centripetal accelerations, joint geometry) makes such a component, not a mode of "
+          "the structure",
           tone.frequency_hz, tone.combination));
     }
   }

@@ -19,22 +19,6 @@ using testing::MakeRecord;
 using testing::SignalSpec;
 using testing::Synthesize;
 
-// An aerial platform's load drop (200 Hz, 6 s, an inclinometer, two accelerometers and a gyro):
-// its boom's two bending modes 7.83 and 8.46 Hz at 11 and 15 % damping, 0.63 Hz apart against
-// half-power bandwidths of 1.8 and 2.5 Hz, with different shapes, about 20 times the noise at
-// the release (the platform's record: 19).
-SignalSpec PlatformWithCloseModes() {
-  SignalSpec spec;
-  spec.channels = {"incl", "acc_y", "acc_z", "gyro"};
-  spec.sample_interval_s = 0.005;
-  spec.samples = 1201;
-  spec.modes = {{0.9595, 0.109, {1.0, 1.0, 1.0, 1.0}, {0.0, 0.1, 0.2, 0.3}},
-                {6.697, 4.43, {0.1, 0.3, 0.3, 0.05}, {0.0, 0.5, 1.0, 0.2}},
-                {7.826, 5.57, {0.005, 0.04, 0.01, 0.02}, {0.0, 0.3, 2.0, 1.0}},
-                {8.464, 7.94, {0.005, 0.01, 0.04, 0.02}, {1.5, 0.0, 0.4, -2.0}}};
-  return spec;
-}
-
 Eigen::VectorXd PlatformNoise() {
   Eigen::VectorXd noise(4);
   noise << 1e-3, 2e-3, 2e-3, 2e-3;
@@ -50,7 +34,7 @@ TEST(CloseModesTest, TwoModesInsideEachOthersBandwidthAreSplit) {
   // At the signal order the pair is one mode at 8.10-8.22 Hz with a standard deviation of
   // 0.05 Hz (6 of them from either true mode), its residual at the noise level: reliable and
   // wrong. Its residual's Taylor terms are significant; split, both modes come back.
-  const SignalSpec spec = PlatformWithCloseModes();
+  const SignalSpec spec = testing::PlatformWithCloseModes(0.04);  // 20 times the noise
   const Eigen::MatrixXd clean = Synthesize(spec);
   for (int seed = 1; seed <= 5; ++seed) {
     std::mt19937_64 rng(seed);
@@ -72,7 +56,7 @@ TEST(CloseModesTest, TwoModesInsideEachOthersBandwidthAreSplit) {
 TEST(CloseModesTest, ASingleModeIsNotSplit) {
   // The same record with one mode where the pair was: its residual is noise, the score stays
   // under its threshold (a false alarm of 1e-3 per mode), nothing is split.
-  SignalSpec spec = PlatformWithCloseModes();
+  SignalSpec spec = testing::PlatformWithCloseModes(0.04);
   spec.modes.pop_back();
   for (double& a : spec.modes[2].amplitude) a *= 2;
   const Eigen::MatrixXd clean = Synthesize(spec);

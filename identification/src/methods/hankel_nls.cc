@@ -19,6 +19,7 @@
 #include "mbid/identification/significance.h"
 #include "methods/method.h"
 #include "mode_selection.h"
+#include "residual_windows.h"
 
 namespace mbid::identification {
 namespace {
@@ -233,12 +234,21 @@ void AddModesFromSingleChannels(const AnalysisRecord& record, const Identificati
                                 const std::function<void(Estimate*)>& refine, Estimate* estimate) {
   const Eigen::MatrixXd& values = record.decimated;
   if (values.cols() < 2) return;
+  // Also a channel whose residual has 4 times its noise power in some window (a weak tone at
+  // the start of an excavator's accelerometer record).
+  const Eigen::VectorXd window_ratio =
+      AnalyseResidualWindows(values, values - estimate->fit.reconstruction.topRows(values.rows()),
+                             options.significance_false_alarm)
+          .channel_ratio;
   int added = 0;
   for (Eigen::Index c = 0; c < values.cols(); ++c) {
     const Eigen::VectorXd& residual = estimate->fit.residual_variance;
     if (c >= residual.size() || c >= noise_std.size()) break;
     const double rms = std::sqrt(values.col(c).squaredNorm() / static_cast<double>(values.rows()));
-    if (!(std::sqrt(residual(c)) > 3 * std::max(noise_std(c), 1e-6 * rms))) continue;
+    if (!(std::sqrt(residual(c)) > 3 * std::max(noise_std(c), 1e-6 * rms)) &&
+        !(window_ratio(c) >= 4)) {
+      continue;
+    }
     // The channel's residual: the modes found no longer hide the one it lacks.
     const Eigen::VectorXd left =
         values.col(c) - estimate->fit.reconstruction.col(c).head(values.rows());
