@@ -253,13 +253,21 @@ std::string ModalTableMarkdown(const identification::ModalResult& result,
     return std::abs(x) < 1e-12 ? amplitude : amplitude * -std::expm1(-x) / x;
   };
   out << "| k | frequency, Hz | beta, 1/s | half-life ln2/beta, s | damping ratio |";
-  for (const std::string& channel : result.channels) out << " A_" << channel << ", rad |";
-  for (const std::string& channel : result.channels) out << " mean A_" << channel << ", rad |";
+  // Each channel's own unit (an accelerometer's amplitudes are no angles).
+  const auto unit = [&result](size_t c) {
+    return c < result.units.size() && !result.units[c].empty() ? result.units[c] : "rad";
+  };
+  for (size_t c = 0; c < result.channels.size(); ++c) {
+    out << fmt::format(" A_{}, {} |", result.channels[c], unit(c));
+  }
+  for (size_t c = 0; c < result.channels.size(); ++c) {
+    out << fmt::format(" mean A_{}, {} |", result.channels[c], unit(c));
+  }
   if (reference != nullptr) {
     out << fmt::format(" {0}: frequency, Hz | {0}: beta, 1/s |", reference_label);
     if (!reference->empty() && !reference->front().amplitude.empty()) {
-      for (const std::string& channel : result.channels) {
-        out << fmt::format(" {}: A_{}, rad |", reference_label, channel);
+      for (size_t c = 0; c < result.channels.size(); ++c) {
+        out << fmt::format(" {}: A_{}, {} |", reference_label, result.channels[c], unit(c));
       }
     }
   }
@@ -274,7 +282,11 @@ std::string ModalTableMarkdown(const identification::ModalResult& result,
   out << "\n";
   for (size_t k = 0; k < result.modes.size(); ++k) {
     const auto& mode = result.modes[k];
-    out << fmt::format("| {} | {:.4f} ± {:.2g} | {:.3f} ± {:.2g} | {:.3f} | {:.3f} |", k + 1,
+    // A combination tone is no mode of the structure: the table says so where it is read.
+    const std::string label =
+        mode.combination.empty() ? std::to_string(k + 1)
+                                 : fmt::format("{} (combination tone {})", k + 1, mode.combination);
+    out << fmt::format("| {} | {:.4f} ± {:.2g} | {:.3f} ± {:.2g} | {:.3f} | {:.3f} |", label,
                        mode.frequency_hz, mode.std_frequency_hz, -mode.decay_rate_per_s,
                        mode.std_decay_rate_per_s, mode.half_life_s, mode.damping_ratio);
     for (Eigen::Index c = 0; c < mode.amplitude.size(); ++c) {
@@ -292,12 +304,17 @@ std::string ModalTableMarkdown(const identification::ModalResult& result,
           nearest = &candidate;
         }
       }
-      out << fmt::format(" {:.4f} | {:.3f} |", nearest->frequency_hz, -nearest->decay_rate_per_s);
-      if (!nearest->amplitude.empty()) {
+      // A tone has no reference mode: the nearest one is not its counterpart.
+      const bool tone = !mode.combination.empty();
+      out << (tone ? std::string(" - | - |")
+                   : fmt::format(" {:.4f} | {:.3f} |", nearest->frequency_hz,
+                                 -nearest->decay_rate_per_s));
+      if (!reference->front().amplitude.empty()) {
         for (const std::string& channel : result.channels) {
           const auto found = nearest->amplitude.find(channel);
-          out << (found == nearest->amplitude.end() ? std::string(" - |")
-                                                    : fmt::format(" {:.2e} |", found->second));
+          out << (tone || found == nearest->amplitude.end()
+                      ? std::string(" - |")
+                      : fmt::format(" {:.2e} |", found->second));
         }
       }
     }

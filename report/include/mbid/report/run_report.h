@@ -57,7 +57,7 @@ std::string BackboneMarkdown(const identification::ModalResult& result);
 struct ReferenceMode {
   double frequency_hz = 0;
   double decay_rate_per_s = 0;
-  std::map<std::string, double> amplitude;  // per channel, rad; empty if not known
+  std::map<std::string, double> amplitude;  // per channel, its unit; empty if not known
 };
 
 // The paper's Table 1 in Markdown: identified modes (frequency, decay, half-life, amplitudes
