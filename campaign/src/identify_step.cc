@@ -36,6 +36,8 @@ std::shared_ptr<const identification::ModalResult> RunIdentifyStep(const StepInp
     row[prefix + "damping_ratio"] = Number(mode.damping_ratio);
     row[prefix + "std_frequency_hz"] = Number(mode.std_frequency_hz);
     row[prefix + "std_decay_rate_per_s"] = Number(mode.std_decay_rate_per_s);
+    // Empty for a mode; "f1 + f3" for a combination tone, no mode of the structure.
+    row[prefix + "combination"] = mode.combination;
     for (size_t c = 0; c < result->channels.size(); ++c) {
       row[prefix + "amplitude." + result->channels[c]] =
           Number(mode.amplitude[static_cast<Eigen::Index>(c)]);

@@ -72,6 +72,7 @@ TEST_F(CampaignCliTest, OneAndTwoWorkersGiveTheSameFileBitForBit) {
   const std::string csv = ReadText(dir_ / "one" / "summary.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7);
   EXPECT_NE(csv.find("identified.mode1.frequency_hz"), std::string::npos);
+  EXPECT_NE(csv.find("identified.mode1.combination"), std::string::npos);  // empty: a mode
   // Whether the data support each case's modes, beside them (docs/campaigns.md).
   EXPECT_NE(csv.find("identified.modes,identified.reliable,identified.reasons,"), std::string::npos)
       << csv.substr(0, csv.find('\n'));
