@@ -104,6 +104,10 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
   json["significance_threshold"] = NumberOrNull(result.significance_threshold);
   json["offset"] = PerChannel(result.channels, result.offset);
   json["noise_std"] = PerChannel(result.channels, result.noise_std);
+  if (result.residual_to_noise.size() > 0) {
+    json["residual_to_noise"] = PerChannel(result.channels, result.residual_to_noise);
+    json["residual_window_ratio"] = PerChannel(result.channels, result.residual_window_ratio);
+  }
   json["termination"] = result.termination;
   json["iterations"] = result.iterations;
   if (result.has_spectrum) {
@@ -221,6 +225,11 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result, const std::st
     writer.WriteScalar(sub("correlation"), channel, result.correlation(c), "1");
     writer.WriteScalar(sub("offset"), channel, result.offset(c), UnitOf(result, c));
     writer.WriteScalar(sub("noise_std"), channel, result.noise_std(c), UnitOf(result, c));
+    if (result.residual_to_noise.size() > 0) {
+      writer.WriteScalar(sub("residual_to_noise"), channel, result.residual_to_noise(c), "1");
+      writer.WriteScalar(sub("residual_window_ratio"), channel, result.residual_window_ratio(c),
+                         "1");
+    }
     if (result.drift_per_s.size() > 0) {
       writer.WriteScalar(sub("drift_per_s"), channel, result.drift_per_s(c),
                          UnitOf(result, c) + "/s");

@@ -70,6 +70,8 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
         from_s, from_s + windows.excess->samples * tau, windows.excess->power_ratio);
     (windows.excess->power_ratio >= 3 ? reasons : result->warnings).push_back(what);
   }
+  result->residual_to_noise = ratios;
+  result->residual_window_ratio = windows.channel_ratio;
   for (Eigen::Index c = 0; c < result->correlation.size(); ++c) {
     if (!(result->correlation(c) >= options.min_correlation)) {
       // A residual at the noise level is the noise: then the channel's signal is too weak for

@@ -232,7 +232,13 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readonly("release_time_s", &mbid::ModalResult::release_time_s)
       .def_readonly("model_order", &mbid::ModalResult::model_order)
       .def_property_readonly("correlation",
-                             [](const mbid::ModalResult& r) { return ToArray(r.correlation); });
+                             [](const mbid::ModalResult& r) { return ToArray(r.correlation); })
+      .def_property_readonly(
+          "residual_to_noise",
+          [](const mbid::ModalResult& r) { return ToArray(r.residual_to_noise); })
+      .def_property_readonly("residual_window_ratio", [](const mbid::ModalResult& r) {
+        return ToArray(r.residual_window_ratio);
+      });
 
   py::class_<mbid::ParameterValue>(m, "Parameter")
       .def_readonly("value", &mbid::ParameterValue::value)

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "mbid/identification/identify.h"
+#include "mbid/identification/modal_result.h"
 #include "signals.h"
 
 namespace mbid::identification {
@@ -111,6 +112,17 @@ TEST(ResidualWindowsTest, ATransientAtTheStartMakesTheResultUnreliable) {
                             return r.find("the residual from 0 to 0.12 s") != std::string::npos;
                           }))
       << ::testing::PrintToString(result.reasons) << ::testing::PrintToString(result.warnings);
+  // The margins beside the verdict, per channel: the ramp's channel far past 3 in its window,
+  // the other at the noise; over the whole record both under the 3 of the residual check.
+  ASSERT_EQ(result.residual_window_ratio.size(), 2);
+  EXPECT_GT(result.residual_window_ratio(0), 3);
+  EXPECT_LT(result.residual_window_ratio(1), 3);
+  ASSERT_EQ(result.residual_to_noise.size(), 2);
+  EXPECT_LT(result.residual_to_noise.maxCoeff(), 3);
+  const nlohmann::json json = ModalResultToJson(result);
+  EXPECT_DOUBLE_EQ(json["residual_window_ratio"]["a"].get<double>(),
+                   result.residual_window_ratio(0));
+  EXPECT_DOUBLE_EQ(json["residual_to_noise"]["b"].get<double>(), result.residual_to_noise(1));
 }
 
 }  // namespace

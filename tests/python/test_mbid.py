@@ -58,6 +58,7 @@ class IdentifyTest(unittest.TestCase):
              + 0.5 * np.exp(-0.8 * t) * np.sin(2 * np.pi * 5.5 * t))
         result = mbid.identify_arrays(t, {"x": y}, {"x": "m"})
         self.assertEqual(len(result.modes), 2)
+        self.assertLess(result.residual_to_noise[0], 3)  # both modes: nothing left
         self.assertAlmostEqual(result.modes[0].frequency_hz, 2.0, delta=2e-6)
         self.assertAlmostEqual(result.modes[0].decay_rate_per_s, 0.3, delta=3e-7)
         self.assertAlmostEqual(result.modes[1].frequency_hz, 5.5, delta=5.5e-6)
@@ -82,6 +83,9 @@ class IdentifyTest(unittest.TestCase):
         mode = banded.modes[0]
         self.assertAlmostEqual(mode.frequency_hz, 2.0, delta=2 * mode.std_frequency_hz)
         self.assertFalse(banded.reliable)
+        # Its margin says by how much: the 5.5 Hz mode left in the residual, far above 3.
+        self.assertEqual(banded.residual_to_noise.shape, (1,))
+        self.assertGreater(banded.residual_to_noise[0], 3)
         prony = mbid.IdentificationOptions()
         prony.method = "prony-svd"
         prony.release = "none"

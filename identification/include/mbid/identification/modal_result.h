@@ -87,7 +87,13 @@ struct ModalResult {
   // Per channel: the linear drift removed (remove_drift), channel units per second; the record's
   // baseline is then offset + drift (t - start_time_s). Empty when not asked.
   Eigen::VectorXd drift_per_s;
-  Eigen::VectorXd noise_std;       // per channel: residual standard deviation
+  Eigen::VectorXd noise_std;  // per channel: residual standard deviation
+  // Per channel, the margins of the residual checks of `reliable`: the residual's standard
+  // deviation over the record's noise level (a reason above 3), and its largest window power
+  // over its median window's (residual_windows.h; 0 on records too short for the windows).
+  // Empty when not assessed.
+  Eigen::VectorXd residual_to_noise;
+  Eigen::VectorXd residual_window_ratio;
   Eigen::MatrixXd reconstruction;  // samples x channels, offset included
   // eq. 5: [A1 ... Ap] of eq. 2 (m x m p) from the modes' poles and output vectors; empty if
   // not computed.
