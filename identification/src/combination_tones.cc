@@ -61,7 +61,7 @@ void MarkCombinationTones(ModalResult* result) {
         if (a == m || b == m || !(largest[m] < std::min(largest[a], largest[b]))) continue;
         const IdentifiedMode& low = modes[a];
         const IdentifiedMode& high = modes[b];
-        if (!modes[a].combination.empty() && !modes[b].combination.empty()) continue;
+        if (!low.combination.empty() && !high.combination.empty()) continue;
         const double variance_frequency =
             Square(low.std_frequency_hz) + Square(high.std_frequency_hz);
         const double variance_decay =

@@ -218,29 +218,20 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   }
   const int rest = static_cast<int>(std::ceil(t0));  // samples before the release
   if (rest < kMinRestSamples + 1) return detection;
-  // The segment before must really be at rest: within kRestFraction of its own median.
+  // The segment before must really be at rest: within kRestFraction of its own median. A short
+  // "rest" at the record's very start may be the first samples of a release from rest that the
+  // cubic cannot follow over its window (the crane's load drop recorded from the release: 5
+  // samples "at rest" while phi moved 49 noise standard deviations, the release put 45 ms
+  // late). Where fewer than kShortRestSamples precede the release, each channel must also stay
+  // within 6 noise standard deviations of that median (the noise from the whole record's third
+  // differences; a coarsely sampled decay overstates it, which leaves the test lenient).
   for (Eigen::Index c = 0; c < m; ++c) {
     std::vector<double> before(y.col(c).data(), y.col(c).data() + rest);
     std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
     const double level = before[before.size() / 2];
-    if ((y.col(c).head(rest).array() - level).abs().maxCoeff() > kRestFraction * range(c)) {
-      return detection;
-    }
-  }
-  // A short "rest" at the record's very start may be the first samples of a release from rest
-  // that the cubic cannot follow over its window (the crane's load drop recorded from the
-  // release: 5 samples "at rest" while phi moved 49 noise standard deviations, the release put
-  // 45 ms late). Where fewer than kShortRestSamples precede the release, each channel must stay
-  // within 6 noise standard deviations of its level there (the noise from the whole record's
-  // third differences; a coarsely sampled decay overstates it, which leaves the test lenient).
-  if (rest < kShortRestSamples) {
-    for (Eigen::Index c = 0; c < m; ++c) {
-      const double sigma = ThirdDifferenceNoise(y.col(c));
-      std::vector<double> before(y.col(c).data(), y.col(c).data() + rest);
-      std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
-      const double level = before[before.size() / 2];
-      if ((y.col(c).head(rest).array() - level).abs().maxCoeff() > 6 * sigma) return detection;
-    }
+    double bound = kRestFraction * range(c);
+    if (rest < kShortRestSamples) bound = std::min(bound, 6 * ThirdDifferenceNoise(y.col(c)));
+    if ((y.col(c).head(rest).array() - level).abs().maxCoeff() > bound) return detection;
   }
   detection.detected = true;
   detection.from_rest = !jumps;

@@ -161,11 +161,9 @@ TEST(IdentifyTest, AGlitchMakesTheResultUnreliable) {
   }
 }
 
-TEST(IdentifyTest, AModeSeenByOneChannelOfFourIsFound) {
-  // An aerial platform's load drop (6 coordinates): its 1.08 Hz slew mode shows in the
-  // turret's gyro alone, 12 % above the 0.96 Hz luffing mode that all four channels see. In the
-  // summed Hankel matrix it brings one channel's energy against four channels' noise and stays
-  // under the signal order; the gyro's residual (5 times its noise) is searched alone.
+// An aerial platform's load drop (200 Hz, 6 s): its 0.96 Hz luffing mode in all four channels,
+// its 1.08 Hz slew mode in the turret's gyro alone, its 6.7 Hz mode in all but the gyro.
+SignalSpec PlatformWithAGyroMode() {
   SignalSpec spec;
   spec.channels = {"incl", "acc_y", "acc_z", "gyro"};
   spec.sample_interval_s = 0.005;  // 200 Hz, 6 s
@@ -173,6 +171,15 @@ TEST(IdentifyTest, AModeSeenByOneChannelOfFourIsFound) {
   spec.modes = {{0.9595, 0.109, {1.0, 1.0, 1.0, 1.0}, {0.0, 0.1, 0.2, 0.3}},
                 {1.0805, 0.159, {0.0, 0.0, 0.0, 0.35}, {0.0, 0.0, 0.0, 1.0}},
                 {6.697, 4.43, {0.1, 0.3, 0.3, 0.0}, {0.0, 0.5, 1.0, 0.0}}};
+  return spec;
+}
+
+TEST(IdentifyTest, AModeSeenByOneChannelOfFourIsFound) {
+  // An aerial platform's load drop (6 coordinates): its 1.08 Hz slew mode shows in the
+  // turret's gyro alone, 12 % above the 0.96 Hz luffing mode that all four channels see. In the
+  // summed Hankel matrix it brings one channel's energy against four channels' noise and stays
+  // under the signal order; the gyro's residual (5 times its noise) is searched alone.
+  const SignalSpec spec = PlatformWithAGyroMode();
   const Eigen::MatrixXd clean = Synthesize(spec);
   std::mt19937_64 rng(5);
   Eigen::VectorXd noise(4);
@@ -191,13 +198,7 @@ TEST(IdentifyTest, AModeFoundInOneChannelLeavesTheResidualCheckInPlace) {
   // (a hydraulic pump's whine): no sum of decaying modes. The gyro's mode is found alone; the
   // inclinometer's residual must still be weighed against the record's noise (the estimate that
   // found the extra mode once lost that level, and the check passed unnoticed).
-  SignalSpec spec;
-  spec.channels = {"incl", "acc_y", "acc_z", "gyro"};
-  spec.sample_interval_s = 0.005;
-  spec.samples = 1201;
-  spec.modes = {{0.9595, 0.109, {1.0, 1.0, 1.0, 1.0}, {0.0, 0.1, 0.2, 0.3}},
-                {1.0805, 0.159, {0.0, 0.0, 0.0, 0.35}, {0.0, 0.0, 0.0, 1.0}},
-                {6.697, 4.43, {0.1, 0.3, 0.3, 0.0}, {0.0, 0.5, 1.0, 0.0}}};
+  const SignalSpec spec = PlatformWithAGyroMode();
   Eigen::MatrixXd clean = Synthesize(spec);
   for (int j = 0; j < spec.samples; ++j) {
     const double t = j * spec.sample_interval_s;

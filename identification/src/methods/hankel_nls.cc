@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <string>
 
 #include "estimate.h"
 #include "internal.h"
@@ -197,6 +198,13 @@ Estimate TrialFrom(const Estimate& estimate) {
   return trial;
 }
 
+// The warning of a search that added modes: "<added> more significant mode(s) <how>".
+void NoteAddedModes(int added, const std::string& how, Estimate* estimate) {
+  if (added > 0) {
+    estimate->warnings.push_back(fmt::format("{} more significant mode(s) {}", added, how));
+  }
+}
+
 // Refines `trial` (the estimate's modes and more) and tests it for significance; when it keeps
 // more significant modes, all carrying amplitude (and passes `accept`, if given), it replaces the
 // estimate. Returns how many modes it added (0: the estimate stands).
@@ -268,12 +276,9 @@ void AddModesFromSingleChannels(const AnalysisRecord& record, const Identificati
     if (trial.lambda.size() == estimate->lambda.size()) continue;
     added += KeepIfMoreModes(record, options, refine, std::move(trial), estimate);
   }
-  if (added > 0) {
-    estimate->warnings.push_back(fmt::format(
-        "{} more significant mode(s) found in single channels whose residual the other modes "
-        "left above the noise",
-        added));
-  }
+  NoteAddedModes(added,
+                 "found in single channels whose residual the other modes left above the noise",
+                 estimate);
 }
 
 // The score of "mode k hides a second one": two poles lambda +- delta whose shapes differ add,
@@ -345,10 +350,12 @@ void SplitCloseModes(const AnalysisRecord& record, const IdentificationOptions& 
     if (CloseModeScore(record, *estimate, *model_qr, residual, variance, k) <= threshold) continue;
     Estimate trial = TrialFrom(*estimate);
     const std::complex<double> lambda = estimate->lambda[k];
-    const std::complex<double> delta(0, 0.5 * std::max(-lambda.real(), 0.01 * lambda.imag()));
+    // The half-power half bandwidth, rad/s: the decay rate, at least 1 % of the frequency.
+    const double half_width = std::max(-lambda.real(), 0.01 * lambda.imag());
+    const std::complex<double> delta(0, 0.5 * half_width);
     trial.lambda[k] = lambda + delta;
     trial.lambda.push_back(lambda - delta);
-    const double radius = 1.5 * std::max(-lambda.real(), 0.01 * lambda.imag());
+    const double radius = 1.5 * half_width;
     const auto is_pair = [lambda, radius](const Estimate& split) {
       return std::count_if(split.lambda.begin(), split.lambda.end(), [&](std::complex<double> l) {
                return std::abs(l - lambda) <= radius;
@@ -358,12 +365,8 @@ void SplitCloseModes(const AnalysisRecord& record, const IdentificationOptions& 
     if (split > 0) model_qr.reset();
     added += split;
   }
-  if (added > 0) {
-    estimate->warnings.push_back(fmt::format(
-        "{} more significant mode(s) found by splitting modes whose residual holds a second, "
-        "close one",
-        added));
-  }
+  NoteAddedModes(added, "found by splitting modes whose residual holds a second, close one",
+                 estimate);
 }
 
 // HankelOptions::extra_orders: restarts from every pole at the orders above the signal order;
@@ -384,11 +387,9 @@ void AddModesFromHigherOrders(const AnalysisRecord& record, const Identification
     if (trial.lambda.size() <= estimate->lambda.size()) continue;
     added += KeepIfMoreModes(record, options, refine, std::move(trial), estimate);
   }
-  if (added > 0) {
-    estimate->warnings.push_back(fmt::format(
-        "{} more significant mode(s) found by restarting from orders above the signal order {}",
-        added, order));
-  }
+  NoteAddedModes(added,
+                 fmt::format("found by restarting from orders above the signal order {}", order),
+                 estimate);
 }
 
 Estimate EstimateHankelNls(const AnalysisRecord& record, const IdentificationOptions& options) {
