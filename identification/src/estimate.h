@@ -30,6 +30,7 @@ struct Estimate {
   int iterations = 0;
   std::vector<StabilizationOrder> stabilization;
   std::vector<std::string> warnings;
+  std::vector<std::string> doubts;  // what the data do not support: AssessReliability's reasons
 };
 
 // NumericalError("identification", "no modes found: <reason>").

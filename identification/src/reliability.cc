@@ -10,6 +10,12 @@
 
 namespace mbid::identification {
 
+bool IsDetermined(double frequency_hz, double std_frequency_hz, double decay_rate_per_s,
+                  double std_decay_rate_per_s) {
+  return !(std_frequency_hz > 0.1 * frequency_hz ||
+           (decay_rate_per_s > 0 && std_decay_rate_per_s > decay_rate_per_s));
+}
+
 std::vector<std::string> RecordFaults(const AnalysisRecord& record) {
   std::vector<std::string> faults;
   for (Eigen::Index c = 0; c < record.values.cols(); ++c) {
@@ -32,6 +38,7 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   std::vector<std::string>& reasons = result->reasons;
   const std::vector<std::string> faults = RecordFaults(record);
   reasons.insert(reasons.end(), faults.begin(), faults.end());
+  reasons.insert(reasons.end(), estimate.doubts.begin(), estimate.doubts.end());
   // The fit's residual against the record's own noise level: a record the modes explain leaves
   // noise (ratio about 1; coloured noise a little more). 3 x the noise, or a residual above a
   // millionth of the signal when the record is noiseless, means something in the record is not
@@ -101,8 +108,8 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
       reasons.push_back(fmt::format("the mode at {:.4g} Hz is at the bottom of the band ({} Hz)",
                                     mode.frequency_hz, options.min_frequency_hz));
     }
-    if (mode.std_frequency_hz > 0.1 * mode.frequency_hz ||
-        (mode.decay_rate_per_s > 0 && mode.std_decay_rate_per_s > mode.decay_rate_per_s)) {
+    if (!IsDetermined(mode.frequency_hz, mode.std_frequency_hz, mode.decay_rate_per_s,
+                      mode.std_decay_rate_per_s)) {
       reasons.push_back(fmt::format(
           "the mode at {:.4g} Hz is undetermined (std of frequency {:.3g} Hz, of decay {:.3g} "
           "1/s)",

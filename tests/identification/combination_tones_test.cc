@@ -65,6 +65,25 @@ TEST(CombinationTonesTest, AModeAtASumFrequencyWithItsOwnDecayIsAMode) {
   }
 }
 
+TEST(CombinationTonesTest, AModeAtASumWithAToneTooStrongIsAModeWithAWarning) {
+  // The component at the sum's pole with 0.15 in the accelerometers: weaker than both modes
+  // (largest 2.0 and 1.5) but 7.5 % of the stronger's amplitude, where a quadratic tone of small
+  // vibrations has under 2 % (the reference crane's third mode sits at f1 + f2 so, with 5 %).
+  SignalSpec spec = ArmWithTone(1.2215 + 3.5092);
+  spec.modes[2].amplitude = {0.0, 0.0, 0.15, 0.15};
+  for (int seed = 1; seed <= 3; ++seed) {
+    const ModalResult result = IdentifyArm(spec, seed);
+    ASSERT_EQ(result.modes.size(), 3u) << "seed " << seed;
+    for (const IdentifiedMode& mode : result.modes) EXPECT_TRUE(mode.combination.empty());
+    EXPECT_TRUE(std::any_of(result.warnings.begin(), result.warnings.end(),
+                            [](const std::string& w) {
+                              return w.find("lies where a combination tone would (f1 + f2 with ") !=
+                                     std::string::npos;
+                            }))
+        << ::testing::PrintToString(result.warnings);
+  }
+}
+
 TEST(CombinationTonesTest, AHarmonicIsATone) {
   // A component at twice the first mode's pole (a quadratic term of one mode): "2 f1".
   SignalSpec spec = ArmWithTone(0);
