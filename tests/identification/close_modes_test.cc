@@ -1,5 +1,5 @@
 // Two modes closer than their bandwidths, which the Hankel matrix's signal order counts as one
-// (hankel_nls.cc: SplitCloseModes), and combination tones of a quadratic nonlinearity
+// (close_modes.cc: SplitCloseModes), and combination tones of a quadratic nonlinearity
 // (combination_tones.cc).
 #include <gtest/gtest.h>
 
