@@ -103,12 +103,11 @@ void SplitCloseModes(const AnalysisRecord& record, const IdentificationOptions& 
                               &basis);
       if (basis.cols() + 4 >= samples) return 0.0;
       model_qr.emplace(basis);
-      residual = values - estimate->fit.reconstruction.topRows(samples);
-      // A noiseless record's round-off is no second mode: the level at least 1e-6 of the RMS,
-      // as AssessReliability's.
+      residual = DecimatedResidual(record, *estimate);
+      // A noiseless record's round-off is no second mode: AssessReliability's floor.
       variance = estimate->fit.residual_variance;
       for (Eigen::Index c = 0; c < variance.size(); ++c) {
-        variance(c) = std::max(variance(c), 1e-12 * values.col(c).squaredNorm() / samples);
+        variance(c) = std::max(variance(c), std::pow(RoundOffNoiseStd(values, c), 2));
       }
     }
     return CloseModeScore(record, *estimate, *model_qr, residual, variance, k);

@@ -7,6 +7,14 @@
 
 namespace mbid::identification {
 
+Eigen::MatrixXd DecimatedResidual(const AnalysisRecord& record, const Estimate& estimate) {
+  return record.decimated - estimate.fit.reconstruction.topRows(record.decimated.rows());
+}
+
+double RoundOffNoiseStd(const Eigen::MatrixXd& values, Eigen::Index c) {
+  return 1e-6 * std::sqrt(values.col(c).squaredNorm() / static_cast<double>(values.rows()));
+}
+
 void NoModes(const std::string& reason) {
   throw NumericalError("identification", "no modes found: " + reason);
 }

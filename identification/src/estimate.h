@@ -11,6 +11,7 @@
 #include "mbid/identification/modal_fit.h"
 #include "mbid/identification/modal_result.h"
 #include "mbid/identification/options.h"
+#include "record.h"
 
 namespace mbid::identification {
 
@@ -32,6 +33,13 @@ struct Estimate {
   std::vector<std::string> warnings;
   std::vector<std::string> doubts;  // what the data do not support: AssessReliability's reasons
 };
+
+// The decimated record less the estimate's fit: what its modes leave, samples x channels.
+Eigen::MatrixXd DecimatedResidual(const AnalysisRecord& record, const Estimate& estimate);
+
+// The lowest noise level channel c of `values` is judged against: a noiseless record's
+// round-off, 1e-6 of the channel's RMS (in variance, 1e-12 of its mean square).
+double RoundOffNoiseStd(const Eigen::MatrixXd& values, Eigen::Index c);
 
 // NumericalError("identification", "no modes found: <reason>").
 [[noreturn]] void NoModes(const std::string& reason);

@@ -25,7 +25,7 @@ bool CarriesAmplitude(const Estimate& estimate) {
 
 }  // namespace
 
-// A trial estimate that starts from `estimate`'s poles and keeps its warnings and orders.
+// A trial estimate that starts from `estimate`'s poles and keeps its warnings, doubts and orders.
 Estimate TrialFrom(const Estimate& estimate) {
   Estimate trial;
   trial.warnings = estimate.warnings;

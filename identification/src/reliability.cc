@@ -46,8 +46,7 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   const Eigen::VectorXd& residual = estimate.fit.residual_variance;
   Eigen::VectorXd ratios = Eigen::VectorXd::Constant(result->correlation.size(), 0.0);
   for (Eigen::Index c = 0; c < residual.size() && c < estimate.noise_std.size(); ++c) {
-    const double rms = std::sqrt(record.decimated.col(c).squaredNorm() / record.decimated.rows());
-    const double level = std::max(estimate.noise_std(c), 1e-6 * rms);
+    const double level = std::max(estimate.noise_std(c), RoundOffNoiseStd(record.decimated, c));
     const double ratio = std::sqrt(residual(c)) / level;
     if (c < ratios.size()) ratios(c) = ratio;
     if (ratio > 3) {
@@ -64,9 +63,7 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   // (a drill mast's record), as does a pair of boom modes at 10 times the noise that a stronger
   // mode absorbed (2.2-2.4).
   const ResidualWindows windows = AnalyseResidualWindows(
-      record.decimated,
-      record.decimated - estimate.fit.reconstruction.topRows(record.decimated.rows()),
-      options.significance_false_alarm);
+      record.decimated, DecimatedResidual(record, estimate), options.significance_false_alarm);
   if (windows.excess) {
     const double tau = record.decimated_interval_s;
     const double from_s = record.decimated_start_time_s + windows.excess->first_sample * tau;

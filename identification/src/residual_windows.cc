@@ -1,8 +1,10 @@
 #include "residual_windows.h"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
+#include "estimate.h"
 #include "mbid/identification/significance.h"
 
 namespace mbid::identification {
@@ -26,8 +28,9 @@ ResidualWindows AnalyseResidualWindows(const Eigen::MatrixXd& values,
     // The median window's power is the noise's: robust to the few windows that are not noise.
     std::vector<double> sorted(power.col(c).data(), power.col(c).data() + windows);
     std::nth_element(sorted.begin(), sorted.begin() + windows / 2, sorted.end());
+    // A noiseless record's round-off is no excess: AssessReliability's floor.
     const double level = std::max(sorted[static_cast<size_t>(windows / 2)],
-                                  1e-12 * values.col(c).squaredNorm() / values.rows());
+                                  std::pow(RoundOffNoiseStd(values, c), 2));
     if (level > 0) {
       power.col(c) /= level;
     } else {

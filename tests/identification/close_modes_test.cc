@@ -25,6 +25,12 @@ Eigen::VectorXd PlatformNoise() {
   return noise;
 }
 
+// `spec` with the platform's noise drawn from `seed`, identified with the default options.
+ModalResult IdentifyNoisyPlatform(const SignalSpec& spec, const Eigen::MatrixXd& clean, int seed) {
+  std::mt19937_64 rng(seed);
+  return Identify(MakeRecord(spec, testing::AddNoise(clean, PlatformNoise(), &rng)), {});
+}
+
 bool Warns(const ModalResult& result, const std::string& text) {
   return std::any_of(result.warnings.begin(), result.warnings.end(),
                      [&](const std::string& w) { return w.find(text) != std::string::npos; });
@@ -37,9 +43,7 @@ TEST(CloseModesTest, TwoModesInsideEachOthersBandwidthAreSplit) {
   const SignalSpec spec = testing::PlatformWithCloseModes(0.04);  // 20 times the noise
   const Eigen::MatrixXd clean = Synthesize(spec);
   for (int seed = 1; seed <= 5; ++seed) {
-    std::mt19937_64 rng(seed);
-    const ModalResult result =
-        Identify(MakeRecord(spec, testing::AddNoise(clean, PlatformNoise(), &rng)), {});
+    const ModalResult result = IdentifyNoisyPlatform(spec, clean, seed);
     ASSERT_EQ(result.modes.size(), 4u) << "seed " << seed;
     EXPECT_TRUE(Warns(result, "splitting")) << "seed " << seed;
     for (size_t k = 0; k < 4; ++k) {
@@ -61,9 +65,7 @@ TEST(CloseModesTest, ASingleModeIsNotSplit) {
   for (double& a : spec.modes[2].amplitude) a *= 2;
   const Eigen::MatrixXd clean = Synthesize(spec);
   for (int seed = 1; seed <= 5; ++seed) {
-    std::mt19937_64 rng(seed);
-    const ModalResult result =
-        Identify(MakeRecord(spec, testing::AddNoise(clean, PlatformNoise(), &rng)), {});
+    const ModalResult result = IdentifyNoisyPlatform(spec, clean, seed);
     ASSERT_EQ(result.modes.size(), 3u) << "seed " << seed;
     EXPECT_FALSE(Warns(result, "splitting")) << "seed " << seed;
     EXPECT_FALSE(Warns(result, "shape of its own")) << "seed " << seed;
@@ -80,9 +82,7 @@ TEST(CloseModesTest, APairAbsorbedByAStrongerModeIsWarnedOf) {
   const Eigen::MatrixXd clean = Synthesize(spec);
   int warned = 0;
   for (int seed = 1; seed <= 5; ++seed) {
-    std::mt19937_64 rng(seed);
-    const ModalResult result =
-        Identify(MakeRecord(spec, testing::AddNoise(clean, PlatformNoise(), &rng)), {});
+    const ModalResult result = IdentifyNoisyPlatform(spec, clean, seed);
     if (result.modes.size() == 2u && Warns(result, "shape of its own")) ++warned;
   }
   // Each seed's score is a draw: at least 3 of 5 above the threshold (all 5 measured).

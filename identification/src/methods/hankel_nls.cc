@@ -188,15 +188,14 @@ void AddModesFromSingleChannels(const AnalysisRecord& record, const Identificati
   // Also a channel whose residual has 4 times its noise power in some window (a weak tone at
   // the start of an excavator's accelerometer record).
   const Eigen::VectorXd window_ratio =
-      AnalyseResidualWindows(values, values - estimate->fit.reconstruction.topRows(values.rows()),
+      AnalyseResidualWindows(values, DecimatedResidual(record, *estimate),
                              options.significance_false_alarm)
           .channel_ratio;
   int added = 0;
   for (Eigen::Index c = 0; c < values.cols(); ++c) {
     const Eigen::VectorXd& residual = estimate->fit.residual_variance;
     if (c >= residual.size() || c >= noise_std.size()) break;
-    const double rms = std::sqrt(values.col(c).squaredNorm() / static_cast<double>(values.rows()));
-    if (!(std::sqrt(residual(c)) > 3 * std::max(noise_std(c), 1e-6 * rms)) &&
+    if (!(std::sqrt(residual(c)) > 3 * std::max(noise_std(c), RoundOffNoiseStd(values, c))) &&
         !(window_ratio(c) >= 4)) {
       continue;
     }
