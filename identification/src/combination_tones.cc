@@ -9,7 +9,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <optional>
 #include <string>
+#include <vector>
+
+#include "mbid/identification/modal_fit.h"
+#include "mbid/identification/significance.h"
 
 namespace mbid::identification {
 namespace {
@@ -54,9 +60,169 @@ double Square(double x) { return x * x; }
 // with 5-18 % of the stronger one's amplitude: a mode.
 constexpr double kMaxToneRatio = 0.02;
 
+constexpr size_t kMaxParents = 6;
+constexpr size_t kMaxProducts = 8;
+
+// A product of the parents' poles: sum_i count_i lambda_i, a negative count taking the
+// conjugate (the difference frequency).
+struct Product {
+  std::complex<double> lambda;
+  std::string name;  // "2 f3", "f1 + f2 - f3", 1-based in `modes`
+};
+
+std::string ProductName(std::vector<std::pair<size_t, int>> terms) {
+  // "f1 + 2 f2 - f3": added terms first, each group in the modes' order.
+  std::sort(terms.begin(), terms.end(), [](const auto& a, const auto& b) {
+    return (a.second > 0) != (b.second > 0) ? a.second > 0 : a.first < b.first;
+  });
+  std::string name;
+  for (const auto& [mode, count] : terms) {
+    if (count == 0) continue;
+    const int size = std::abs(count);
+    const std::string term =
+        (size > 1 ? fmt::format("{} ", size) : "") + fmt::format("f{}", mode + 1);
+    name += name.empty() ? (count < 0 ? "-" + term : term) : (count < 0 ? " - " : " + ") + term;
+  }
+  return name;
+}
+
+// Whether the half-power bands of a pole and a mode overlap: their frequencies differ by less
+// than the sum of their half widths (decay / (2 pi) in Hz).
+bool Overlap(std::complex<double> lambda, const IdentifiedMode& mode) {
+  return std::abs(lambda.imag() / (2 * M_PI) - mode.frequency_hz) <=
+         (mode.decay_rate_per_s - lambda.real()) / (2 * M_PI);
+}
+
+// The second- and third-order products of `parents` whose half-power band overlaps
+// `candidate`'s (farther ones cannot be mistaken for it) and below the Nyquist frequency.
+std::vector<Product> NearbyProducts(const std::vector<IdentifiedMode>& modes,
+                                    const std::vector<size_t>& parents,
+                                    const IdentifiedMode& candidate, double nyquist_hz) {
+  std::vector<Product> products;
+  const auto add = [&](std::vector<std::pair<size_t, int>> terms) {
+    std::complex<double> lambda = 0;
+    for (const auto& [mode, count] : terms) {
+      const std::complex<double> pole = modes[mode].lambda;
+      lambda += count > 0 ? double(count) * pole : double(-count) * std::conj(pole);
+    }
+    if (lambda.imag() < 0) {  // the conjugate pair's other member: name it by its positive one
+      lambda = std::conj(lambda);
+      for (auto& term : terms) term.second = -term.second;
+    }
+    const double frequency_hz = lambda.imag() / (2 * M_PI);
+    if (frequency_hz <= 0 || frequency_hz >= nyquist_hz || !Overlap(lambda, candidate)) return;
+    products.push_back({lambda, ProductName(terms)});
+  };
+  const size_t n = parents.size();
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i; j < n; ++j) {
+      const size_t a = parents[i];
+      const size_t b = parents[j];
+      if (a == b) {
+        add({{a, 2}});
+      } else {
+        add({{a, 1}, {b, 1}});
+        add({{b, 1}, {a, -1}});
+      }
+      for (size_t k = j; k < n; ++k) {
+        const size_t c = parents[k];
+        if (a == b && b == c) {
+          add({{a, 3}});
+        } else if (a == b || b == c) {
+          const size_t twice = a == b ? a : c;
+          const size_t once = a == b ? c : a;
+          add({{twice, 2}, {once, 1}});
+          add({{twice, 2}, {once, -1}});
+        } else {
+          add({{a, 1}, {b, 1}, {c, 1}});
+          add({{a, 1}, {b, 1}, {c, -1}});
+          add({{a, 1}, {c, 1}, {b, -1}});
+          add({{b, 1}, {c, 1}, {a, -1}});
+        }
+      }
+    }
+  }
+  return products;
+}
+
+// A weak mode that no single sum matches may still be products: at a few times the noise, the
+// second- and third-order products of the modes (at 2 mrad on the excavator arm: 2 f3 = 14.83,
+// 3 f2 = 14.45, 2 f1 + f3 = 13.50 Hz) overlap within their bandwidths, and one pole fitted to
+// them lands between them with a standard deviation that knows nothing of its neighbours
+// (14.05 +- 0.09 Hz). Fitted beside those products' poles (with free amplitudes: the
+// nonlinearity is unknown) such a mode is no longer significant, and the record cannot tell it
+// from them. A mode of the structure that weak and that near a product cannot be told from it
+// either; one away from them (a bandwidth or more, or with its own decay) stays significant.
+void MarkProductsOfModes(const AnalysisRecord& record, const IdentificationOptions& options,
+                         const std::vector<double>& largest, ModalResult* result) {
+  std::vector<IdentifiedMode>& modes = result->modes;
+  const double nyquist_hz = 0.5 / record.decimated_interval_s;
+  std::optional<AmplitudeFit> all;  // of every mode: fitted once, when a candidate needs it
+  for (size_t m = 0; m < modes.size(); ++m) {
+    IdentifiedMode& candidate = modes[m];
+    if (!candidate.combination.empty() || !candidate.significant) continue;
+    // The strongest modes only: a product's amplitude goes with its parents'. Bounded counts
+    // keep a record of many spurious poles (a decay cut before its release) from a fit of
+    // thousands.
+    std::vector<size_t> parents;
+    for (size_t k = 0; k < modes.size(); ++k) {
+      if (k != m && modes[k].combination.empty() && largest[k] > largest[m]) parents.push_back(k);
+    }
+    std::sort(parents.begin(), parents.end(),
+              [&largest](size_t a, size_t b) { return largest[a] > largest[b]; });
+    if (parents.size() > kMaxParents) parents.resize(kMaxParents);
+    if (parents.empty() || !(largest[m] <= kMaxToneRatio * largest[parents.front()])) continue;
+    const double strongest = largest[parents.front()];
+    std::sort(parents.begin(), parents.end());  // names in the modes' order
+    std::vector<Product> products = NearbyProducts(modes, parents, candidate, nyquist_hz);
+    if (products.empty()) continue;
+    std::stable_sort(
+        products.begin(), products.end(), [&candidate](const Product& a, const Product& b) {
+          return std::abs(a.lambda - candidate.lambda) < std::abs(b.lambda - candidate.lambda);
+        });
+    if (products.size() > kMaxProducts) products.resize(kMaxProducts);
+    if (!all) {
+      std::vector<std::complex<double>> lambda;
+      for (const IdentifiedMode& mode : modes) lambda.push_back(mode.lambda);
+      all = FitAmplitudes(record.decimated, record.decimated_interval_s, lambda,
+                          options.offset == OffsetRemoval::kFit);
+    }
+    // Locally: the record less the fitted modes outside the candidate's band (which hardly
+    // overlap it), fitted with those inside, the products, and the candidate last; a fit of
+    // all of them per candidate costs many times more on a record of many spurious poles.
+    std::vector<std::complex<double>> inside;
+    Eigen::MatrixXd values = record.decimated - all->reconstruction;
+    for (size_t k = 0; k <= modes.size(); ++k) {
+      const size_t mode = k < modes.size() ? k : m;  // the candidate last
+      if (k == m || (k < modes.size() && !Overlap(modes[k].lambda, candidate))) continue;
+      const std::vector<std::complex<double>> pole = {modes[mode].lambda};
+      values += CalcDampedSinusoidBasis(pole, record.decimated_interval_s,
+                                        static_cast<int>(values.rows()), false) *
+                all->coefficients.middleRows(2 * static_cast<Eigen::Index>(mode), 2);
+      if (k < modes.size()) inside.push_back(modes[k].lambda);
+    }
+    for (const Product& product : products) inside.push_back(product.lambda);
+    inside.push_back(candidate.lambda);
+    const AmplitudeFit fit = FitAmplitudes(values, record.decimated_interval_s, inside, false);
+    const double significance = CalcSignificance(fit)(static_cast<Eigen::Index>(inside.size()) - 1);
+    if (significance >= result->significance_threshold) continue;
+    const Product* nearest = &products.front();
+    candidate.combination = nearest->name;
+    result->warnings.push_back(fmt::format(
+        "the mode at {:.4g} Hz ({:.2g} % of the strongest mode's amplitude) is no longer "
+        "significant (significance {:.3g}, threshold {:.3g}) beside the products of the modes' "
+        "poles within its bandwidth ({}, nearest {} at {:.4g} Hz): the record cannot tell it "
+        "from such combination tones, and it is marked as one",
+        candidate.frequency_hz, 100 * largest[m] / strongest, significance,
+        result->significance_threshold, products.size(), nearest->name,
+        nearest->lambda.imag() / (2 * M_PI)));
+  }
+}
+
 }  // namespace
 
-void MarkCombinationTones(ModalResult* result) {
+void MarkCombinationTones(const AnalysisRecord& record, const IdentificationOptions& options,
+                          ModalResult* result) {
   std::vector<IdentifiedMode>& modes = result->modes;
   const size_t n = modes.size();
   std::vector<double> largest(n);
@@ -110,6 +276,7 @@ void MarkCombinationTones(ModalResult* result) {
           tone.frequency_hz, tone.combination));
     }
   }
+  MarkProductsOfModes(record, options, largest, result);
 }
 
 }  // namespace mbid::identification

@@ -57,7 +57,7 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
     // The whole decay knows the release better than its first samples (release.h).
     result.release_time_s = RefineReleaseFromModes(result, result.release_time_s);
   }
-  MarkCombinationTones(&result);
+  MarkCombinationTones(record, options, &result);
   AssessReliability(record, options, estimate, &result);
   return result;
 }

@@ -107,10 +107,16 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
     }
     if (!IsDetermined(mode.frequency_hz, mode.std_frequency_hz, mode.decay_rate_per_s,
                       mode.std_decay_rate_per_s)) {
-      reasons.push_back(fmt::format(
+      const std::string what = fmt::format(
           "the mode at {:.4g} Hz is undetermined (std of frequency {:.3g} Hz, of decay {:.3g} "
           "1/s)",
-          mode.frequency_hz, mode.std_frequency_hz, mode.std_decay_rate_per_s));
+          mode.frequency_hz, mode.std_frequency_hz, mode.std_decay_rate_per_s);
+      // A combination tone is no mode of the structure: its spread says nothing of theirs.
+      if (mode.combination.empty()) {
+        reasons.push_back(what);
+      } else {
+        result->warnings.push_back(what + ", a combination tone");
+      }
     }
   }
   for (const IdentifiedMode& mode : result->modes) {

@@ -13,11 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "mbid/common/yaml_reader.h"
 #include "mbid/identification/identify.h"
-#include "mbid/model/model_factory.h"
-#include "mbid/simulation/scenario_sections.h"
-#include "mbid/simulation/simulate.h"
+#include "scenario_record.h"
 
 namespace mbid {
 namespace {
@@ -40,13 +37,10 @@ std::vector<std::string> ExpectTheFourExactModes(const SweepCase& sweep_case,
   if (scenario.find(elevation) == std::string::npos) return {};
   scenario.replace(scenario.find(elevation), elevation.size(),
                    "boom_elevation_deg: " + std::to_string(sweep_case.elevation_deg));
-  const YamlReader root = YamlReader::FromString(scenario, "reference-crane.yaml");
-  const auto model = model::MakeModel(root.Child("model"));
-  simulation::SensorOptions sensors = simulation::ReadSensorOptions(root.Child("sensors"), *model);
-  sensors.seed = sweep_case.seed;
-  const simulation::SimulationResult record =
-      Simulate(*model, simulation::ReadExcitation(root.Child("excitation"), *model),
-               simulation::ReadSimulationOptions(root.Child("simulation")), sensors);
+  const testing::ScenarioRecord simulated = testing::SimulateScenario(
+      YamlReader::FromString(scenario, "reference-crane.yaml"), sweep_case.seed);
+  const model::MechanicalModel* model = simulated.model.get();
+  const simulation::SimulationResult& record = simulated.record;
 
   const identification::ModalResult identified =
       identification::Identify(record.measured, identification::IdentificationOptions{});

@@ -38,8 +38,10 @@ struct IdentifiedMode {
   // For a mode whose frequency drifts with amplitude (close poles merged into it): its
   // frequency and damping ratio against amplitude (backbone.h).
   std::optional<Backbone> backbone;
-  // Non-empty for a combination tone of two other modes ("f1 + f3", "2 f1", "f3 - f1", 1-based
-  // in `modes`): their poles' sum (combination_tones.cc), no mode of the structure.
+  // Non-empty for a combination tone of other modes ("f1 + f3", "2 f1", "f3 - f1", 1-based
+  // in `modes`): their poles' sum (combination_tones.cc), no mode of the structure. A weak mode
+  // the record cannot tell from the products up to third order is named by the nearest one
+  // ("3 f2", "2 f1 + f3", "f2 + f3 - f1").
   std::string combination;
 
   // Fills the derived quantities from lambda.
