@@ -186,6 +186,9 @@ int Main(int argc, char** argv) {
       ->check(CLI::IsMember({"clusters", "always", "never"}));
   identify->add_flag("--remove-drift", identify_options.remove_drift,
                      "Fit and subtract a linear drift per channel with the modes");
+  identify->add_flag("--keep-clipped{false}", identify_options.skip_clipped,
+                     "Analyse a record clipped at its start from the release, not from after "
+                     "its last clipped sample");
 
   std::vector<std::string> update_data;
   CLI::App* update = app.add_subcommand(

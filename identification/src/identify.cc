@@ -3,6 +3,7 @@
 // (reliability.h).
 #include "mbid/identification/identify.h"
 
+#include "clipped_start.h"
 #include "combination_tones.h"
 #include "estimate.h"
 #include "free_decay.h"
@@ -25,7 +26,8 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   ModalResult result;
   options.Validate("identification options");
   bool from_rest = false;
-  const IdentificationOptions applied = ApplyRelease(measurement, options, &result, &from_rest);
+  IdentificationOptions applied = ApplyRelease(measurement, options, &result, &from_rest);
+  if (options.skip_clipped) SkipClippedStart(measurement, &applied, &result);
   const AnalysisRecord record = PrepareRecord(measurement, applied, origin);
   result.channels = record.channels;
   result.units = record.units;

@@ -183,6 +183,7 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readwrite("compute_stabilization", &IdentificationOptions::compute_stabilization)
       .def_readwrite("compute_uncertainty", &IdentificationOptions::compute_uncertainty)
       .def_readwrite("remove_drift", &IdentificationOptions::remove_drift)
+      .def_readwrite("skip_clipped", &IdentificationOptions::skip_clipped)
       .def_property(
           "backbone",
           [](const IdentificationOptions& o) {
@@ -230,6 +231,7 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readonly("method", &mbid::ModalResult::method)
       .def_readonly("channels", &mbid::ModalResult::channels)
       .def_readonly("release_time_s", &mbid::ModalResult::release_time_s)
+      .def_readonly("start_time_s", &mbid::ModalResult::start_time_s)
       .def_readonly("model_order", &mbid::ModalResult::model_order)
       .def_property_readonly("correlation",
                              [](const mbid::ModalResult& r) { return ToArray(r.correlation); })

@@ -112,19 +112,52 @@ Eigen::MatrixXd OneDecay() {
 }
 
 TEST(IdentifyTest, AClippedChannelMakesTheResultUnreliable) {
-  // OneDecay() held at 60 % of its first peak (a logger at the end of its range): the
-  // flattened peaks bring modes of their own.
+  // OneDecay() held at 60 % of its first peak (a logger at the end of its range) and analysed
+  // as recorded (skip_clipped false): the flattened peaks bring modes of their own.
   const SignalSpec spec = OneDecaySpec();
   const Eigen::MatrixXd noisy = OneDecay();
   const ModalResult as_recorded = Identify(MakeRecord(spec, noisy), {});
   EXPECT_TRUE(as_recorded.reliable) << ::testing::PrintToString(as_recorded.reasons);
   const double rail = 0.6 * noisy.maxCoeff();
-  const ModalResult clipped = Identify(MakeRecord(spec, noisy.cwiseMin(rail)), {});
+  IdentificationOptions keep;
+  keep.skip_clipped = false;
+  const ModalResult clipped = Identify(MakeRecord(spec, noisy.cwiseMin(rail)), keep);
   EXPECT_FALSE(clipped.reliable);
   ASSERT_FALSE(clipped.reasons.empty());
   EXPECT_NE(clipped.reasons[0].find("channel x stays at its largest value"), std::string::npos)
       << clipped.reasons[0];
   EXPECT_NE(clipped.reasons[0].find("(clipped)"), std::string::npos) << clipped.reasons[0];
+}
+
+TEST(IdentifyTest, AClippedStartIsSkipped) {
+  // The same record by default: its peaks (every 2/3 s) are above the rail at 0 and 2/3 s
+  // (e^(-0.47 * 2/3) = 0.73) and below it from 4/3 s on (0.53), so the decay after the clipped
+  // peak at 2/3 s is analysed, about 90 % of the record.
+  const SignalSpec spec = OneDecaySpec();
+  const Eigen::MatrixXd noisy = OneDecay();
+  const double rail = 0.6 * noisy.maxCoeff();
+  const ModalResult result = Identify(MakeRecord(spec, noisy.cwiseMin(rail)), {});
+  EXPECT_TRUE(result.reliable) << ::testing::PrintToString(result.reasons);
+  EXPECT_GT(result.start_time_s, 2.0 / 3.0);
+  EXPECT_LT(result.start_time_s, 4.0 / 3.0);
+  EXPECT_TRUE(std::any_of(result.warnings.begin(), result.warnings.end(), [](const std::string& w) {
+    return w.find("channel x stays at its largest value") != std::string::npos &&
+           w.find("the analysis starts after the last clipped sample") != std::string::npos;
+  })) << ::testing::PrintToString(result.warnings);
+  ASSERT_EQ(result.modes.size(), 1u);
+  // The true pole within 4 standard deviations (40 dB of noise: a fraction of a percent).
+  EXPECT_NEAR(result.modes[0].frequency_hz, 1.5, 4 * result.modes[0].std_frequency_hz);
+  EXPECT_NEAR(result.modes[0].decay_rate_per_s, 0.47, 4 * result.modes[0].std_decay_rate_per_s);
+
+  // Held at 5 % of its first peak, the decay is inside the rail only from about 6.4 s on
+  // (ln 20 / 0.47): under half the record would be left, so nothing is skipped; unreliable.
+  const ModalResult deep = Identify(MakeRecord(spec, noisy.cwiseMin(0.05 * noisy.maxCoeff())), {});
+  EXPECT_FALSE(deep.reliable);
+  EXPECT_TRUE(std::none_of(deep.warnings.begin(), deep.warnings.end(), [](const std::string& w) {
+    return w.find("the analysis starts after the last clipped sample") != std::string::npos;
+  })) << ::testing::PrintToString(deep.warnings);
+  ASSERT_FALSE(deep.reasons.empty());
+  EXPECT_NE(deep.reasons[0].find("(clipped)"), std::string::npos) << deep.reasons[0];
 }
 
 TEST(IdentifyTest, AGlitchMakesTheResultUnreliable) {

@@ -106,6 +106,26 @@ class IdentifyTest(unittest.TestCase):
         options.remove_drift = True
         self.assertTrue(options.remove_drift)
 
+    def test_a_clipped_start_is_skipped_unless_kept(self):
+        # exp(-0.3 t) cos(2 pi 2 t) held at 0.6 (a logger's range): its peaks, every 0.5 s,
+        # reach exp(-0.15 k); the one at 1.5 s (0.64) is the last clipped, and the decay after it
+        # is whole, so its pole comes back to 1e-5 relative. Kept, the record is unreliable.
+        t = np.arange(2000) * 0.005
+        y = np.minimum(np.exp(-0.3 * t) * np.cos(2 * np.pi * 2.0 * t), 0.6)
+        result = mbid.identify_arrays(t, {"x": y}, {"x": "m"})
+        self.assertTrue(result.reliable, result.reasons)
+        self.assertGreater(result.start_time_s, 1.5)
+        self.assertLess(result.start_time_s, 2.0)
+        self.assertEqual(len(result.modes), 1)
+        self.assertAlmostEqual(result.modes[0].frequency_hz, 2.0, delta=2e-5)
+        self.assertAlmostEqual(result.modes[0].decay_rate_per_s, 0.3, delta=3e-6)
+        options = mbid.IdentificationOptions()
+        self.assertTrue(options.skip_clipped)
+        options.skip_clipped = False
+        kept = mbid.identify_arrays(t, {"x": y}, {"x": "m"}, options)
+        self.assertFalse(kept.reliable)
+        self.assertIn("(clipped)", kept.reasons[0])
+
     def test_identify_of_a_record_equals_identify_of_its_arrays(self):
         record = mbid.simulate(mbid.load_scenario(REFERENCE))
         a = mbid.identify(record)

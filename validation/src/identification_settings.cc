@@ -32,6 +32,7 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
                      "min_correlation",
                      "backbone",
                      "remove_drift",
+                     "skip_clipped",
                      "prony"});
   const std::string method = section.Choice("method", identification::MethodNames(),
                                             identification::Method::kHankelNls.name());
@@ -62,6 +63,7 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
       section.Bool("compute_stabilization", options.compute_stabilization);
   options.compute_uncertainty = section.Bool("compute_uncertainty", options.compute_uncertainty);
   options.remove_drift = section.Bool("remove_drift", options.remove_drift);
+  options.skip_clipped = section.Bool("skip_clipped", options.skip_clipped);
   identification::ParseBackboneMode(
       section.Choice("backbone", {"clusters", "always", "never"},
                      identification::BackboneModeName(options.backbone)),

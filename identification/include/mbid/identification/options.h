@@ -195,6 +195,11 @@ struct IdentificationOptions {
   // whose sensors drift (a thermal drift, an integrating amplifier). The constant part stays with
   // `offset`.
   bool remove_drift = false;
+  // A record clipped at its start (its first swings beyond a sensor's or logger's range) is
+  // analysed from the sample after its last clipped one, if that leaves half the window or more
+  // and nothing later is clipped (clipped_start.h); false: the window as given, and a clipped
+  // record is unreliable.
+  bool skip_clipped = true;
 
   SpectrumOptions spectrum;
   PronySvdOptions prony;
