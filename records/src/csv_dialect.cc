@@ -104,8 +104,11 @@ CellKind ClassifyCell(const std::string& cell, char separator, double* value) {
     return CellKind::kNumber;
   }
   Timestamp timestamp;
-  if (ParseTimestamp(cell, &timestamp)) return CellKind::kTimestamp;
-  if (ParseDate(cell, &timestamp)) return CellKind::kDate;
+  // "01/03/2026" either way round: the record's dates decide which (csv_reader.cc).
+  for (const SlashOrder order : {SlashOrder::kDayFirst, SlashOrder::kMonthFirst}) {
+    if (ParseTimestamp(cell, &timestamp, order)) return CellKind::kTimestamp;
+    if (ParseDate(cell, &timestamp, order)) return CellKind::kDate;
+  }
   return CellKind::kText;
 }
 

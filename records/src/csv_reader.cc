@@ -23,6 +23,65 @@
 namespace mbid::records::internal {
 namespace {
 
+// How the record's "NN/NN/YYYY" dates read (in its time or date column): day first where a
+// first field is over 12, month first where a second one is; else the order in which the dates
+// run on by 0 or 1 day from row to row (a record that passes midnight). Dates all of one day
+// give the same times either way. A record that fits both or neither order is refused.
+SlashOrder DecideSlashOrder(const std::string& path, const std::vector<TextLine>& lines,
+                            int first_row, char separator, const std::vector<int>& date_columns) {
+  struct SlashDate {
+    int first, second, year, line;
+  };
+  std::vector<SlashDate> dates;
+  for (size_t i = static_cast<size_t>(first_row); i < lines.size(); ++i) {
+    if (IsCommentOrBlank(lines[i].text)) continue;
+    const std::vector<std::string> fields = SplitFields(lines[i].text, separator);
+    for (const int c : date_columns) {
+      SlashDate date{0, 0, 0, lines[i].number};
+      if (c >= 0 && static_cast<size_t>(c) < fields.size() &&
+          ReadSlashDate(fields[static_cast<size_t>(c)], &date.first, &date.second, &date.year)) {
+        dates.push_back(date);
+      }
+    }
+  }
+  const auto day_over_12 =
+      std::find_if(dates.begin(), dates.end(), [](const SlashDate& d) { return d.first > 12; });
+  const auto month_over_12 =
+      std::find_if(dates.begin(), dates.end(), [](const SlashDate& d) { return d.second > 12; });
+  if (day_over_12 != dates.end() && month_over_12 != dates.end()) {
+    throw InputError(path, LineField(month_over_12->line),
+                     fmt::format("a date month first ({:02}/{:02}) after one day first (line {})",
+                                 month_over_12->first, month_over_12->second, day_over_12->line),
+                     "the dates with '/' in one order, day first or month first");
+  }
+  if (day_over_12 != dates.end()) return SlashOrder::kDayFirst;
+  if (month_over_12 != dates.end()) return SlashOrder::kMonthFirst;
+  const auto runs_on = [&dates](SlashOrder order) {
+    for (size_t k = 1; k < dates.size(); ++k) {
+      const bool month_first = order == SlashOrder::kMonthFirst;
+      const auto day = [month_first](const SlashDate& d) {
+        return DaysFromCivil(d.year, month_first ? d.first : d.second,
+                             month_first ? d.second : d.first);
+      };
+      const std::int64_t step = day(dates[k]) - day(dates[k - 1]);
+      if (step != 0 && step != 1) return false;
+    }
+    return true;
+  };
+  const bool day_first = runs_on(SlashOrder::kDayFirst);
+  const bool month_first = runs_on(SlashOrder::kMonthFirst);
+  if (day_first != month_first) return day_first ? SlashOrder::kDayFirst : SlashOrder::kMonthFirst;
+  if (day_first && std::all_of(dates.begin(), dates.end(), [&dates](const SlashDate& d) {
+        return d.first == dates.front().first && d.second == dates.front().second &&
+               d.year == dates.front().year;
+      })) {
+    return SlashOrder::kDayFirst;  // one day: the times are the same either way
+  }
+  throw InputError(path, LineField(dates.empty() ? 0 : dates.back().line),
+                   "dates with '/' that read as well day first as month first",
+                   "dates in ISO form (2026-03-01), or a record whose dates tell the order");
+}
+
 constexpr char kExpected[] =
     "a table of numbers with a header line, separated by ',', ';' or tabs (docs/records.md)";
 
@@ -197,6 +256,9 @@ RawTable ReadCsv(const std::string& path) {
     break;
   }
 
+  const SlashOrder slash_order =
+      DecideSlashOrder(path, lines, first_row, separator, {time_column, date_column});
+
   // Rows. A column of text, no number in any row (a logger's status or event marks), is no
   // channel: its first text is kept until a number in the column makes it an error.
   struct FirstText {
@@ -236,10 +298,12 @@ RawTable ReadCsv(const std::string& path) {
     }
     const bool first = table.sample_lines.empty();
     Timestamp date;
-    if (date_column >= 0 && !ParseDate(fields[static_cast<size_t>(date_column)], &date)) {
-      throw InputError(path, cell_field(line.number, static_cast<size_t>(date_column)),
-                       "'" + fields[static_cast<size_t>(date_column)] + "' is not a date",
-                       "a date as in the first row (2026-03-01, 2026/03/01 or 01.03.2026)");
+    if (date_column >= 0 &&
+        !ParseDate(fields[static_cast<size_t>(date_column)], &date, slash_order)) {
+      throw InputError(
+          path, cell_field(line.number, static_cast<size_t>(date_column)),
+          "'" + fields[static_cast<size_t>(date_column)] + "' is not a date",
+          "a date as in the first row (2026-03-01, 2026/03/01, 01.03.2026 or 01/03/2026)");
     }
     for (size_t c = 0; c < fields.size(); ++c) {
       double value = 0;
@@ -254,7 +318,7 @@ RawTable ReadCsv(const std::string& path) {
       if (static_cast<int>(c) == time_column && first) timestamps = kind == CellKind::kTimestamp;
       if (static_cast<int>(c) == time_column && timestamps) {
         Timestamp timestamp;
-        const bool parsed = ParseTimestamp(fields[c], &timestamp);
+        const bool parsed = ParseTimestamp(fields[c], &timestamp, slash_order);
         if (parsed && !timestamp.has_date && date_column >= 0) {
           timestamp.seconds += date.seconds;
           timestamp.has_date = true;

@@ -24,7 +24,37 @@ bool Expect(const std::string& text, size_t* at, char c) {
   return true;
 }
 
-// Days from 1970-01-01 to the proleptic Gregorian date y-m-d (H. Hinnant's days_from_civil).
+// The date: "2026-03-01", "2026/03/01", day first "01.03.2026" or "01/03/2026" in `order`; false
+// when `text` does not start with one.
+bool ReadDate(const std::string& text, size_t* at, SlashOrder order, int* year, int* month,
+              int* day) {
+  size_t start = *at;
+  if (ReadDigits(text, at, 4, year) && *at < text.size() &&
+      (text[*at] == '-' || text[*at] == '/')) {
+    const char separator = text[(*at)++];
+    return ReadDigits(text, at, 2, month) && Expect(text, at, separator) &&
+           ReadDigits(text, at, 2, day);
+  }
+  *at = start;
+  int first = 0, second = 0;
+  if (!ReadDigits(text, at, 2, &first) || *at >= text.size() ||
+      (text[*at] != '.' && text[*at] != '/')) {
+    return false;
+  }
+  const char separator = text[(*at)++];
+  if (!ReadDigits(text, at, 2, &second) || !Expect(text, at, separator) ||
+      !ReadDigits(text, at, 4, year)) {
+    return false;
+  }
+  const bool month_first = separator == '/' && order == SlashOrder::kMonthFirst;
+  *day = month_first ? second : first;
+  *month = month_first ? first : second;
+  return true;
+}
+
+}  // namespace
+
+// H. Hinnant's days_from_civil.
 std::int64_t DaysFromCivil(std::int64_t y, int m, int d) {
   y -= m <= 2 ? 1 : 0;
   const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
@@ -34,28 +64,18 @@ std::int64_t DaysFromCivil(std::int64_t y, int m, int d) {
   return era * 146097 + doe - 719468;
 }
 
-// The date: "2026-03-01", "2026/03/01" or day first "01.03.2026"; false when `text` does not
-// start with one.
-bool ReadDate(const std::string& text, size_t* at, int* year, int* month, int* day) {
-  size_t start = *at;
-  if (ReadDigits(text, at, 4, year) && *at < text.size() &&
-      (text[*at] == '-' || text[*at] == '/')) {
-    const char separator = text[(*at)++];
-    return ReadDigits(text, at, 2, month) && Expect(text, at, separator) &&
-           ReadDigits(text, at, 2, day);
-  }
-  *at = start;
-  return ReadDigits(text, at, 2, day) && Expect(text, at, '.') && ReadDigits(text, at, 2, month) &&
-         Expect(text, at, '.') && ReadDigits(text, at, 4, year);
+bool ReadSlashDate(const std::string& text, int* first, int* second, int* year) {
+  size_t at = 0;
+  return ReadDigits(text, &at, 2, first) && Expect(text, &at, '/') &&
+         ReadDigits(text, &at, 2, second) && Expect(text, &at, '/') &&
+         ReadDigits(text, &at, 4, year);
 }
 
-}  // namespace
-
-bool ParseDate(const std::string& text, Timestamp* date) {
+bool ParseDate(const std::string& text, Timestamp* date, SlashOrder order) {
   size_t at = 0;
   int year = 0, month = 0, day = 0;
-  if (!ReadDate(text, &at, &year, &month, &day) || at != text.size() || month < 1 || month > 12 ||
-      day < 1 || day > 31) {
+  if (!ReadDate(text, &at, order, &year, &month, &day) || at != text.size() || month < 1 ||
+      month > 12 || day < 1 || day > 31) {
     return false;
   }
   *date = Timestamp{};
@@ -63,10 +83,10 @@ bool ParseDate(const std::string& text, Timestamp* date) {
   return true;
 }
 
-bool ParseTimestamp(const std::string& text, Timestamp* timestamp) {
+bool ParseTimestamp(const std::string& text, Timestamp* timestamp, SlashOrder order) {
   size_t at = 0;
   int year = 1970, month = 1, day = 1, hour = 0, minute = 0, second = 0;
-  const bool has_date = ReadDate(text, &at, &year, &month, &day);
+  const bool has_date = ReadDate(text, &at, order, &year, &month, &day);
   if (has_date) {
     if (at >= text.size() || (text[at] != 'T' && text[at] != ' ')) return false;
     ++at;

@@ -1,5 +1,6 @@
 // Layouts spreadsheets and loggers write around the numbers: a separator at every line's end,
-// dates day first, a date column beside a time of day, a time of day that passes midnight.
+// dates day first or month first, a date column beside a time of day, a time of day that passes
+// midnight.
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -151,13 +152,78 @@ TEST(DateAndLayoutTest, DatesAndTimesOfDayParse) {
   EXPECT_FALSE(morning.has_date);
   EXPECT_EQ(morning.seconds, 9 * 3600 + 5 * 60);
   EXPECT_EQ(morning.decimals, 2);
+  // "01/03/2026" is the 1st of March day first, the 3rd of January month first.
+  Timestamp day_first, month_first;
+  ASSERT_TRUE(ParseTimestamp("01/03/2026 12:00:00", &day_first));
+  EXPECT_DOUBLE_EQ(SecondsBetween(dotted, day_first), 0.0);
+  ASSERT_TRUE(
+      ParseTimestamp("03/01/2026 12:00:00.5", &month_first, internal::SlashOrder::kMonthFirst));
+  EXPECT_DOUBLE_EQ(SecondsBetween(iso, month_first), 0.0);
   Timestamp t;
-  // Month-first dates with '/' are ambiguous (03/01/2026) and not read; nor are impossible ones.
-  for (const char* text : {"03/01/2026 12:00:00", "32.01.2026 12:00:00", "01.13.2026", "24:00:00",
-                           "12:60:00", "1.3.2026 12:00:00", "9:05"}) {
+  // Impossible dates and times are not read.
+  for (const char* text : {"13/13/2026 12:00:00", "32.01.2026 12:00:00", "01.13.2026", "24:00:00",
+                           "12:60:00", "1.3.2026 12:00:00", "9:05", "01/03.2026 12:00:00"}) {
     EXPECT_FALSE(ParseTimestamp(text, &t)) << text;
   }
+  EXPECT_FALSE(ParseTimestamp("12/13/2026 12:00:00", &t));  // day first: no 13th month
+  EXPECT_TRUE(ParseTimestamp("12/13/2026 12:00:00", &t, internal::SlashOrder::kMonthFirst));
   EXPECT_FALSE(ParseDate("01.13.2026", &t));
+}
+
+// "MM/DD/YYYY hh:mm:ss.sss" at 100 Hz from `start_s` after midnight of `first_date`'s day,
+// printed as a US logger prints it (dates month first) or day first.
+std::string SlashExport(int month, int day, double start_s, bool month_first, int samples,
+                        const Decay& psi) {
+  return MakeExport("Date/Time,psi [deg]\n", samples, [&](int j) {
+    const int ms = static_cast<int>(std::lround((start_s + j * 0.01) * 1000));
+    const int d = day + ms / 86400000;  // the test dates stay inside their month
+    const int of_day = ms % 86400000;
+    return fmt::format("{:02d}/{:02d}/2026 {:02d}:{:02d}:{:02d}.{:03d},{}", month_first ? month : d,
+                       month_first ? d : month, of_day / 3600000, of_day / 60000 % 60,
+                       of_day / 1000 % 60, of_day % 1000, Print(psi(j * 0.01)));
+  });
+}
+
+TEST(DateAndLayoutTest, SlashDatesAreReadInTheOrderTheRecordTells) {
+  TempDir dir;
+  const Decay psi;
+  const std::string path = dir.File("slash.csv");
+  // November 28th, month first (a day of 28 tells the order), across midnight.
+  WriteText(path, SlashExport(11, 28, 86399.0, true, 301, psi));
+  Measurement m = ImportMeasurement(path);
+  EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-12);
+  ExpectDecayRead(m, 0, psi, kDegree);
+  // March 1st to 2nd: 03/01 -> 03/02 runs on by a day month first; day first it would jump from
+  // January 3rd to February 3rd, so month first it is.
+  WriteText(path, SlashExport(3, 1, 86399.0, true, 301, psi));
+  m = ImportMeasurement(path);
+  EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-12);
+  ExpectDecayRead(m, 0, psi, kDegree);
+  // The same days day first (01/03 -> 02/03).
+  WriteText(path, SlashExport(3, 1, 86399.0, false, 301, psi));
+  m = ImportMeasurement(path);
+  EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-12);
+  ExpectDecayRead(m, 0, psi, kDegree);
+  // All of one ambiguous day: the times are the same in either order.
+  WriteText(path, SlashExport(3, 1, 43200.0, true, 301, psi));
+  m = ImportMeasurement(path);
+  EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-12);
+  ExpectDecayRead(m, 0, psi, kDegree);
+}
+
+TEST(DateAndLayoutTest, SlashDatesInBothOrdersAreRefused) {
+  TempDir dir;
+  const std::string path = dir.File("both.csv");
+  WriteText(path,
+            "Date/Time,psi [deg]\n13/01/2026 12:00:00.00,1\n13/01/2026 12:00:00.01,1\n"
+            "01/13/2026 12:00:00.02,1\n");
+  try {
+    ImportMeasurement(path);
+    ADD_FAILURE() << "dates in both orders were read";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("line 4"));
+    EXPECT_THAT(e.what(), HasSubstr("day first or month first"));
+  }
 }
 
 TEST(DateAndLayoutTest, AStatedRateSettlesACoarselyPrintedTimeColumn) {
