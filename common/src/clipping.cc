@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace mbid {
@@ -50,7 +51,52 @@ Runs RunsAt(const Eigen::Ref<const Eigen::VectorXd>& values, double level, doubl
   return runs;
 }
 
+// The last sample of `values` held at a rail of `clipping` (within FindClipping's tolerance).
+Eigen::Index LastClipped(const Eigen::Ref<const Eigen::VectorXd>& values,
+                         const Clipping& clipping) {
+  const double tolerance = 1e-9 * (clipping.maximum - clipping.minimum);
+  for (Eigen::Index j = values.size() - 1; j >= 0; --j) {
+    if ((clipping.at_maximum && std::abs(values[j] - clipping.maximum) <= tolerance) ||
+        (clipping.at_minimum && std::abs(values[j] - clipping.minimum) <= tolerance)) {
+      return j;
+    }
+  }
+  return -1;
+}
+
 }  // namespace
+
+std::optional<ClippedStart> FindClippedStart(const Measurement& record, Eigen::Index first,
+                                             Eigen::Index last,
+                                             const std::vector<std::string>& channels) {
+  const Eigen::Index count = last - first + 1;
+  if (first < 0 || last >= record.values.rows() || count < 16) return std::nullopt;
+  ClippedStart found{first, ""};
+  for (int c = 0; c < record.channel_count(); ++c) {
+    const std::string& name = record.channels[static_cast<size_t>(c)];
+    if (!channels.empty() && std::find(channels.begin(), channels.end(), name) == channels.end()) {
+      continue;
+    }
+    const auto values = record.values.col(c).segment(first, count);
+    const std::optional<Clipping> clipping = FindClipping(values);
+    if (!clipping) continue;
+    const Eigen::Index after = first + LastClipped(values, *clipping) + 1;
+    if (after > found.first_whole) {
+      found.first_whole = after;
+      found.reason = ClippingReason(name, record.units[static_cast<size_t>(c)], *clipping);
+    }
+  }
+  if (found.first_whole == first || 2 * (last - found.first_whole + 1) < count) {
+    return std::nullopt;
+  }
+  for (int c = 0; c < record.channel_count(); ++c) {
+    if (FindClipping(
+            record.values.col(c).segment(found.first_whole, last - found.first_whole + 1))) {
+      return std::nullopt;
+    }
+  }
+  return found;
+}
 
 std::optional<Clipping> FindClipping(const Eigen::Ref<const Eigen::VectorXd>& values) {
   if (values.size() < 8 || !values.allFinite()) return std::nullopt;

@@ -65,6 +65,12 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
           fmt::format("test {}: free decay from {:.6g} s of the record ({}); that is "
                       "t = 0 of the test",
                       test.name, test.release->release_time_s, test.release->how));
+      if (test.release->clipped_until_s) {
+        say(
+            fmt::format("test {}: {}; the test is analysed from t = {:.6g} s, after its last "
+                        "clipped sample",
+                        test.name, test.release->clipped, *test.release->clipped_until_s));
+      }
     }
     say(fmt::format("test {}: {} ({} samples x {} channels)", test.name, test.origin,
                     test.measured.samples(), test.measured.channel_count()));

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "mbid/common/clipping.h"
 #include "mbid/common/error.h"
 #include "mbid/identification/identify.h"
 #include "mbid/identification/release.h"
@@ -26,12 +27,16 @@ ReleaseChoice OverrideRelease(const ReleaseChoice& entry, const ImportOverrides&
 }
 
 nlohmann::json AppliedRelease::ToJson() const {
-  return {{"release_time_s", release_time_s}, {"release", how}};
+  nlohmann::json json = {{"release_time_s", release_time_s}, {"release", how}};
+  if (clipped_until_s) json["clipped_until_s"] = *clipped_until_s;
+  return json;
 }
 
-AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin,
-                                  const ReleaseChoice& choice,
-                                  const simulation::Excitation& excitation) {
+namespace {
+
+AppliedRelease CutAtReleaseOnly(Measurement* record, const std::string& origin,
+                                const ReleaseChoice& choice,
+                                const simulation::Excitation& excitation) {
   AppliedRelease applied;
   applied.release_time_s = record->start_time_s;
   if (choice.time_s) {
@@ -81,6 +86,25 @@ AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin
     }
   }
   *record = identification::CutAtRelease(*record, applied.release_time_s, origin);
+  return applied;
+}
+
+}  // namespace
+
+AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin,
+                                  const ReleaseChoice& choice,
+                                  const simulation::Excitation& excitation) {
+  AppliedRelease applied = CutAtReleaseOnly(record, origin, choice, excitation);
+  if (applied.how == "forced test") return applied;  // its forcing belongs to the fit
+  // Clipped samples are no measured values: the fit and the identification both start after
+  // the last one (the simulation still starts at the release).
+  const std::optional<ClippedStart> clipped = FindClippedStart(*record, 0, record->samples() - 1);
+  if (!clipped) return applied;
+  const Eigen::Index kept = record->values.rows() - clipped->first_whole;
+  record->values = record->values.bottomRows(kept).eval();
+  record->start_time_s += static_cast<double>(clipped->first_whole) * record->sample_interval_s;
+  applied.clipped_until_s = record->start_time_s;
+  applied.clipped = clipped->reason;
   return applied;
 }
 

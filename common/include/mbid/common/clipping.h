@@ -9,6 +9,9 @@
 #include <Eigen/Core>
 #include <optional>
 #include <string>
+#include <vector>
+
+#include "mbid/common/measurement.h"
 
 namespace mbid {
 
@@ -27,6 +30,20 @@ struct Clipping {
 // between its extremes is not judged (a peak held for one quantization step looks the same);
 // nor one with under 8 samples or no range.
 std::optional<Clipping> FindClipping(const Eigen::Ref<const Eigen::VectorXd>& values);
+
+// A record clipped only at its start (its first swings beyond a sensor's or logger's range)
+// is whole again from the sample after its last clipped one.
+struct ClippedStart {
+  Eigen::Index first_whole = 0;  // that sample's row in the record
+  std::string reason;            // ClippingReason of the channel clipped last
+};
+
+// The clipped start of rows [first, last] of `record` (in `channels`, or all if empty): found
+// if at least half of those rows are left after it and no channel is clipped in them (a
+// channel on a rail to the end is a stuck sensor, not a decay back inside its range).
+std::optional<ClippedStart> FindClippedStart(const Measurement& record, Eigen::Index first,
+                                             Eigen::Index last,
+                                             const std::vector<std::string>& channels = {});
 
 // "channel psi stays at its largest and smallest values, 0.00095 and -0.00095 rad, for 49
 // samples: the sensor or logger was at the end of its range (clipped)"

@@ -32,13 +32,18 @@ struct AppliedRelease {
   // simulated), "none" (--release none) or "forced test" (the excitation forces the structure
   // from t = 0, which is then the origin).
   std::string how;
+  // A record clipped at its start (common/clipping.h) is used from the sample after its last
+  // clipped one, this many seconds after the release; `clipped` says which channel and how.
+  std::optional<double> clipped_until_s;
+  std::string clipped;
   nlohmann::json ToJson() const;
 };
 
 // Cuts `record` at its release with the release as time origin (start_time_s in [0, tau)):
 // given, or found (identification/release.h) in records mbid did not simulate when the excitation
 // is a release (a load drop or an initial deflection). Forced tests and --release none are left
-// whole.
+// whole. A record clipped at its start (but a forced test's) then keeps only the samples after
+// its last clipped one (common/clipping.h: FindClippedStart).
 AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin,
                                   const ReleaseChoice& choice,
                                   const simulation::Excitation& excitation);
