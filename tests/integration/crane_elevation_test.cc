@@ -28,15 +28,9 @@ struct SweepCase {
 // Unless `reasons` is given, the result must be reliable; else it gets the reasons.
 std::vector<std::string> ExpectTheFourExactModes(const SweepCase& sweep_case,
                                                  std::vector<std::string>* reasons = nullptr) {
-  std::ifstream file(std::string(MBID_SOURCE_DIR) + "/scenarios/reference-crane.yaml");
-  std::stringstream text;
-  text << file.rdbuf();
-  std::string scenario = text.str();
-  const std::string elevation = "boom_elevation_deg: 16.0";
-  EXPECT_NE(scenario.find(elevation), std::string::npos);
-  if (scenario.find(elevation) == std::string::npos) return {};
-  scenario.replace(scenario.find(elevation), elevation.size(),
-                   "boom_elevation_deg: " + std::to_string(sweep_case.elevation_deg));
+  const std::string scenario = testing::ShippedScenarioText(
+      "reference-crane.yaml", "boom_elevation_deg: 16.0",
+      "boom_elevation_deg: " + std::to_string(sweep_case.elevation_deg));
   const testing::ScenarioRecord simulated = testing::SimulateScenario(
       YamlReader::FromString(scenario, "reference-crane.yaml"), sweep_case.seed);
   const model::MechanicalModel* model = simulated.model.get();

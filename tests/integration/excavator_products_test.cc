@@ -16,18 +16,12 @@
 namespace mbid {
 namespace {
 
-class ExcavatorProductsTest : public ::testing::TestWithParam<std::uint64_t> {};
-
-TEST_P(ExcavatorProductsTest, ProductsOfTheModesAreNoFourthMode) {
-  const testing::ScenarioRecord simulated = testing::SimulateScenario(
-      YamlReader::FromFile(std::string(MBID_SOURCE_DIR) + "/scenarios/excavator-arm.yaml"),
-      GetParam());
-  const model::MechanicalModel* model = simulated.model.get();
-  const simulation::SimulationResult& record = simulated.record;
-  const identification::ModalResult identified =
-      identification::Identify(record.measured, identification::IdentificationOptions{});
-
-  const std::vector<model::Mode> exact = model::CalcModes(model->Linearize());
+// The identified modes that are no combination tone: three, each within 5 standard deviations
+// plus 0.5 % of the linearization's (2 and 10 mrad deflections move the modes by under 0.1 %:
+// the noiseless records' modes against it).
+void ExpectTheThreeExactModes(const testing::ScenarioRecord& simulated,
+                              const identification::ModalResult& identified) {
+  const std::vector<model::Mode> exact = model::CalcModes(simulated.model->Linearize());
   ASSERT_EQ(exact.size(), 3u);
   std::vector<identification::IdentifiedMode> modes;
   for (const identification::IdentifiedMode& mode : identified.modes) {
@@ -35,18 +29,30 @@ TEST_P(ExcavatorProductsTest, ProductsOfTheModesAreNoFourthMode) {
   }
   ASSERT_EQ(modes.size(), 3u) << ::testing::PrintToString(identified.warnings);
   for (size_t k = 0; k < 3; ++k) {
-    // Within 5 standard deviations plus 0.5 %: the 2 mrad deflection's second-order terms move
-    // the modes by under 0.1 % (the noiseless record's modes against the linearization).
     EXPECT_NEAR(modes[k].frequency_hz, exact[k].frequency_hz(),
                 5 * modes[k].std_frequency_hz + 0.005 * exact[k].frequency_hz())
         << k;
   }
+}
+
+bool Warns(const identification::ModalResult& identified, const std::string& what) {
+  return std::any_of(identified.warnings.begin(), identified.warnings.end(),
+                     [&what](const std::string& w) { return w.find(what) != std::string::npos; });
+}
+
+class ExcavatorProductsTest : public ::testing::TestWithParam<std::uint64_t> {};
+
+TEST_P(ExcavatorProductsTest, ProductsOfTheModesAreNoFourthMode) {
+  const testing::ScenarioRecord simulated = testing::SimulateScenario(
+      YamlReader::FromString(testing::ShippedScenarioText("excavator-arm.yaml"),
+                             "excavator-arm.yaml"),
+      GetParam());
+  const identification::ModalResult identified =
+      identification::Identify(simulated.record.measured, identification::IdentificationOptions{});
+  ExpectTheThreeExactModes(simulated, identified);
   // The component between the products is still reported, marked, and the warning says why.
-  const bool explained = std::any_of(
-      identified.warnings.begin(), identified.warnings.end(), [](const std::string& warning) {
-        return warning.find("beside the products of the modes' poles") != std::string::npos;
-      });
-  EXPECT_TRUE(explained) << ::testing::PrintToString(identified.warnings);
+  EXPECT_TRUE(Warns(identified, "beside the products of the modes' poles"))
+      << ::testing::PrintToString(identified.warnings);
   // A tone, even an undetermined one, is no reason to distrust the three modes.
   EXPECT_TRUE(identified.reliable) << ::testing::PrintToString(identified.reasons);
 }
@@ -58,6 +64,27 @@ TEST_P(ExcavatorProductsTest, ProductsOfTheModesAreNoFourthMode) {
 INSTANTIATE_TEST_SUITE_P(CampaignSeeds, ExcavatorProductsTest,
                          ::testing::Values(1705094727u, 2085212535u, 936228567u, 852914484u,
                                            93948706u));
+
+// The same arm released from 5 times the deflection (10 mrad, a harder pull): its tones f1 + f3
+// and 2 f3 have 3-4 % of their stronger parent's amplitude, above a tone of small vibrations
+// (2 %); in 28 of 40 seeds one was reported as a reliable fourth mode. Three of those seeds.
+class ExcavatorLargeVibrationTest : public ::testing::TestWithParam<std::uint64_t> {};
+
+TEST_P(ExcavatorLargeVibrationTest, TonesOfALargeReleaseAreNoFourthMode) {
+  const std::string scenario = testing::ShippedScenarioText(
+      "excavator-arm.yaml", "deflection_rad: {swing: 0.002, boom: -0.0015, stick: 0.002}",
+      "deflection_rad: {swing: 0.01, boom: -0.0075, stick: 0.01}");
+  const testing::ScenarioRecord simulated =
+      testing::SimulateScenario(YamlReader::FromString(scenario, "excavator-arm.yaml"), GetParam());
+  const identification::ModalResult identified =
+      identification::Identify(simulated.record.measured, identification::IdentificationOptions{});
+  ExpectTheThreeExactModes(simulated, identified);
+  EXPECT_TRUE(Warns(identified, "the test's vibrations were large"))
+      << ::testing::PrintToString(identified.warnings);
+}
+
+INSTANTIATE_TEST_SUITE_P(CampaignSeeds, ExcavatorLargeVibrationTest,
+                         ::testing::Values(1216681718u, 867888699u, 1463950283u));
 
 }  // namespace
 }  // namespace mbid

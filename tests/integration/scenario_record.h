@@ -3,7 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <fstream>
 #include <memory>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "mbid/common/yaml_reader.h"
@@ -28,6 +31,20 @@ inline ScenarioRecord SimulateScenario(const YamlReader& root, std::uint64_t see
       Simulate(*out.model, simulation::ReadExcitation(root.Child("excitation"), *out.model),
                simulation::ReadSimulationOptions(root.Child("simulation")), sensors);
   return out;
+}
+
+// The text of scenarios/<name> with `from` replaced by `to` (empty `from`: as shipped); throws
+// if `from` is not in it, so that a changed scenario fails the test rather than passing it.
+inline std::string ShippedScenarioText(const std::string& name, const std::string& from = "",
+                                       const std::string& to = "") {
+  std::ifstream file(std::string(MBID_SOURCE_DIR) + "/scenarios/" + name);
+  std::stringstream text;
+  text << file.rdbuf();
+  std::string scenario = text.str();
+  if (from.empty()) return scenario;
+  const size_t at = scenario.find(from);
+  if (at == std::string::npos) throw std::runtime_error(name + " has no '" + from + "'");
+  return scenario.replace(at, from.size(), to);
 }
 
 }  // namespace mbid::testing
