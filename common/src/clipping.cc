@@ -10,6 +10,9 @@
 namespace mbid {
 namespace {
 
+// A sample is at a rail when within this fraction of the channel's range of its extreme.
+constexpr double kRailTolerance = 1e-9;
+
 // The smallest positive step between the channel's distinct values: its quantization step when
 // it was recorded on a grid (an ADC's counts, a logger's printed digits), else about roundoff.
 double SmallestStep(const Eigen::Ref<const Eigen::VectorXd>& values) {
@@ -54,7 +57,7 @@ Runs RunsAt(const Eigen::Ref<const Eigen::VectorXd>& values, double level, doubl
 // The last sample of `values` held at a rail of `clipping` (within FindClipping's tolerance).
 Eigen::Index LastClipped(const Eigen::Ref<const Eigen::VectorXd>& values,
                          const Clipping& clipping) {
-  const double tolerance = 1e-9 * (clipping.maximum - clipping.minimum);
+  const double tolerance = kRailTolerance * (clipping.maximum - clipping.minimum);
   for (Eigen::Index j = values.size() - 1; j >= 0; --j) {
     if ((clipping.at_maximum && std::abs(values[j] - clipping.maximum) <= tolerance) ||
         (clipping.at_minimum && std::abs(values[j] - clipping.minimum) <= tolerance)) {
@@ -103,7 +106,7 @@ std::optional<Clipping> FindClipping(const Eigen::Ref<const Eigen::VectorXd>& va
   const double high = values.maxCoeff(), low = values.minCoeff();
   const double range = high - low;
   if (!(range > 0) || SmallestStep(values) > 1e-3 * range) return std::nullopt;
-  const double tolerance = 1e-9 * range;
+  const double tolerance = kRailTolerance * range;
   const Runs top = RunsAt(values, high, tolerance);
   const Runs bottom = RunsAt(values, low, tolerance);
   const bool clipped =

@@ -8,18 +8,16 @@
 #include <optional>
 
 #include "mbid/common/clipping.h"
+#include "record.h"
 
 namespace mbid::identification {
 
 void SkipClippedStart(const Measurement& measurement, IdentificationOptions* applied,
                       ModalResult* result) {
-  const double tau = measurement.sample_interval_s;
   const Eigen::VectorXd time = measurement.CalcTime();
-  // The window's samples as PrepareRecord keeps them (half a sample of slack on each side).
-  Eigen::Index first = 0;
-  while (first < time.size() && time[first] < applied->window_start_s - 0.5 * tau) ++first;
-  Eigen::Index last = time.size() - 1;
-  while (last >= first && time[last] > applied->window_end_s + 0.5 * tau) --last;
+  const WindowRows window = FindWindowRows(measurement, *applied);
+  const Eigen::Index first = window.first;
+  const Eigen::Index last = window.last;
   const std::optional<ClippedStart> clipped =
       FindClippedStart(measurement, first, last, applied->channels);
   if (!clipped) return;

@@ -20,23 +20,30 @@
 namespace mbid::identification {
 namespace {
 
+// 3 combined standard deviations of a mode and the sum of two others' poles.
+struct Spread {
+  double frequency_hz = 0;
+  double decay_per_s = 0;
+};
+
+Spread CalcSpread(const IdentifiedMode& tone, double variance_frequency, double variance_decay) {
+  return {3 * std::sqrt(variance_frequency + tone.std_frequency_hz * tone.std_frequency_hz),
+          3 * std::sqrt(variance_decay + tone.std_decay_rate_per_s * tone.std_decay_rate_per_s)};
+}
+
 // Frequency within 3 standard deviations plus 0.2 % (the tone's pole is refined beside its
 // parents and shifted by their errors); decay within 3 standard deviations plus 25 % (a weak
 // tone's decay is the least determined of its quantities: 21 % off on the excavator arm). Only
 // where those 3 standard deviations are narrow (6 % of the frequency, the decay itself) does a
 // match tell a sum from a coincidence: a mode known to +- 0.8 Hz matches some sum of any others.
 bool Matches(const IdentifiedMode& tone, double frequency_hz, double decay_per_s,
-             double variance_frequency, double variance_decay) {
-  const double spread_frequency =
-      3 * std::sqrt(variance_frequency + tone.std_frequency_hz * tone.std_frequency_hz);
-  const double spread_decay =
-      3 * std::sqrt(variance_decay + tone.std_decay_rate_per_s * tone.std_decay_rate_per_s);
-  if (!(spread_frequency <= 0.06 * tone.frequency_hz && spread_decay <= decay_per_s)) {
+             const Spread& spread) {
+  if (!(spread.frequency_hz <= 0.06 * tone.frequency_hz && spread.decay_per_s <= decay_per_s)) {
     return false;
   }
   return std::abs(tone.frequency_hz - frequency_hz) <=
-             spread_frequency + 2e-3 * tone.frequency_hz &&
-         std::abs(tone.decay_rate_per_s - decay_per_s) <= spread_decay + 0.25 * decay_per_s;
+             spread.frequency_hz + 2e-3 * tone.frequency_hz &&
+         std::abs(tone.decay_rate_per_s - decay_per_s) <= spread.decay_per_s + 0.25 * decay_per_s;
 }
 
 // The largest amplitude of a mode over the channels, each in units of its noise: a product of
@@ -68,14 +75,9 @@ constexpr double kMaxToneRatio = 0.02;
 constexpr double kMaxLargeToneRatio = 0.10;
 constexpr double kPreciseFrequency = 0.01;
 
-bool IsPrecise(const IdentifiedMode& tone, double decay_per_s, double variance_frequency,
-               double variance_decay) {
-  const double spread_frequency =
-      3 * std::sqrt(variance_frequency + tone.std_frequency_hz * tone.std_frequency_hz);
-  const double spread_decay =
-      3 * std::sqrt(variance_decay + tone.std_decay_rate_per_s * tone.std_decay_rate_per_s);
-  return spread_frequency <= kPreciseFrequency * tone.frequency_hz &&
-         spread_decay <= 0.25 * decay_per_s;
+bool IsPrecise(const IdentifiedMode& tone, double decay_per_s, const Spread& spread) {
+  return spread.frequency_hz <= kPreciseFrequency * tone.frequency_hz &&
+         spread.decay_per_s <= 0.25 * decay_per_s;
 }
 
 constexpr size_t kMaxParents = 6;
@@ -208,17 +210,25 @@ void MarkProductsOfModes(const AnalysisRecord& record, const IdentificationOptio
     // Locally: the record less the fitted modes outside the candidate's band (which hardly
     // overlap it), fitted with those inside, the products, and the candidate last; a fit of
     // all of them per candidate costs many times more on a record of many spurious poles.
-    std::vector<std::complex<double>> inside;
-    Eigen::MatrixXd values = record.decimated - all->reconstruction;
-    for (size_t k = 0; k <= modes.size(); ++k) {
-      const size_t mode = k < modes.size() ? k : m;  // the candidate last
-      if (k == m || (k < modes.size() && !Overlap(modes[k].lambda, candidate))) continue;
-      const std::vector<std::complex<double>> pole = {modes[mode].lambda};
-      values += CalcDampedSinusoidBasis(pole, record.decimated_interval_s,
-                                        static_cast<int>(values.rows()), false) *
-                all->coefficients.middleRows(2 * static_cast<Eigen::Index>(mode), 2);
-      if (k < modes.size()) inside.push_back(modes[k].lambda);
+    std::vector<size_t> local;  // the modes inside the band, then the candidate
+    for (size_t k = 0; k < modes.size(); ++k) {
+      if (k != m && Overlap(modes[k].lambda, candidate)) local.push_back(k);
     }
+    local.push_back(m);
+    std::vector<std::complex<double>> poles;
+    Eigen::MatrixXd coefficients(2 * local.size(), record.decimated.cols());
+    for (size_t i = 0; i < local.size(); ++i) {
+      poles.push_back(modes[local[i]].lambda);
+      coefficients.middleRows(2 * static_cast<Eigen::Index>(i), 2) =
+          all->coefficients.middleRows(2 * static_cast<Eigen::Index>(local[i]), 2);
+    }
+    const Eigen::MatrixXd values =
+        record.decimated - all->reconstruction +
+        CalcDampedSinusoidBasis(poles, record.decimated_interval_s,
+                                static_cast<int>(record.decimated.rows()), false) *
+            coefficients;
+    // The modes inside the band, the products, and the candidate last.
+    std::vector<std::complex<double>> inside(poles.begin(), poles.end() - 1);
     for (const Product& product : products) inside.push_back(product.lambda);
     inside.push_back(candidate.lambda);
     const AmplitudeFit fit = FitAmplitudes(values, record.decimated_interval_s, inside, false);
@@ -255,17 +265,15 @@ void MarkCombinationTones(const AnalysisRecord& record, const IdentificationOpti
         const IdentifiedMode& low = modes[a];
         const IdentifiedMode& high = modes[b];
         if (!low.combination.empty() && !high.combination.empty()) continue;
-        const double variance_frequency =
-            Square(low.std_frequency_hz) + Square(high.std_frequency_hz);
-        const double variance_decay =
-            Square(low.std_decay_rate_per_s) + Square(high.std_decay_rate_per_s);
+        const Spread spread =
+            CalcSpread(tone, Square(low.std_frequency_hz) + Square(high.std_frequency_hz),
+                       Square(low.std_decay_rate_per_s) + Square(high.std_decay_rate_per_s));
         const double decay = low.decay_rate_per_s + high.decay_rate_per_s;
-        if (Matches(tone, low.frequency_hz + high.frequency_hz, decay, variance_frequency,
-                    variance_decay)) {
+        if (Matches(tone, low.frequency_hz + high.frequency_hz, decay, spread)) {
           tone.combination =
               a == b ? fmt::format("2 f{}", a + 1) : fmt::format("f{} + f{}", a + 1, b + 1);
-        } else if (a != b && Matches(tone, std::abs(high.frequency_hz - low.frequency_hz), decay,
-                                     variance_frequency, variance_decay)) {
+        } else if (a != b &&
+                   Matches(tone, std::abs(high.frequency_hz - low.frequency_hz), decay, spread)) {
           tone.combination = fmt::format("f{} - f{}", std::max(a, b) + 1, std::min(a, b) + 1);
         }
         if (tone.combination.empty()) continue;
@@ -273,8 +281,7 @@ void MarkCombinationTones(const AnalysisRecord& record, const IdentificationOpti
         const std::string share = fmt::format("{:.2g} % of f{}'s amplitude", 100 * ratio,
                                               (largest[a] >= largest[b] ? a : b) + 1);
         if (ratio <= kMaxToneRatio) continue;
-        if (ratio <= kMaxLargeToneRatio &&
-            IsPrecise(tone, decay, variance_frequency, variance_decay)) {
+        if (ratio <= kMaxLargeToneRatio && IsPrecise(tone, decay, spread)) {
           large = share;
           continue;
         }

@@ -104,6 +104,21 @@ int RequiredSamples(const IdentificationOptions& options, int channels) {
   return FindMethod(options.method.name())->required_samples(options, channels);
 }
 
+WindowRows FindWindowRows(const Measurement& measurement, const IdentificationOptions& options) {
+  const double tau = measurement.sample_interval_s;
+  const double t0 = measurement.start_time_s;
+  WindowRows window;
+  window.last = measurement.samples() - 1;
+  while (window.first < measurement.samples() &&
+         t0 + window.first * tau < options.window_start_s - 0.5 * tau) {
+    ++window.first;
+  }
+  while (window.last >= window.first && t0 + window.last * tau > options.window_end_s + 0.5 * tau) {
+    --window.last;
+  }
+  return window;
+}
+
 AnalysisRecord PrepareRecord(const Measurement& measurement, const IdentificationOptions& options,
                              const std::string& origin) {
   const double tau = measurement.sample_interval_s;
@@ -142,15 +157,10 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
     throw InputError(origin, "channels", "the record has no channels", "at least one channel");
   }
 
-  // Time window: samples with window_start_s <= t_j <= window_end_s (half a sample of slack
-  // so that a window given on the sample grid keeps its end samples).
-  const int samples = measurement.samples();
   const double t0 = measurement.start_time_s;
-  int first = 0;
-  while (first < samples && t0 + first * tau < options.window_start_s - 0.5 * tau) ++first;
-  int last = samples - 1;
-  while (last >= first && t0 + last * tau > options.window_end_s + 0.5 * tau) --last;
-  const int count = last - first + 1;
+  const WindowRows window = FindWindowRows(measurement, options);
+  const int first = window.first;
+  const int count = window.count();
   record.sample_interval_s = tau;
   record.start_time_s = t0 + first * tau;
   // The window's channels as recorded (checked below, after the sample count).

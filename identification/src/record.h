@@ -32,6 +32,16 @@ struct AnalysisRecord {
   double flat_frequency_hz = 0;
 };
 
+// The rows of `measurement` in the options' time window: window_start_s <= t_j <= window_end_s,
+// with half a sample of slack so that a window given on the sample grid keeps its end samples.
+// None when last < first.
+struct WindowRows {
+  int first = 0;
+  int last = -1;
+  int count() const { return last - first + 1; }
+};
+WindowRows FindWindowRows(const Measurement& measurement, const IdentificationOptions& options);
+
 // Applies the options (already checked by Identify, its caller) to the measurement and checks the
 // input (see Identify for the errors).
 AnalysisRecord PrepareRecord(const Measurement& measurement, const IdentificationOptions& options,

@@ -31,11 +31,6 @@ ModalResult IdentifyNoisyPlatform(const SignalSpec& spec, const Eigen::MatrixXd&
   return Identify(MakeRecord(spec, testing::AddNoise(clean, PlatformNoise(), &rng)), {});
 }
 
-bool Warns(const ModalResult& result, const std::string& text) {
-  return std::any_of(result.warnings.begin(), result.warnings.end(),
-                     [&](const std::string& w) { return w.find(text) != std::string::npos; });
-}
-
 TEST(CloseModesTest, TwoModesInsideEachOthersBandwidthAreSplit) {
   // At the signal order the pair is one mode at 8.10-8.22 Hz with a standard deviation of
   // 0.05 Hz (6 of them from either true mode), its residual at the noise level: reliable and
@@ -45,7 +40,7 @@ TEST(CloseModesTest, TwoModesInsideEachOthersBandwidthAreSplit) {
   for (int seed = 1; seed <= 5; ++seed) {
     const ModalResult result = IdentifyNoisyPlatform(spec, clean, seed);
     ASSERT_EQ(result.modes.size(), 4u) << "seed " << seed;
-    EXPECT_TRUE(Warns(result, "splitting")) << "seed " << seed;
+    EXPECT_TRUE(testing::Mentions(result.warnings, "splitting")) << "seed " << seed;
     for (size_t k = 0; k < 4; ++k) {
       // Within 4 reported standard deviations (5 seeds x 4 modes x 2 quantities).
       const IdentifiedMode& mode = result.modes[k];
@@ -67,8 +62,8 @@ TEST(CloseModesTest, ASingleModeIsNotSplit) {
   for (int seed = 1; seed <= 5; ++seed) {
     const ModalResult result = IdentifyNoisyPlatform(spec, clean, seed);
     ASSERT_EQ(result.modes.size(), 3u) << "seed " << seed;
-    EXPECT_FALSE(Warns(result, "splitting")) << "seed " << seed;
-    EXPECT_FALSE(Warns(result, "shape of its own")) << "seed " << seed;
+    EXPECT_FALSE(testing::Mentions(result.warnings, "splitting")) << "seed " << seed;
+    EXPECT_FALSE(testing::Mentions(result.warnings, "shape of its own")) << "seed " << seed;
     EXPECT_TRUE(result.reliable) << ::testing::PrintToString(result.reasons);
   }
 }
@@ -83,7 +78,8 @@ TEST(CloseModesTest, APairAbsorbedByAStrongerModeIsWarnedOf) {
   int warned = 0;
   for (int seed = 1; seed <= 5; ++seed) {
     const ModalResult result = IdentifyNoisyPlatform(spec, clean, seed);
-    if (result.modes.size() == 2u && Warns(result, "shape of its own")) ++warned;
+    if (result.modes.size() == 2u && testing::Mentions(result.warnings, "shape of its own"))
+      ++warned;
   }
   // Each seed's score is a draw: at least 3 of 5 above the threshold (all 5 measured).
   EXPECT_GE(warned, 3);

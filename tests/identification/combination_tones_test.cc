@@ -46,11 +46,7 @@ TEST(CombinationTonesTest, AComponentAtTheSumOfTwoPolesIsATone) {
     EXPECT_TRUE(result.modes[1].combination.empty());
     EXPECT_EQ(result.modes[2].combination, "f1 + f2")
         << "seed " << seed << ": " << ::testing::PrintToString(result.warnings);
-    EXPECT_TRUE(std::any_of(result.warnings.begin(), result.warnings.end(),
-                            [](const std::string& w) {
-                              return w.find("Hz is a combination tone (f1 + f2)") !=
-                                     std::string::npos;
-                            }))
+    EXPECT_TRUE(testing::Mentions(result.warnings, "Hz is a combination tone (f1 + f2)"))
         << ::testing::PrintToString(result.warnings);
     // A tone is no reason to distrust the modes.
     EXPECT_TRUE(result.reliable) << ::testing::PrintToString(result.reasons);
@@ -77,11 +73,8 @@ TEST(CombinationTonesTest, AModeAtASumWithAToneTooStrongIsAModeWithAWarning) {
     const ModalResult result = IdentifyArm(spec, seed);
     ASSERT_EQ(result.modes.size(), 3u) << "seed " << seed;
     for (const IdentifiedMode& mode : result.modes) EXPECT_TRUE(mode.combination.empty());
-    EXPECT_TRUE(std::any_of(result.warnings.begin(), result.warnings.end(),
-                            [](const std::string& w) {
-                              return w.find("lies where a combination tone would (f1 + f2 with ") !=
-                                     std::string::npos;
-                            }))
+    EXPECT_TRUE(
+        testing::Mentions(result.warnings, "lies where a combination tone would (f1 + f2 with "))
         << ::testing::PrintToString(result.warnings);
   }
 }
@@ -98,11 +91,7 @@ TEST(CombinationTonesTest, AStrongToneOfLargeVibrationsAtTheExactSumIsATone) {
     ASSERT_EQ(result.modes.size(), 3u) << "seed " << seed;
     EXPECT_EQ(result.modes[2].combination, "f1 + f2")
         << "seed " << seed << ": " << ::testing::PrintToString(result.warnings);
-    EXPECT_TRUE(std::any_of(result.warnings.begin(), result.warnings.end(),
-                            [](const std::string& w) {
-                              return w.find("the test's vibrations were large") !=
-                                     std::string::npos;
-                            }))
+    EXPECT_TRUE(testing::Mentions(result.warnings, "the test's vibrations were large"))
         << ::testing::PrintToString(result.warnings);
   }
 }

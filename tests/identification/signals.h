@@ -159,4 +159,12 @@ inline SignalSpec PaperSignal() {
   return spec;
 }
 
+// Whether one of `lines` (warnings, reasons) contains `what`.
+inline bool Mentions(const std::vector<std::string>& lines, const std::string& what) {
+  for (const std::string& line : lines) {
+    if (line.find(what) != std::string::npos) return true;
+  }
+  return false;
+}
+
 }  // namespace mbid::testing

@@ -59,17 +59,13 @@ std::vector<std::string> ExpectTheFourExactModes(const SweepCase& sweep_case,
   return identified.warnings;
 }
 
-bool Mentions(const std::vector<std::string>& lines, const std::string& what) {
-  return std::any_of(lines.begin(), lines.end(),
-                     [&](const std::string& w) { return w.find(what) != std::string::npos; });
-}
-
 TEST(CraneElevationTest, AModeThatDriftsWithAmplitudeIsNoHiddenPair) {
   // 40 deg, seed 936228567: the 0.71 Hz mode leaves the Taylor terms of a drift in its own shape
   // (close-mode score 39.9 against 26.1 when the shape is not taken out; 6.9 against 18.5 when
   // it is). Split, it gave 0.7072 +- 0.0025 Hz and 0.4175 +- 0.075 Hz, decay 1.52 +- 0.58 1/s.
   const std::vector<std::string> warnings = ExpectTheFourExactModes({40, 936228567});
-  EXPECT_FALSE(Mentions(warnings, "found by splitting")) << ::testing::PrintToString(warnings);
+  EXPECT_FALSE(testing::Mentions(warnings, "found by splitting"))
+      << ::testing::PrintToString(warnings);
 }
 
 TEST(CraneElevationTest, ASplitWhosePoleTheRecordCannotPlaceIsRefused) {
@@ -78,7 +74,8 @@ TEST(CraneElevationTest, ASplitWhosePoleTheRecordCannotPlaceIsRefused) {
   // kept as a fifth mode. Refused, the four modes stand and the result says why it is doubtful.
   std::vector<std::string> reasons;
   ExpectTheFourExactModes({25, 1471176023}, &reasons);
-  EXPECT_TRUE(Mentions(reasons, "the record does not determine the two modes it splits into"))
+  EXPECT_TRUE(
+      testing::Mentions(reasons, "the record does not determine the two modes it splits into"))
       << ::testing::PrintToString(reasons);
 }
 
@@ -86,11 +83,11 @@ TEST(CraneElevationTest, AWeakModeNearASumIsNoCombinationTone) {
   // 45 deg, seed 1750952045: the third mode (2.21 Hz, 3.0 1/s exact) was identified at
   // 2.27 +- 0.03 Hz, matching f1 + f2 = 2.23 Hz, with 5.5 % of f2's amplitude; this record's
   // 0.77 Hz mode also has a significant close-mode score.
-  EXPECT_TRUE(Mentions(ExpectTheFourExactModes({45, 1750952045}),
-                       "lies where a combination tone would (f1 + f2"));
+  EXPECT_TRUE(testing::Mentions(ExpectTheFourExactModes({45, 1750952045}),
+                                "lies where a combination tone would (f1 + f2"));
   // 35 deg, seed 1138335979: the third mode near f4 - f1, with 18 % of f1's amplitude.
-  EXPECT_TRUE(Mentions(ExpectTheFourExactModes({35, 1138335979}),
-                       "lies where a combination tone would (f4 - f1"));
+  EXPECT_TRUE(testing::Mentions(ExpectTheFourExactModes({35, 1138335979}),
+                                "lies where a combination tone would (f4 - f1"));
 }
 
 }  // namespace

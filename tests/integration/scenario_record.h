@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/model_factory.h"
@@ -45,6 +46,14 @@ inline std::string ShippedScenarioText(const std::string& name, const std::strin
   const size_t at = scenario.find(from);
   if (at == std::string::npos) throw std::runtime_error(name + " has no '" + from + "'");
   return scenario.replace(at, from.size(), to);
+}
+
+// Whether one of `lines` (warnings, reasons) contains `what`.
+inline bool Mentions(const std::vector<std::string>& lines, const std::string& what) {
+  for (const std::string& line : lines) {
+    if (line.find(what) != std::string::npos) return true;
+  }
+  return false;
 }
 
 }  // namespace mbid::testing
