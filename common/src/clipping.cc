@@ -74,12 +74,15 @@ std::optional<ClippedStart> FindClippedStart(const Measurement& record, Eigen::I
                                              const std::vector<std::string>& channels) {
   const Eigen::Index count = last - first + 1;
   if (first < 0 || last >= record.values.rows() || count < 16) return std::nullopt;
+  // Channels left out of the analysis neither set the start nor, stuck on a rail, prevent it.
+  const auto analysed = [&](int c) {
+    const std::string& name = record.channels[static_cast<size_t>(c)];
+    return channels.empty() || std::find(channels.begin(), channels.end(), name) != channels.end();
+  };
   ClippedStart found{first, ""};
   for (int c = 0; c < record.channel_count(); ++c) {
+    if (!analysed(c)) continue;
     const std::string& name = record.channels[static_cast<size_t>(c)];
-    if (!channels.empty() && std::find(channels.begin(), channels.end(), name) == channels.end()) {
-      continue;
-    }
     const auto values = record.values.col(c).segment(first, count);
     const std::optional<Clipping> clipping = FindClipping(values);
     if (!clipping) continue;
@@ -93,8 +96,8 @@ std::optional<ClippedStart> FindClippedStart(const Measurement& record, Eigen::I
     return std::nullopt;
   }
   for (int c = 0; c < record.channel_count(); ++c) {
-    if (FindClipping(
-            record.values.col(c).segment(found.first_whole, last - found.first_whole + 1))) {
+    if (analysed(c) && FindClipping(record.values.col(c).segment(found.first_whole,
+                                                                 last - found.first_whole + 1))) {
       return std::nullopt;
     }
   }

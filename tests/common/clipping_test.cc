@@ -73,5 +73,38 @@ TEST(ClippingTest, ACoarseGridIsNotJudgedAFineOneIs) {
   EXPECT_TRUE(FindClipping(fine.cwiseMin(0.6)));
 }
 
+// Two channels of the decay: `a` held at a rail of 0.6 on its first peaks, `b` as given.
+Measurement TwoChannels(const Eigen::VectorXd& b) {
+  Measurement record;
+  record.channels = {"a", "b"};
+  record.units = {"m", "m"};
+  record.sample_interval_s = 0.01;
+  record.values.resize(801, 2);
+  record.values.col(0) = Decay(1e-3).cwiseMin(0.6);
+  record.values.col(1) = b;
+  return record;
+}
+
+TEST(ClippingTest, AClippedStartIsFoundInTheAnalysedChannelsOnly) {
+  // `a`'s last clipped sample is on its third peak (t = 1.33 s, 1.33 periods in): the record is
+  // whole from the next one on, well over half of it left.
+  const Eigen::VectorXd decay = Decay(1e-3);
+  const std::optional<ClippedStart> start = FindClippedStart(TwoChannels(decay), 0, 800);
+  ASSERT_TRUE(start);
+  const Eigen::VectorXd a = Decay(1e-3).cwiseMin(0.6);
+  EXPECT_EQ(a[start->first_whole - 1], 0.6);
+  EXPECT_LT(a.segment(start->first_whole, 801 - start->first_whole).maxCoeff(), 0.6);
+  EXPECT_THAT(start->reason, HasSubstr("channel a stays at its largest value"));
+  // `b` on a rail to the end (0.02 and above held; the decay's last peaks are 0.023): no decay back
+  // inside its range, so no start is whole - unless `b` is left out of the analysis.
+  const Measurement stuck = TwoChannels(decay.cwiseMin(0.02));
+  EXPECT_FALSE(FindClippedStart(stuck, 0, 800));
+  const std::optional<ClippedStart> without_b = FindClippedStart(stuck, 0, 800, {"a"});
+  ASSERT_TRUE(without_b);
+  EXPECT_EQ(without_b->first_whole, start->first_whole);
+  // Only `b` analysed: clipped to the end, nothing to skip to.
+  EXPECT_FALSE(FindClippedStart(stuck, 0, 800, {"b"}));
+}
+
 }  // namespace
 }  // namespace mbid

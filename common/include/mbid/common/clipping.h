@@ -39,8 +39,8 @@ struct ClippedStart {
 };
 
 // The clipped start of rows [first, last] of `record` (in `channels`, or all if empty): found
-// if at least half of those rows are left after it and no channel is clipped in them (a
-// channel on a rail to the end is a stuck sensor, not a decay back inside its range).
+// if at least half of those rows are left after it and none of those channels is clipped in
+// them (a channel on a rail to the end is a stuck sensor, not a decay back inside its range).
 std::optional<ClippedStart> FindClippedStart(const Measurement& record, Eigen::Index first,
                                              Eigen::Index last,
                                              const std::vector<std::string>& channels = {});
