@@ -1,5 +1,6 @@
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -13,6 +14,7 @@
 
 namespace mbid::campaign {
 using validation::LoadScenarioFromText;
+using validation::ModelTruth;
 using validation::Scenario;
 using validation::WriteModelTruth;
 using validation::WriteSimulationInfo;
@@ -48,6 +50,25 @@ void AddExactModes(const std::vector<model::Mode>& modes, CaseOutcome& outcome) 
   outcome.row["exact.min_damping_ratio"] = Number(smallest);
 }
 
+// The inputs a case's model and noise-free test depend on: all but its sensors' seed and errors
+// (applied to the noise-free record afterwards) and its identification and validation settings.
+std::string TestKey(const CampaignCase& one_case) {
+  static const std::vector<std::string> kAfterTheTest = {
+      "sensors.seed",    "sensors.noise_std_", "sensors.bias_", "sensors.quantization_step_",
+      "identification.", "validation."};
+  std::string key;
+  for (const Assignment& input : one_case.inputs) {
+    const std::string dotted = input.key + ".";
+    if (std::any_of(kAfterTheTest.begin(), kAfterTheTest.end(), [&](const std::string& prefix) {
+          return dotted.compare(0, prefix.size(), prefix) == 0;
+        })) {
+      continue;
+    }
+    key += input.key + "=" + ValueText(input.value) + "\n";
+  }
+  return key;
+}
+
 void Fail(CaseOutcome& outcome, const std::string& status, const std::string& step,
           const std::string& reason) {
   outcome.status = status;
@@ -57,7 +78,17 @@ void Fail(CaseOutcome& outcome, const std::string& status, const std::string& st
 
 }  // namespace
 
-CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case) {
+struct CaseCache::Test {
+  std::string key;  // TestKey of the case that computed it
+  std::shared_ptr<const model::MechanicalModel> model;
+  std::shared_ptr<const ModelTruth> truth;
+  std::shared_ptr<const simulation::SimulationResult> test;  // none unless the case simulates
+};
+
+CaseCache::CaseCache() = default;
+CaseCache::~CaseCache() = default;
+
+CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case, CaseCache* cache) {
   CaseOutcome outcome;
   outcome.id = one_case.id;
   outcome.index = one_case.index;
@@ -81,26 +112,49 @@ CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case) 
     }
 
     step = "modes";
-    std::shared_ptr<const model::MechanicalModel> model = scenario.MakeModel();
-    for (const model::Parameter& parameter : model->parameters()) {
+    const std::string key = cache != nullptr ? TestKey(one_case) : "";
+    const CaseCache::Test* cached =
+        cache != nullptr && cache->last_ && cache->last_->key == key ? cache->last_.get() : nullptr;
+    if (cached != nullptr) ++cache->hits_;
+    const std::shared_ptr<const model::MechanicalModel> model =
+        cached != nullptr ? cached->model : scenario.MakeModel();
+    const std::shared_ptr<const ModelTruth> truth =
+        cached != nullptr ? cached->truth
+                          : std::make_shared<const ModelTruth>(validation::CalcModelTruth(*model));
+    for (const model::Parameter& parameter : truth->parameters) {
       row["truth." + parameter.name] = parameter.value;
     }
-    AddExactModes(model::CalcModes(model->Linearize()), outcome);
+    AddExactModes(truth->modes, outcome);
 
     if (!campaign.steps.simulate) {
-      outcome.groups.push_back([model](H5Writer& file) { WriteModelTruth(file, *model); });
+      if (cache != nullptr && cached == nullptr) {
+        cache->last_ =
+            std::make_unique<const CaseCache::Test>(CaseCache::Test{key, model, truth, {}});
+      }
+      outcome.groups.push_back([truth](H5Writer& file) { WriteModelTruth(file, *truth); });
     } else {
       step = "simulate";
       const simulation::Excitation excitation = scenario.RequireExcitation();
-      const auto test = std::make_shared<const simulation::SimulationResult>(
-          simulation::Simulate(*model, excitation, scenario.simulation, scenario.sensors));
+      std::shared_ptr<const simulation::SimulationResult> test;
+      if (cached != nullptr) {
+        auto repeated = std::make_shared<simulation::SimulationResult>(*cached->test);
+        repeated->measured = simulation::ApplySensor(repeated->exact, scenario.sensors);
+        test = std::move(repeated);
+      } else {
+        test = std::make_shared<const simulation::SimulationResult>(
+            simulation::Simulate(*model, excitation, scenario.simulation, scenario.sensors));
+        if (cache != nullptr) {
+          cache->last_ =
+              std::make_unique<const CaseCache::Test>(CaseCache::Test{key, model, truth, test});
+        }
+      }
       row["simulation.samples"] = test->measured.samples();
       row["simulation.cvodes_steps"] = test->statistics.steps;
       row["simulation.rhs_evaluations"] = test->statistics.rhs_evaluations;
       const simulation::SimulationOptions options = scenario.simulation;
-      outcome.groups.push_back([model, test, excitation, options](H5Writer& file) {
+      outcome.groups.push_back([truth, test, excitation, options](H5Writer& file) {
         file.WriteMeasurement(test->measured);
-        WriteTruth(file, *model, *test);
+        WriteTruth(file, *truth, *test);
         WriteSimulationInfo(file, excitation, options, *test);
       });
       if (campaign.study) campaign.study->AddCaseMetrics(*test, &outcome);

@@ -235,8 +235,10 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const std::string& outp
   };
   const auto work = [&] {
     try {
+      CaseCache cache;
       while (const std::optional<int> index = queue.Pop()) {
-        if (!commits.Push(ComputeCase(campaign, campaign.cases[static_cast<size_t>(*index)]))) {
+        if (!commits.Push(
+                ComputeCase(campaign, campaign.cases[static_cast<size_t>(*index)], &cache))) {
           break;
         }
       }

@@ -352,6 +352,45 @@ laws:
   EXPECT_NE(text.str().find("### truth.d_z (N*s/m)"), std::string::npos) << text.str();
 }
 
+TEST_F(CampaignTest, RepeatedTestsReuseTheSimulationWithTheSameBits) {
+  Write("oscillator.yaml", kOscillator);
+  // Cases in order: stiffness 100 (noise 1e-4 twice, noise 2e-4 twice, a prony-svd
+  // identification), then 200 the same way. Within a stiffness only the sensors' errors and
+  // seed and the identification differ: 4 of each 5 reuse the test before them.
+  const Campaign campaign = LoadCampaign(Write("c.yaml", R"(name: c
+base: oscillator.yaml
+steps: [simulate, identify]
+sweep:
+  - grid:
+      model.joints.angle.stiffness_Nm_per_rad: [100, 200]
+  - list:
+      sensors.noise_std_rad: [1.0e-4, 2.0e-4, 1.0e-4]
+      identification: [{max_modes: 4}, {max_modes: 4}, {method: prony-svd, prony: {order: 6}}]
+  - repeat: 2
+)"));
+  ASSERT_EQ(campaign.cases.size(), 12u);
+  campaign::CaseCache cache;
+  for (size_t i = 0; i < campaign.cases.size(); ++i) {
+    const campaign::CaseOutcome fresh = campaign::ComputeCase(campaign, campaign.cases[i]);
+    const campaign::CaseOutcome reused = campaign::ComputeCase(campaign, campaign.cases[i], &cache);
+    ASSERT_TRUE(fresh.ok()) << fresh.reason;
+    EXPECT_EQ(fresh.row.dump(), reused.row.dump()) << "case " << i;
+    const std::string a = (dir_ / ("fresh" + std::to_string(i) + ".h5")).string();
+    const std::string b = (dir_ / ("reused" + std::to_string(i) + ".h5")).string();
+    campaign::WriteCaseFile(fresh, a);
+    campaign::WriteCaseFile(reused, b);
+    std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+    const std::string bytes_a((std::istreambuf_iterator<char>(fa)), {});
+    const std::string bytes_b((std::istreambuf_iterator<char>(fb)), {});
+    EXPECT_GT(bytes_a.size(), 5000u) << "a record, its truth and its modes";
+    EXPECT_TRUE(bytes_a == bytes_b) << "case " << i << ": the files differ";
+  }
+  EXPECT_EQ(cache.hits(), 10);  // all but the first case of each stiffness
+  // The noise differs between repeats: the reused test got each case's own sensors.
+  EXPECT_NE(campaign::ComputeCase(campaign, campaign.cases[0]).row.dump(),
+            campaign::ComputeCase(campaign, campaign.cases[1]).row.dump());
+}
+
 TEST_F(CampaignTest, IdentificationSettingsAreReadStrictly) {
   Write("oscillator.yaml", kOscillator);
   // The scenario's identification: section reaches the identifier (prony-svd with p = 6 on the

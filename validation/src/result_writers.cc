@@ -17,29 +17,45 @@ Eigen::VectorXd ModeField(const std::vector<model::Mode>& modes,
 
 }  // namespace
 
-void WriteTruth(H5Writer& file, const model::MechanicalModel& model,
+ModelTruth CalcModelTruth(const model::MechanicalModel& model) {
+  ModelTruth truth;
+  truth.parameters = model.parameters();
+  truth.linear = model.Linearize();
+  truth.modes = model::CalcModes(truth.linear);
+  truth.coordinate_names = model.coordinate_names();
+  truth.coordinate_units = model.coordinate_units();
+  truth.output_units = model.output_units();
+  return truth;
+}
+
+void WriteTruth(H5Writer& file, const ModelTruth& truth,
                 const simulation::SimulationResult& result) {
-  WriteModelTruth(file, model);
+  WriteModelTruth(file, truth);
   file.WriteVector("/truth", "initial_q", result.initial_q, "rad");
-  file.WriteStrings("/truth", "coordinates", model.coordinate_names());
+  file.WriteStrings("/truth", "coordinates", truth.coordinate_names);
   for (int c = 0; c < result.exact.channel_count(); ++c) {
     file.WriteVector("/truth/exact", result.exact.channels[c], result.exact.values.col(c),
                      result.exact.units[c]);
   }
 }
 
-void WriteModelTruth(H5Writer& file, const model::MechanicalModel& model) {
-  for (const model::Parameter& parameter : model.parameters()) {
+void WriteTruth(H5Writer& file, const model::MechanicalModel& model,
+                const simulation::SimulationResult& result) {
+  WriteTruth(file, CalcModelTruth(model), result);
+}
+
+void WriteModelTruth(H5Writer& file, const ModelTruth& truth) {
+  for (const model::Parameter& parameter : truth.parameters) {
     file.WriteScalar("/truth/parameters", parameter.name, parameter.value, parameter.units);
   }
-  const model::LinearModel linear = model.Linearize();
+  const model::LinearModel& linear = truth.linear;
   file.WriteStrings("/truth/linear_model", "coordinates", linear.coordinates);
   file.WriteStrings("/truth/linear_model", "outputs", linear.outputs);
-  const std::vector<std::string> coordinate_units = model.coordinate_units();
+  const std::vector<std::string>& coordinate_units = truth.coordinate_units;
   const bool angles = std::all_of(coordinate_units.begin(), coordinate_units.end(),
                                   [](const std::string& unit) { return unit == "rad"; });
   file.WriteStrings("/truth/linear_model", "coordinate_units", coordinate_units);
-  file.WriteStrings("/truth/linear_model", "output_units", model.output_units());
+  file.WriteStrings("/truth/linear_model", "output_units", truth.output_units);
   std::vector<double> orders(linear.outputs.size(), 0.0);
   for (size_t i = 0; i < linear.output_orders.size() && i < orders.size(); ++i) {
     orders[i] = linear.output_orders[i];
@@ -50,7 +66,7 @@ void WriteModelTruth(H5Writer& file, const model::MechanicalModel& model) {
       "1");
   // Mixed machines (angles and slides) have no single unit per matrix.
   const bool plain_outputs =
-      std::all_of(model.output_units().begin(), model.output_units().end(),
+      std::all_of(truth.output_units.begin(), truth.output_units.end(),
                   [](const std::string& unit) { return unit == "rad"; }) &&
       std::all_of(orders.begin(), orders.end(), [](double order) { return order == 0; });
   file.WriteMatrix("/truth/linear_model", "M", linear.M, angles ? "kg*m^2" : "SI, per coordinate");
@@ -63,7 +79,7 @@ void WriteModelTruth(H5Writer& file, const model::MechanicalModel& model) {
                        ? "rad/rad"
                        : "output_units per coordinate_units (and output_orders)");
 
-  const std::vector<model::Mode> modes = model::CalcModes(linear);
+  const std::vector<model::Mode>& modes = truth.modes;
   file.WriteVector("/truth/modes", "frequency_hz", ModeField(modes, &model::Mode::frequency_hz),
                    "Hz");
   file.WriteVector("/truth/modes", "decay_rate_per_s",

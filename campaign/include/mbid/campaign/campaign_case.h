@@ -2,6 +2,7 @@
 
 #include <functional>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -37,11 +38,33 @@ struct CaseOutcome {
   bool ok() const { return status == "ok"; }
 };
 
-// Runs the case: resolves its scenario, builds its own model, computes the exact modes and
-// runs the campaign's steps. Never throws for a failure of the case itself (bad value,
-// integrator, identification): those are recorded in the outcome. Safe to call from several
-// threads at once (each call owns its model and states).
-CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case);
+// What a worker keeps of the last case it simulated. Repeated tests differ only in their sensors'
+// seed and errors (or in how they are identified): the next such case of the same campaign
+// reuses its model, exact modes and noise-free simulation and applies its own sensors to it,
+// with the same bits as computed afresh. A model serves one thread: one cache per worker.
+class CaseCache {
+ public:
+  CaseCache();
+  ~CaseCache();
+  CaseCache(const CaseCache&) = delete;
+  CaseCache& operator=(const CaseCache&) = delete;
+
+  int hits() const { return hits_; }  // cases that reused the cached test
+
+ private:
+  friend CaseOutcome ComputeCase(const Campaign&, const CampaignCase&, CaseCache*);
+  struct Test;
+  std::unique_ptr<const Test> last_;
+  int hits_ = 0;
+};
+
+// Runs the case: resolves its scenario, builds its own model (or takes it from `cache`),
+// computes the exact modes and runs the campaign's steps. Never throws for a failure of the
+// case itself (bad value, integrator, identification): those are recorded in the outcome. Safe
+// to call from several threads at once, each with its own cache or none (each call owns its
+// model and states).
+CaseOutcome ComputeCase(const Campaign& campaign, const CampaignCase& one_case,
+                        CaseCache* cache = nullptr);
 
 // Writes the case's file atomically (temporary name, renamed when complete): the groups of a
 // run at the root, the resolved scenario, and root attributes case_id, index, status, step,
