@@ -11,6 +11,7 @@
 #include "mbid/app/exit_code.h"
 #include "mbid/app/run_cycle.h"
 #include "mbid/app/version.h"
+#include "mbid/common/atomic_file.h"
 #include "mbid/common/error.h"
 #include "mbid/common/interrupt_cleanup.h"
 #include "mbid/identification/options.h"
@@ -244,6 +245,15 @@ int Main(int argc, char** argv) {
     return static_cast<int>(mbid::app::ExitCode::kInvalidInput);
   }
   common.import = MakeOverrides(import_flags);
+  // No output may replace an input or another output. Only one command's lists are filled.
+  std::vector<mbid::NamedFile> inputs{{"SCENARIO", scenario_path}, {"DATA", data_path}};
+  for (const auto* data : {&update_data, &plan_data, &structure_data}) {
+    for (const std::string& path : *data) inputs.push_back({"DATA", path});
+  }
+  inputs.push_back({"--candidates", plan_candidates});
+  std::vector<mbid::NamedFile> outputs{{"-o", output_path}, {"--json", common.json_path}};
+  for (const std::string& path : export_paths) outputs.push_back({"--export", path});
+  mbid::CheckOutputsAreNew(inputs, outputs);
   if (run->parsed()) {
     if (scenario_path.empty()) scenario_path = mbid::validation::DefaultScenarioPath();
     return mbid::app::RunValidationCycle(scenario_path, output_dir, common);

@@ -145,4 +145,40 @@ void AtomicFile::Commit() {
   if (sync_) internal::SyncFolder(fs::path(path_).parent_path().string());
 }
 
+namespace {
+
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code error;
+  if (fs::absolute(a, error).lexically_normal() == fs::absolute(b, error).lexically_normal()) {
+    return true;
+  }
+  return fs::exists(a, error) && fs::exists(b, error) && fs::equivalent(a, b, error);
+}
+
+}  // namespace
+
+void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
+                        const std::vector<NamedFile>& outputs) {
+  for (size_t o = 0; o < outputs.size(); ++o) {
+    const NamedFile& output = outputs[o];
+    if (output.path.empty() || output.path == "-") continue;
+    for (const NamedFile& input : inputs) {
+      if (!input.path.empty() && SameFile(output.path, input.path)) {
+        throw InputError(
+            output.flag, output.path,
+            "is the input " + input.flag + " " + input.path + ", which writing it would destroy",
+            "an output name other than the command's input files");
+      }
+    }
+    for (size_t p = 0; p < o; ++p) {
+      if (!outputs[p].path.empty() && outputs[p].path != "-" &&
+          SameFile(output.path, outputs[p].path)) {
+        throw InputError(output.flag, output.path,
+                         "is also the output of " + outputs[p].flag + ", and one would be lost",
+                         "a name of its own for each output");
+      }
+    }
+  }
+}
+
 }  // namespace mbid

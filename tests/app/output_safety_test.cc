@@ -189,6 +189,45 @@ INSTANTIATE_TEST_SUITE_P(Names, ScenarioNameTest, ::testing::ValuesIn(kNames),
                            return std::string(param_info.param.test_name);
                          });
 
+TEST_F(OutputSafetyTest, AnOutputThatNamesAnInputOrAnotherOutputIsRefused) {
+  const fs::path scenario = Scenario("", "", "2");
+  const std::string h5 = (work_ / "rec.h5").string(), csv = (work_ / "rec.csv").string();
+  ASSERT_EQ(
+      Run("simulate " + scenario.string() + " --quiet -o " + h5 + " --export " + csv).exit_code, 0);
+  const std::string csv_text = ReadText(csv), h5_bytes = ReadText(h5);
+  const std::string scenario_text = ReadText(scenario);
+  // The summary written over the record it summarises.
+  CommandResult result = Run("identify " + csv + " --quiet --json " + csv);
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_NE(result.err.find("--json:" + csv + ": is the input DATA " + csv), std::string::npos)
+      << result.err;
+  EXPECT_EQ(ReadText(csv), csv_text);
+  // The HDF5 output over its input: by the same name, another spelling and a link.
+  fs::create_symlink(h5, work_ / "alias.h5");
+  for (const std::string& name :
+       {h5, (work_ / "." / "rec.h5").string(), (work_ / "alias.h5").string()}) {
+    result = Run("identify " + h5 + " --quiet -o " + name);
+    EXPECT_EQ(result.exit_code, 2) << name << ": " << result.err;
+    EXPECT_EQ(ReadText(h5), h5_bytes) << name;
+  }
+  // Two outputs of one name: one would be lost; nothing is written.
+  const std::string both = (work_ / "both.h5").string();
+  result = Run("identify " + h5 + " --quiet -o " + both + " --json " + both);
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_NE(result.err.find("is also the output of -o"), std::string::npos) << result.err;
+  EXPECT_FALSE(fs::exists(both));
+  // The scenario is an input too, and so are update's records.
+  result = Run("simulate " + scenario.string() + " --quiet -o " + scenario.string());
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_EQ(ReadText(scenario), scenario_text);
+  result = Run("update " + scenario.string() + " " + h5 + " --quiet --json " + h5);
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_EQ(ReadText(h5), h5_bytes);
+  // Names of their own still work.
+  result = Run("identify " + csv + " --quiet --json " + (work_ / "modes.json").string());
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+}
+
 TEST_F(OutputSafetyTest, OutputPathsWithShellCharactersWorkAndRunNothing) {
   // Space, ';', $(...), backquotes, a quote (gnuplot's string quoting) and Unicode at once.
   const fs::path out = work_ / "out dir;$(touch W)`touch V`'q' \u00e4";

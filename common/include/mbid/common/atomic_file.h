@@ -2,6 +2,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "mbid/common/interrupt_cleanup.h"
 
@@ -38,5 +39,19 @@ class AtomicFile {
   bool sync_;
   bool committed_ = false;
 };
+
+// A command's file named on its command line: the flag or argument that names it ("--json",
+// "-o", "DATA") and the path.
+struct NamedFile {
+  std::string flag;
+  std::string path;
+};
+
+// Throws InputError (naming the output's flag and path) when an output names the same file as
+// an input (replacing it would destroy the user's record) or as another output (one of the two
+// would be lost). Outputs "" and "-" (standard output) are skipped. Same file: the same path
+// once made absolute and normal, or, where both exist, one file under two names (a link).
+void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
+                        const std::vector<NamedFile>& outputs);
 
 }  // namespace mbid
