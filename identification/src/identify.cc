@@ -3,6 +3,8 @@
 // (reliability.h).
 #include "mbid/identification/identify.h"
 
+#include <fmt/format.h>
+
 #include "clipped_start.h"
 #include "combination_tones.h"
 #include "estimate.h"
@@ -15,6 +17,7 @@
 #include "methods/method.h"
 #include "mode_results.h"
 #include "mode_selection.h"
+#include "out_of_band.h"
 #include "record.h"
 #include "reliability.h"
 
@@ -58,6 +61,28 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   if (from_rest) {
     // The whole decay knows the release better than its first samples (release.h).
     result.release_time_s = RefineReleaseFromModes(result, result.release_time_s);
+  }
+  if (options.decimation == 0 && record.decimation > 1) {
+    // What the band chosen from the spectrum left out: a decaying mode above it is a burst at
+    // the full-rate residual's start (out_of_band.h). Analysed again with a band that holds it.
+    const Eigen::MatrixXd residual =
+        record.centered - FitAmplitudes(record.centered, record.sample_interval_s, estimate.lambda,
+                                        options.offset == OffsetRemoval::kFit)
+                              .reconstruction;
+    const double top_hz =
+        FindDecayingContentTop(record.centered, residual, record.sample_interval_s);
+    if (top_hz > record.flat_frequency_hz) {
+      IdentificationOptions wider = options;
+      wider.decimation =
+          DecimationForBand(1.25 * top_hz, record.sample_interval_s, record.values.rows());
+      ModalResult again = Identify(measurement, wider, origin);
+      again.warnings.insert(
+          again.warnings.begin(),
+          fmt::format("the record's start holds a decaying component up to {:.4g} Hz, above the "
+                      "{:.4g} Hz its spectrum showed (decimation {}): analysed with decimation {}",
+                      top_hz, record.flat_frequency_hz, record.decimation, wider.decimation));
+      return again;
+    }
   }
   MarkCombinationTones(record, options, &result);
   AssessReliability(record, options, estimate, &result);

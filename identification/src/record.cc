@@ -94,6 +94,10 @@ int ChooseDecimation(const Eigen::MatrixXd& centered, double sample_interval_s,
     if (top_hz <= 0) return 1;
     band_hz = 1.25 * top_hz;
   }
+  return DecimationForBand(band_hz, sample_interval_s, samples);
+}
+
+int DecimationForBand(double band_hz, double sample_interval_s, Eigen::Index samples) {
   const double nyquist_hz = 0.5 / sample_interval_s;
   const int by_band = static_cast<int>(std::floor(kFlatFraction * nyquist_hz / band_hz));
   const int by_length = static_cast<int>(samples / 500);

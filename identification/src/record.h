@@ -54,6 +54,10 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
 int ChooseDecimation(const Eigen::MatrixXd& centered, double sample_interval_s,
                      double max_frequency_hz);
 
+// The largest decimation factor whose filter passes `band_hz` flat and leaves at least 500 of
+// `samples`; at least 1.
+int DecimationForBand(double band_hz, double sample_interval_s, Eigen::Index samples);
+
 // Samples of the decimated record that the method's order needs.
 int RequiredSamples(const IdentificationOptions& options, int channels);
 

@@ -1,0 +1,54 @@
+#include "out_of_band.h"
+
+#include "mbid/identification/spectrum.h"
+
+namespace mbid::identification {
+namespace {
+
+constexpr Eigen::Index kSegment = 2048;
+constexpr Eigen::Index kBandBins = 32;
+constexpr double kPowerRatio = 10;
+constexpr double kRoundOff = 1e-12;
+
+// Squared amplitude spectrum of `segment` mirrored (its periodic extension continuous).
+Eigen::MatrixXd MirroredPower(const Eigen::MatrixXd& segment, double sample_interval_s,
+                              Eigen::VectorXd* frequency_hz) {
+  Eigen::MatrixXd mirrored(2 * segment.rows(), segment.cols());
+  mirrored.topRows(segment.rows()) = segment.colwise().reverse();
+  mirrored.bottomRows(segment.rows()) = segment;
+  SpectrumOptions options;
+  options.window = SpectrumWindow::kNone;
+  options.zero_padding_factor = 1;
+  options.min_peak_prominence = 1;  // no peak list needed
+  const Spectrum spectrum = CalcSpectrum(mirrored, sample_interval_s, options);
+  *frequency_hz = spectrum.frequency_hz;
+  return spectrum.amplitude.array().square();
+}
+
+}  // namespace
+
+double FindDecayingContentTop(const Eigen::MatrixXd& values, const Eigen::MatrixXd& residual,
+                              double sample_interval_s) {
+  const Eigen::Index samples = residual.rows();
+  if (samples < 2 * kSegment) return 0;
+  Eigen::VectorXd frequency_hz;
+  const Eigen::MatrixXd start =
+      MirroredPower(residual.topRows(kSegment), sample_interval_s, &frequency_hz);
+  const Eigen::MatrixXd end =
+      MirroredPower(residual.bottomRows(kSegment), sample_interval_s, &frequency_hz);
+  const Eigen::VectorXd total =
+      MirroredPower(values.topRows(kSegment), sample_interval_s, &frequency_hz).colwise().sum();
+  double top_hz = 0;
+  for (Eigen::Index c = 0; c < residual.cols(); ++c) {
+    for (Eigen::Index b = 1; b + kBandBins <= start.rows(); b += kBandBins) {
+      const double at_start = start.col(c).segment(b, kBandBins).sum();
+      const double at_end = end.col(c).segment(b, kBandBins).sum();
+      if (at_start > kPowerRatio * at_end && at_start > kRoundOff * total(c)) {
+        top_hz = std::max(top_hz, frequency_hz(b + kBandBins - 1));
+      }
+    }
+  }
+  return top_hz;
+}
+
+}  // namespace mbid::identification

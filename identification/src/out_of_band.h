@@ -1,0 +1,23 @@
+#pragma once
+
+// A decimated record is analysed below the band its spectrum showed. A strong mode above that
+// band which decays within a small part of the record hardly shows in the whole record's
+// spectrum, and decimation removes it without a trace: the result would lack it and still look
+// complete. What the modes leave of the full-rate record tells: such a mode is a burst at its
+// start, noise is the same throughout.
+
+#include <Eigen/Core>
+
+namespace mbid::identification {
+
+// The highest frequency (Hz) at which the start of `residual` (samples x channels at the full
+// sample rate: the record `values` less its fitted modes) holds 10 times the power its end
+// holds, in bands of 32 bins of the spectra of its first and last 2048 samples (each mirrored,
+// so that its ends leak nothing), and over 1e-12 of the power of the values' start (round-off
+// of a noiseless record is no mode); 0 if there is none or the record is under 4096 samples.
+// Stationary noise, coloured or not, has the same power at both ends: the F ratio of 64 degrees
+// of freedom exceeds 10 with probability below 1e-12.
+double FindDecayingContentTop(const Eigen::MatrixXd& values, const Eigen::MatrixXd& residual,
+                              double sample_interval_s);
+
+}  // namespace mbid::identification
