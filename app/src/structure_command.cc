@@ -79,9 +79,12 @@ int RunStructureCommand(const std::string& scenario_path,
                      "a machine described by bodies and joints (multibody, truck_crane)");
   }
   const std::vector<std::string> compliant = model::CompliantCoordinates(multibody->description());
-  if (max_rigid < 0 || max_rigid > static_cast<int>(compliant.size())) {
+  // A machine with every coordinate rigid cannot move: at least one stays.
+  const int most = static_cast<int>(compliant.size()) -
+                   (static_cast<int>(compliant.size()) == multibody->coordinate_count() ? 1 : 0);
+  if (max_rigid < 0 || max_rigid > most) {
     throw InputError("command line", "--max-rigid", std::to_string(max_rigid),
-                     fmt::format("0 to {} (the compliant coordinates: {})", compliant.size(),
+                     fmt::format("0 to {} (the compliant coordinates: {}; one must move)", most,
                                  fmt::join(compliant, ", ")));
   }
   if (threads < 0) {

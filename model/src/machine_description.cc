@@ -189,9 +189,16 @@ void MachineDescription::Validate() const {
              "zero axis", "a non-zero direction");
       }
     }
+    // Simbody builds the joint frame on the first axis and the second made perpendicular to
+    // it: axes typed to 6 digits (1e-6 in the cosine, 0.06 mdeg) are perpendicular enough.
     if (joint.type == JointType::kUniversal &&
-        std::abs(joint.axes[0].normalized().dot(joint.axes[1].normalized())) > 1e-9) {
-      Fail(field + ".joint.axes", "axes not perpendicular", "two perpendicular axes");
+        std::abs(joint.axes[0].normalized().dot(joint.axes[1].normalized())) > 1e-6) {
+      Fail(field + ".joint.axes",
+           fmt::format("axes at {:.7g} deg to each other",
+                       std::acos(std::clamp(
+                           joint.axes[0].normalized().dot(joint.axes[1].normalized()), -1.0, 1.0)) *
+                           180 / M_PI),
+           "two perpendicular axes (to 1e-6 in the cosine of their angle)");
     }
     for (const auto& [matrix, key] :
          {std::pair{&joint.in_parent_rotation, "in_parent_rotation_deg"},
@@ -210,6 +217,11 @@ void MachineDescription::Validate() const {
     }
     if (!body.com_m.allFinite()) Fail(field + ".com_m", "non-finite position", "finite, in m");
     CheckInertia(body, field + ".inertia_kgm2");
+  }
+  if (coordinate_names.empty()) {
+    Fail("bodies", "no joint coordinate: every joint is a weld",
+         "at least one revolute, prismatic or universal joint (a machine that cannot move has no "
+         "modes)");
   }
   for (const BodyDescription& body : bodies) {
     if (body.mass_kg == 0 && !parents.count(body.name)) {
@@ -272,12 +284,21 @@ void MachineDescription::Validate() const {
   for (const OutputDescription& output : outputs) {
     const std::string field = "outputs." + output.name;
     if (!output_names.insert(output.name).second) Fail(field, "output named twice", "each once");
+    // A channel is an output or a coordinate by its name: one name, one quantity.
+    const bool coordinate_name = std::find(all_coordinates.begin(), all_coordinates.end(),
+                                           output.name) != all_coordinates.end();
+    const auto fail_name = [&] {
+      Fail(field, "output named like the coordinate '" + output.name + "'",
+           "a name of its own (or a coordinate output of that coordinate)");
+    };
+    if (coordinate_name && output.type != OutputType::kCoordinate) fail_name();
     switch (output.type) {
       case OutputType::kCoordinate:
         if (!coordinate_names.count(output.coordinate) && !FindRigid(output.coordinate)) {
           Fail(field + ".coordinate", "unknown coordinate '" + output.coordinate + "'",
                "one of " + JoinNames(all_coordinates));
         }
+        if (coordinate_name && output.coordinate != output.name) fail_name();
         continue;
       case OutputType::kAzimuth:
       case OutputType::kElevation:

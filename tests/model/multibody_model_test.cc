@@ -430,6 +430,29 @@ TEST(MultibodyModelTest, MatrixUnitsFollowTheCoordinates) {
             (std::vector<std::string>{"rad", "rad", "m", "m", "m/s", "m/s^2", "rad/s", "rad"}));
 }
 
+// A machine that cannot move has no modes: refused on reading (it crashed Simbody's integrator
+// setup and the eigensolver with exit 139). Universal axes typed to 7 digits are perpendicular
+// enough (Simbody makes the second perpendicular to the first).
+TEST(MultibodyModelTest, AWeldOnlyMachineIsRefusedTypedAxesAreAccepted) {
+  try {
+    FromYaml(R"(
+type: multibody
+bodies:
+  a: {parent: ground, joint: {type: weld}, mass_kg: 1.0, inertia_kgm2: [1, 1, 1]}
+points: {p: {body: a, at_m: [0, 0, 0]}}
+outputs: {x: {type: displacement, point: p, direction: [1, 0, 0]}}
+)");
+    FAIL() << "a weld-only machine was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.field(), "model.bodies") << error.what();
+    EXPECT_NE(std::string(error.what()).find("every joint is a weld"), std::string::npos);
+  }
+  std::string text = kEveryJoint;
+  const std::string axes = "axes: [[0, 0, 1], [0, 1, 0]]";
+  text.replace(text.find(axes), axes.size(), "axes: [[0, 0, 1], [0, 1, 3e-7]]");
+  EXPECT_EQ(FromYaml(text)->coordinate_count(), 4);
+}
+
 struct BadCase {
   const char* name;
   const char* replace;  // text of kEveryJoint to replace
@@ -492,7 +515,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"inertia size", "[1, 2, 2.5]", "[1, 2]", "model.bodies.head.inertia_kgm2",
                 "2 entries"},
         BadCase{"universal axes not perpendicular", "axes: [[0, 0, 1], [0, 1, 0]]",
-                "axes: [[0, 0, 1], [0, 1, 1]]", "model.bodies.mast.joint.axes", "perpendicular"},
+                "axes: [[0, 0, 1], [0, 1, 1]]", "model.bodies.mast.joint.axes",
+                "axes at 45 deg to each other"},
+        // 89.99 deg: 1.7e-4 in the cosine, over the 1e-6 that typed digits need.
+        BadCase{"universal axes 0.01 deg off", "axes: [[0, 0, 1], [0, 1, 0]]",
+                "axes: [[0, 0, 1], [0, 0.99999998, 0.00017453]]", "model.bodies.mast.joint.axes",
+                "axes at 89.99"},
+        BadCase{"output named like a coordinate", "tip_x: {type: displacement",
+                "x: {type: displacement", "model.outputs.x", "named like the coordinate 'x'"},
+
         BadCase{"free coordinate under gravity",
                 "  c: {stiffness_Nm_per_rad: 3.0e5, damping_Nms_per_rad: 800}\n", "",
                 "model.springs", "gravity"},
