@@ -19,7 +19,7 @@ int RunModesCommand(const std::string& scenario_path, const CommonOptions& commo
   const std::vector<model::Mode> modes = model::CalcModes(linear);
   if (!common.json_path.empty()) WriteJson(LinearModelToJson(linear, modes), common.json_path);
   if (common.json_path != "-") {
-    std::cout << fmt::format("{}: {} coordinates, {} outputs, linearized at the unloaded rest\n",
+    std::cout << fmt::format("{}: {} coordinates, {} outputs, linearized at rest\n",
                              scenario.name, linear.coordinates.size(), linear.outputs.size());
     std::cout << fmt::format("{:>4} {:>14} {:>16} {:>13} {:>15}\n", "mode", "frequency_hz",
                              "decay_rate_per_s", "damping_ratio", "undamped_hz");

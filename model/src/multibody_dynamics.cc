@@ -2,6 +2,8 @@
 // equilibrium and the linearization.
 #include <Eigen/Dense>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -11,17 +13,93 @@
 #include "multibody_model_impl.h"
 
 namespace mbid::model {
+namespace {
+
+// Newton's chord method on f(q) = 0 from q = 0: the tangent starts as `rest_tangent` (-C at
+// rest: no evaluations), kept while the steps shrink fast and refreshed by central differences
+// when they do not. The root's accuracy depends only on f, so the iteration reaches machine
+// precision.
+Eigen::VectorXd SolveEquilibrium(
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& force,
+    const Eigen::MatrixXd& rest_tangent) {
+  const Eigen::Index n = rest_tangent.rows();
+  auto tangent = [&](const Eigen::VectorXd& q) {
+    Eigen::MatrixXd jacobian(n, n);
+    const double h = 1e-7;  // rad or m; smooth forces, curvature scale ~1
+    for (Eigen::Index j = 0; j < n; ++j) {
+      Eigen::VectorXd dq = Eigen::VectorXd::Zero(n);
+      dq[j] = h;
+      jacobian.col(j) = (force(q + dq) - force(q - dq)) / (2 * h);
+    }
+    return Eigen::FullPivLU<Eigen::MatrixXd>(jacobian);
+  };
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd f = force(q);
+  if (f.lpNorm<Eigen::Infinity>() == 0) return q;
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(rest_tangent);
+  if (!lu.isInvertible()) {
+    throw NumericalError("static equilibrium",
+                         "the machine has no stiffness against a load on a free coordinate");
+  }
+  double last_step = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    const Eigen::VectorXd step = lu.solve(-f);
+    q += step;
+    f = force(q);
+    const double step_norm = step.lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(step_norm)) break;
+    // Converged when the step is at roundoff of q, or stops shrinking after being tiny.
+    if (step_norm <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, q.norm()) ||
+        (step_norm < 1e-12 && step_norm >= last_step)) {
+      return q;
+    }
+    if (step_norm > 0.1 * last_step) lu = tangent(q);  // slow contraction: refresh the tangent
+    last_step = step_norm;
+  }
+  throw NumericalError("static equilibrium", "Newton did not converge in 50 iterations; residual " +
+                                                 std::to_string(f.norm()));
+}
+
+}  // namespace
+
+Eigen::MatrixXd MultibodyModel::Impl::CalcRestTangent(const Eigen::MatrixXd& K_g) const {
+  Eigen::MatrixXd tangent = -K_g;
+  for (Eigen::Index i = 0; i < tangent.rows(); ++i) {
+    const SpringDescription* spring = machine.FindSpring(coordinates[static_cast<size_t>(i)]);
+    if (spring != nullptr) tangent(i, i) -= spring->stiffness;
+  }
+  return tangent;
+}
 
 void MultibodyModel::Impl::CalcRestMatrices(RestMatrices& result) const {
   const Eigen::Index n = static_cast<Eigen::Index>(coordinates.size());
-  // One scratch state at q = 0 with springs and dampers off serves every evaluation (a Simbody
-  // State copy costs about four right-hand sides); M and H do not depend on the forces.
+  result.q = Eigen::VectorXd::Zero(n);
+  CalcMatricesAt(result);
+  if (machine.attached_payload_kg == 0) return;
+  // The springs carry the unloaded machine at q = 0; an attached payload's weight deflects it to
+  // a rest of its own, where it vibrates: the matrices belong there.
+  SimTK::State s = MakeSpringState();  // the preload carries the unloaded machine
+  result.q = SolveEquilibrium([&](const Eigen::VectorXd& q) { return CalcStaticForceAt(s, q, {}); },
+                              CalcRestTangent(result.K_g));
+  if (result.q.lpNorm<Eigen::Infinity>() > 0) CalcMatricesAt(result);
+}
+
+SimTK::State MultibodyModel::Impl::MakeStaticState() const {
   SimTK::State s = default_state;
   for (size_t k = 0; k < springs.size(); ++k) {
     springs[k].setStiffness(s, 0.0);
     dampers[k].setDamping(s, 0.0);
   }
-  s.updQ() = 0;
+  return s;
+}
+
+void MultibodyModel::Impl::CalcMatricesAt(RestMatrices& result) const {
+  const Eigen::Index n = static_cast<Eigen::Index>(coordinates.size());
+  const Eigen::VectorXd& q0 = result.q;
+  // One scratch state with springs and dampers off serves every evaluation (a Simbody State
+  // copy costs about four right-hand sides); M and H do not depend on the forces.
+  SimTK::State s = MakeStaticState();
+  for (Eigen::Index i = 0; i < n; ++i) s.updQ()[static_cast<int>(i)] = q0[i];
   s.updU() = 0;
   system.realize(s, SimTK::Stage::Position);
   SimTK::Matrix M;
@@ -34,7 +112,7 @@ void MultibodyModel::Impl::CalcRestMatrices(RestMatrices& result) const {
   auto central = [&](Eigen::Index j, double h) {
     Eigen::VectorXd dq = Eigen::VectorXd::Zero(n);
     dq[j] = h;
-    return Eigen::VectorXd((gravity_force(dq) - gravity_force(-dq)) / (2 * h));
+    return Eigen::VectorXd((gravity_force(q0 + dq) - gravity_force(q0 - dq)) / (2 * h));
   };
   Eigen::MatrixXd K_g(n, n);
   const double h = 1e-3;
@@ -44,7 +122,7 @@ void MultibodyModel::Impl::CalcRestMatrices(RestMatrices& result) const {
   // H exactly: with q' = e_j at q = 0 every output's rate is its derivative by q_j; velocity
   // and acceleration outputs are J q' and J q'' at rest, the same Jacobian rows.
   result.H = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(outputs.size()), n);
-  s.updQ() = 0;
+  for (Eigen::Index i = 0; i < n; ++i) s.updQ()[static_cast<int>(i)] = q0[i];
   for (Eigen::Index j = 0; j < n; ++j) {
     s.updU() = 0;
     s.updU()[static_cast<int>(j)] = 1;
@@ -186,54 +264,11 @@ Eigen::VectorXd MultibodyModel::CalcStaticGeneralizedForce(
 }
 
 Eigen::VectorXd MultibodyModel::SolveStaticEquilibrium(const std::vector<PointLoad>& loads) const {
-  // Newton's chord method on f(q) = 0: the tangent starts as the unloaded machine's -C at rest
-  // (springs plus the cached geometric stiffness: no evaluations), kept while the steps shrink
-  // fast and refreshed by central differences when they do not. The root's accuracy depends
-  // only on f, so the iteration reaches machine precision.
   const Eigen::Index n = static_cast<Eigen::Index>(impl_->coordinates.size());
   SimTK::State s = MakeState(Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n));
-  auto force = [&](const Eigen::VectorXd& q) { return impl_->CalcStaticForceAt(s, q, loads); };
-  auto tangent = [&](const Eigen::VectorXd& q) {
-    Eigen::MatrixXd jacobian(n, n);
-    const double h = 1e-7;  // rad or m; smooth forces, curvature scale ~1
-    for (Eigen::Index j = 0; j < n; ++j) {
-      Eigen::VectorXd dq = Eigen::VectorXd::Zero(n);
-      dq[j] = h;
-      jacobian.col(j) = (force(q + dq) - force(q - dq)) / (2 * h);
-    }
-    return Eigen::FullPivLU<Eigen::MatrixXd>(jacobian);
-  };
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
-  Eigen::VectorXd f = force(q);
-  if (f.lpNorm<Eigen::Infinity>() == 0) return q;
-  Eigen::MatrixXd rest_tangent = -impl_->rest_matrices().K_g;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const SpringDescription* spring =
-        impl_->machine.FindSpring(impl_->coordinates[static_cast<size_t>(i)]);
-    if (spring != nullptr) rest_tangent(i, i) -= spring->stiffness;
-  }
-  Eigen::FullPivLU<Eigen::MatrixXd> lu(rest_tangent);
-  if (!lu.isInvertible()) {
-    throw NumericalError("static equilibrium",
-                         "the machine has no stiffness against a load on a free coordinate");
-  }
-  double last_step = std::numeric_limits<double>::infinity();
-  for (int iteration = 0; iteration < 50; ++iteration) {
-    const Eigen::VectorXd step = lu.solve(-f);
-    q += step;
-    f = force(q);
-    const double step_norm = step.lpNorm<Eigen::Infinity>();
-    if (!std::isfinite(step_norm)) break;
-    // Converged when the step is at roundoff of q, or stops shrinking after being tiny.
-    if (step_norm <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, q.norm()) ||
-        (step_norm < 1e-12 && step_norm >= last_step)) {
-      return q;
-    }
-    if (step_norm > 0.1 * last_step) lu = tangent(q);  // slow contraction: refresh the tangent
-    last_step = step_norm;
-  }
-  throw NumericalError("static equilibrium", "Newton did not converge in 50 iterations; residual " +
-                                                 std::to_string(f.norm()));
+  return SolveEquilibrium(
+      [&](const Eigen::VectorXd& q) { return impl_->CalcStaticForceAt(s, q, loads); },
+      impl_->CalcRestTangent(impl_->rest_matrices().K_g));
 }
 
 LinearModel MultibodyModel::Linearize() const {

@@ -287,6 +287,31 @@ void MultibodyModel::SetParameter(const std::string& name, double value) {
     if (spring.coordinate != impl_->coordinates[static_cast<size_t>(coordinate)]) continue;
     (stiffness ? spring.stiffness : spring.damping) = value;
   }
+  // The rest an attached payload deflects the machine to moves with the stiffness.
+  if (stiffness && impl_->machine.attached_payload_kg > 0) {
+    impl_->rest = std::make_shared<Impl::RestMatrices>();
+  }
+}
+
+SimTK::State MultibodyModel::Impl::MakeSpringState() const {
+  SimTK::State s = default_state;
+  for (const SpringDescription& spring : machine.springs) {
+    const auto found = std::find(coordinates.begin(), coordinates.end(), spring.coordinate);
+    const int coordinate = static_cast<int>(found - coordinates.begin());
+    const int slot = coordinate_data[static_cast<size_t>(coordinate)].spring;
+    ApplyStiffness(s, slot, coordinate, spring.stiffness);
+    dampers[static_cast<size_t>(slot)].setDamping(s, spring.damping);
+  }
+  s.invalidateAllCacheAtOrAbove(SimTK::Stage::Position);
+  return s;
+}
+
+void MultibodyModel::Impl::ApplyStiffness(SimTK::State& state, int slot, int coordinate,
+                                          double stiffness) const {
+  springs[static_cast<size_t>(slot)].setStiffness(state, stiffness);
+  // The preload rule holds for every stiffness: the unloaded machine rests at q = 0.
+  springs[static_cast<size_t>(slot)].setQZero(state,
+                                              -unloaded_gravity_force[coordinate] / stiffness);
 }
 
 void MultibodyModel::ApplyParameterToState(SimTK::State& state, const std::string& name,
@@ -295,10 +320,7 @@ void MultibodyModel::ApplyParameterToState(SimTK::State& state, const std::strin
       ParseSpringParameter(impl_->coordinates, impl_->machine, name, value);
   const int slot = impl_->coordinate_data[static_cast<size_t>(coordinate)].spring;
   if (stiffness) {
-    impl_->springs[static_cast<size_t>(slot)].setStiffness(state, value);
-    // The preload rule holds for every stiffness: the unloaded machine rests at q = 0.
-    impl_->springs[static_cast<size_t>(slot)].setQZero(
-        state, -impl_->unloaded_gravity_force[coordinate] / value);
+    impl_->ApplyStiffness(state, slot, coordinate, value);
   } else {
     impl_->dampers[static_cast<size_t>(slot)].setDamping(state, value);
   }
@@ -329,11 +351,7 @@ SimTK::State MultibodyModel::MakeState(const Eigen::VectorXd& q, const Eigen::Ve
   if (q.size() != n || u.size() != n) {
     throw std::invalid_argument("MultibodyModel::MakeState: q and u need one entry per coordinate");
   }
-  SimTK::State s = impl_->default_state;
-  for (const SpringDescription& spring : impl_->machine.springs) {
-    ApplyParameterToState(s, "c_" + spring.coordinate, spring.stiffness);
-    ApplyParameterToState(s, "d_" + spring.coordinate, spring.damping);
-  }
+  SimTK::State s = impl_->MakeSpringState();
   s.setTime(0.0);
   s.updQ() = ToVector(q);
   s.updU() = ToVector(u);

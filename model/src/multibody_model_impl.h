@@ -112,8 +112,10 @@ struct MultibodyModel::Impl {
   };
   // M, the geometric stiffness and H at q = 0 depend on the inertial data alone, not on c and d;
   // computed once and shared with clones (they cost about 30 right-hand sides).
+  // The linearization point: q = 0, or the rest an attached payload deflects the machine to.
   struct RestMatrices {
     std::once_flag once;
+    Eigen::VectorXd q;  // the rest
     Eigen::MatrixXd M, K_g, H;
   };
 
@@ -219,13 +221,22 @@ struct MultibodyModel::Impl {
           body.mass_kg * machine.gravity_mps2 *
           (1 + body.com_m.norm() + body.joint.in_parent_m.norm() + body.joint.in_body_m.norm());
     }
+    // An attached payload's weight deflects the sprung coordinates to a rest of their own; a free
+    // one it would drive away.
+    Eigen::VectorXd gravity = unloaded_gravity_force;
+    if (machine.attached_payload_kg > 0) {
+      SimTK::State s = MakeStaticState();
+      gravity = CalcStaticForceAt(
+          s, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(coordinates.size())), {});
+    }
     for (size_t i = 0; i < coordinates.size(); ++i) {
-      const double g = unloaded_gravity_force[static_cast<Eigen::Index>(i)];
+      const double g = gravity[static_cast<Eigen::Index>(i)];
       if (coordinate_data[i].spring < 0 && std::abs(g) > 1e-9 * std::max(scale, 1.0)) {
         throw InputError(
             "machine description", "springs",
             "coordinate '" + coordinates[i] + "' has no spring, but gravity drives it at q = 0 (" +
-                std::to_string(g) + (coordinate_data[i].translational ? " N)" : " N*m)"),
+                std::to_string(g) + (coordinate_data[i].translational ? " N" : " N*m") +
+                (machine.attached_payload_kg > 0 ? ", with the attached payload)" : ")"),
             "a spring on '" + coordinates[i] + "' (the unloaded machine rests at q = 0)");
       }
     }
@@ -334,6 +345,17 @@ struct MultibodyModel::Impl {
     return *rest;
   }
   void CalcRestMatrices(RestMatrices& result) const;
+  // M, K_g and H at result.q.
+  void CalcMatricesAt(RestMatrices& result) const;
+  // The default state with springs and dampers off: gravity and loads alone.
+  SimTK::State MakeStaticState() const;
+  // The default state carrying the description's springs and dampers (with the preload rule's
+  // neutral positions): what MakeState starts from.
+  SimTK::State MakeSpringState() const;
+  // Sets spring `slot`'s stiffness (and its preload's neutral position) in `state`.
+  void ApplyStiffness(SimTK::State& state, int slot, int coordinate, double stiffness) const;
+  // df/dq of the static generalized force at rest: -(springs + K_g).
+  Eigen::MatrixXd CalcRestTangent(const Eigen::MatrixXd& K_g) const;
 
   MachineDescription machine;
   std::string type;
