@@ -94,9 +94,11 @@ bool FitRow(std::vector<std::string>* fields, size_t columns) {
 CellKind ClassifyCell(const std::string& cell, char separator, double* value) {
   if (value != nullptr) *value = std::numeric_limits<double>::quiet_NaN();
   if (cell.empty() || cell == "NaN" || cell == "nan" || cell == "NAN") return CellKind::kGap;
-  // A ','-separated file has a decimal point (an unquoted comma would split the cell).
+  // A ','-separated file has a decimal point, unless its quoted cells show a decimal comma
+  // ("0,0005"); the file's mark decides the value (csv_reader.cc).
   const NumberReadings readings = ReadNumber(cell);
-  const std::optional<double> number = separator == ',' ? readings.point
+  const std::optional<double> number = separator == ','
+                                           ? (readings.point ? readings.point : readings.comma)
                                        : readings.comma ? readings.comma
                                                         : readings.point;
   if (number) {

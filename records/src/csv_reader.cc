@@ -130,14 +130,25 @@ struct MarkEvidence {
   std::string cell, where;
 };
 
-// The decimal mark of a file's data rows: a point in ','-separated files; otherwise the mark of
-// the first number that reads with only one of them ("0,5", "1,234.5", "1.234.567"). kUnknown
-// when no number shows it (then "1,234" is ambiguous and refused where it occurs).
+// The decimal mark of a file's data rows: the mark of the first number that reads with only one
+// of them ("0,5", "1,234.5", "1.234.567"); kUnknown when no number shows it (then "1,234" is
+// ambiguous and refused where it occurs). A ','-separated file has a decimal point unless
+// quoted cells hold commas ("107,389": a decimal comma or a thousands separator, as they show).
 MarkEvidence FindDecimalMark(const std::vector<TextLine>& lines, int first_row, char separator) {
   MarkEvidence evidence;
   if (separator == ',') {
-    evidence.mark = DecimalMark::kPoint;
-    return evidence;
+    const bool quoted_commas =
+        std::any_of(lines.begin() + first_row, lines.end(), [&](const TextLine& line) {
+          if (IsCommentOrBlank(line.text)) return false;
+          const std::vector<std::string> fields = SplitFields(line.text, separator);
+          return std::any_of(fields.begin(), fields.end(), [](const std::string& field) {
+            return field.find(',') != std::string::npos;
+          });
+        });
+    if (!quoted_commas) {
+      evidence.mark = DecimalMark::kPoint;
+      return evidence;
+    }
   }
   for (size_t i = static_cast<size_t>(first_row); i < lines.size(); ++i) {
     if (IsCommentOrBlank(lines[i].text)) continue;

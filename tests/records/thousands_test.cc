@@ -158,5 +158,30 @@ TEST(ThousandsTest, TwoDecimalMarksInOneFileNameTheCellAndTheEvidence) {
                                      "column 2 ('0,5') shows"));
 }
 
+// A ','-separated export whose quoted cells hold commas (a spreadsheet in a decimal-comma
+// locale): a cell that shows a decimal comma ("0,0005") sets the file's mark; cells that only
+// read both ways ("107,389") were read as thousands, 1000 times too large, and are now refused
+// as ambiguous.
+TEST(ThousandsTest, QuotedCommasOfACommaSeparatedFileShowTheirMarkOrAreRefused) {
+  TempDir dir;
+  const std::string shown = dir.File("quoted_comma.csv");
+  WriteText(shown,
+            "\"t [s]\",\"y [mm]\"\n\"0\",\"1,001\"\n\"0,0005\",\"0,999\"\n"
+            "\"0,001\",\"1,5\"\n");
+  const Measurement m = ImportMeasurement(shown);
+  EXPECT_NEAR(m.sample_interval_s, 0.0005, 1e-15);
+  EXPECT_NEAR(m.values(0, 0), 1.001e-3, 1e-15);  // mm -> m
+  EXPECT_NEAR(m.values(2, 0), 1.5e-3, 1e-15);
+  const std::string undecided = dir.File("quoted_thousands.csv");
+  WriteText(undecided, "\"t [ms]\",\"y [mm]\"\n\"0\",\"107,389\"\n\"1\",\"107,365\"\n");
+  const InputError e = CatchInputError([&] { ImportMeasurement(undecided); });
+  EXPECT_EQ(e.field(), "line 2, column 2 (y)");
+  EXPECT_THAT(e.problem(), HasSubstr("'107,389' reads as 107.389 with a decimal comma"));
+  // Plain ','-separated files keep their decimal point, "1.234" included.
+  const std::string plain = dir.File("plain.csv");
+  WriteText(plain, "t [s],y [mm]\n0,1.234\n0.5,2.5\n1,3\n");
+  EXPECT_NEAR(ImportMeasurement(plain).values(0, 0), 1.234e-3, 1e-15);
+}
+
 }  // namespace
 }  // namespace mbid::records
