@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <optional>
 #include <set>
 
 #include "formats.h"
@@ -17,6 +18,42 @@
 
 namespace mbid::records {
 namespace {
+
+// How round a sample rate is: its trailing decimal zeros first, then a power of two before them
+// (2048, 25600 and 51200 Hz are as common on loggers as 1000 and 3000).
+int Roundness(long rate) {
+  int zeros = 0;
+  while (rate % 10 == 0) {
+    rate /= 10;
+    ++zeros;
+  }
+  const bool power_of_two = (rate & (rate - 1)) == 0;
+  return 2 * zeros + (power_of_two ? 1 : 0);
+}
+
+// The integer rate an interval printed to `resolution` (the place value of its last digit)
+// most likely rounds from: the roundest one whose interval prints the same, the nearest among
+// equally round ones; none when the print is exact to 1e-9 or no round rate fits.
+std::optional<double> RoundRate(double interval_s, double resolution_s) {
+  if (!(resolution_s > 1e-9 * interval_s) || !(interval_s > 0.5 * resolution_s)) {
+    return std::nullopt;
+  }
+  const double low = 1 / (interval_s + 0.5 * resolution_s);
+  const double high = 1 / (interval_s - 0.5 * resolution_s);
+  if (!(high - low < 1e6)) return std::nullopt;
+  std::optional<long> best;
+  for (long rate = static_cast<long>(std::ceil(low)); rate <= static_cast<long>(std::floor(high));
+       ++rate) {
+    if (rate <= 0) continue;
+    if (!best || Roundness(rate) > Roundness(*best) ||
+        (Roundness(rate) == Roundness(*best) &&
+         std::abs(1.0 / rate - interval_s) < std::abs(1.0 / *best - interval_s))) {
+      best = rate;
+    }
+  }
+  if (!best || Roundness(*best) == 0) return std::nullopt;
+  return static_cast<double>(*best);
+}
 
 using internal::RawColumn;
 using internal::RawTable;
@@ -209,6 +246,25 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
   if (table.time.empty()) {
     m->start_time_s = to_s.scale * table.start + to_s.offset;
     m->sample_interval_s = to_s.scale * table.interval;
+    const double resolution = to_s.scale * table.interval_resolution;
+    if (options.sample_rate_hz > 0) {
+      // A stated rate wins where the printed interval allows it.
+      if (!(std::abs(1 / options.sample_rate_hz - m->sample_interval_s) <=
+            std::max(0.5 * resolution, kTimeUniformityTolerance * m->sample_interval_s))) {
+        throw InputError(path, "sample_rate_hz",
+                         fmt::format("{} Hz disagrees with the file's sample interval {} {}",
+                                     options.sample_rate_hz, table.interval, unit),
+                         "no sample rate, or the rate of the file's interval");
+      }
+      m->sample_interval_s = 1 / options.sample_rate_hz;
+    } else if (const std::optional<double> rate = RoundRate(m->sample_interval_s, resolution)) {
+      report->conversions.push_back(fmt::format(
+          "time: the sample interval {} {} is printed to {:.2g} % (the rate to {:.4g} Hz): read as "
+          "1/{} s, the round rate it rounds from (sample_rate_hz sets another)",
+          table.interval, unit, 50 * resolution / m->sample_interval_s,
+          0.5 * resolution / (m->sample_interval_s * m->sample_interval_s), *rate));
+      m->sample_interval_s = 1 / *rate;
+    }
     return;
   }
   Eigen::VectorXd time(static_cast<Eigen::Index>(table.time.size()));

@@ -393,6 +393,9 @@ class LvmReader {
     if (x_columns_ == XColumns::kNone) {
       table.start = GridNumber(first, "X0", 0);
       table.interval = GridNumber(first, "Delta_X", 0);
+      std::string delta_x = KeyValue(first, "Delta_X", 0);
+      if (decimal_comma_) std::replace(delta_x.begin(), delta_x.end(), ',', '.');
+      table.interval_resolution = std::pow(10.0, PrintedPlace(delta_x));
       table.time_where = LineField(first.key_lines.count("Delta_X") ? first.key_lines["Delta_X"]
                                                                     : first.header_line);
       if (!(table.interval > 0)) {

@@ -32,6 +32,9 @@ struct RawTable {
   std::string time_where;  // "column 1", ...
   double start = 0.0;
   double interval = 0.0;
+  // Place value of the last printed digit of `interval` (a header's "Delta_X 0.000333", UFF
+  // record 7's six digits), or 0 when it is exact.
+  double interval_resolution = 0.0;
   // Place value of the last printed digit of the time column in `time_unit` (text files), or 0.
   double printed_resolution = 0.0;
   // The sample interval the file states besides its time column (mbid's

@@ -383,6 +383,9 @@ RawTable Uff58Reader::Combine() {
       if (!d.exact_interval) {  // a dataset without mbid's exact values: record 7's only
         table.start = first.start;
         table.interval = first.interval;
+        // Record 7 prints the increment as E13.5: six significant digits.
+        table.interval_resolution =
+            first.interval > 0 ? std::pow(10.0, std::floor(std::log10(first.interval)) - 5) : 0.0;
       }
     }
   } else {

@@ -303,6 +303,41 @@ TEST(Lvm, NoXColumnSegmentsConcatenate) {
   EXPECT_EQ(table.columns[0].values, (std::vector<double>{10, 11, 12, 13, 14, 15}));
 }
 
+// A 3 kHz logger writes Delta_X to six decimals, 0.000333: taken as printed it is 3003.003 Hz,
+// and every frequency came out 0.1 % high (1700 std on a clean record) with nothing said. The
+// interval is known to +-5e-10 s, which 2999..3007 Hz all fit: the roundest, 3000 Hz, is taken,
+// and the report says so. A rate the user states wins when the print allows it.
+TEST(Lvm, AnIntervalPrintedToFewDigitsIsTheRoundRateItRoundsFrom) {
+  TempDir dir;
+  const std::string path = dir.File("3k.lvm");
+  std::string text =
+      "LabVIEW Measurement\t\nWriter_Version\t2\nSeparator\tTab\nDecimal_Separator\t.\n"
+      "X_Columns\tNo\n***End_of_Header***\t\n\nChannels\t1\t\nSamples\t8\t\n"
+      "Y_Unit_Label\tm/s^2\t\nX_Dimension\tTime\t\nX0\t0\t\nDelta_X\t0.000333\t\n"
+      "***End_of_Header***\t\nacc\tComment\n";
+  for (int j = 0; j < 8; ++j) text += std::to_string(0.1 * j) + "\n";
+  WriteText(path, text);
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, {}, &report);
+  EXPECT_EQ(m.sample_interval_s, 1.0 / 3000);
+  ASSERT_FALSE(report.conversions.empty());
+  EXPECT_NE(report.conversions.back().find("read as 1/3000 s"), std::string::npos)
+      << report.conversions.back();
+  ImportOptions stated;
+  stated.sample_rate_hz = 3001;  // 3.33222e-4 s prints as 0.000333 too
+  EXPECT_EQ(ImportMeasurement(path, stated).sample_interval_s, 1.0 / 3001);
+  stated.sample_rate_hz = 2500;
+  const InputError e = CatchInputError([&] { ImportMeasurement(path, stated); });
+  EXPECT_EQ(e.field(), "sample_rate_hz");
+  // Printed exactly enough (0.002000 at 500 Hz, 1e-6 of 0.002 is 5e-4 relative, yet only 500 Hz
+  // fits among round rates): the same value.
+  const std::string exact = dir.File("500.lvm");
+  std::string slow = text;
+  slow.replace(slow.find("0.000333"), 8, "0.002000");
+  WriteText(exact, slow);
+  EXPECT_EQ(ImportMeasurement(exact).sample_interval_s, 1.0 / 500);
+}
+
 TEST(Lvm, SegmentThatDoesNotContinueIsAnError) {
   TempDir dir;
   const std::string path = dir.File("gap.lvm");
