@@ -1,5 +1,7 @@
 #include "mbid/simulation/sensor.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <random>
 
@@ -25,6 +27,22 @@ Measurement ApplySensor(const Measurement& clean, const SensorOptions& options) 
     }
   }
   return measured;
+}
+
+std::vector<std::string> FindAliasedModes(const std::vector<model::Mode>& modes,
+                                          double sample_interval_s) {
+  std::vector<std::string> lines;
+  const double rate_hz = 1 / sample_interval_s;
+  for (size_t k = 0; k < modes.size(); ++k) {
+    const double f = modes[k].frequency_hz();
+    if (!(f >= 0.5 * rate_hz)) continue;
+    const double alias = std::abs(f - std::round(f / rate_hz) * rate_hz);
+    lines.push_back(fmt::format(
+        "the model's mode {} at {:.4g} Hz lies above the Nyquist frequency {:.4g} Hz of the "
+        "sampling: the record aliases it to {:.4g} Hz; sampling at {:.4g} Hz or more records it",
+        k + 1, f, 0.5 * rate_hz, alias, std::ceil(2.1 * f)));
+  }
+  return lines;
 }
 
 }  // namespace mbid::simulation

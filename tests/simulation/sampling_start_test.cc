@@ -147,6 +147,30 @@ TEST(SamplingStartTest, FractionalStartSamplesBetweenTheGridPoints) {
             1e-5);
 }
 
+// A mode above the Nyquist frequency shows in the record as its alias, a mode of its own the
+// data cannot tell from a real one: the crane's modes sampled at 100 Hz (all below 5 Hz) have
+// none; at 5 Hz every mode of 2.5 Hz or more is named with its alias |f - 5 round(f / 5)|.
+TEST(SamplingStartTest, ModesAboveTheNyquistFrequencyAreNamedWithTheirAlias) {
+  const SampledCrane crane = LoadSampledCrane();
+  const std::vector<model::Mode> modes = model::CalcModes(crane.model->Linearize());
+  EXPECT_TRUE(FindAliasedModes(modes, 0.01).empty());
+  const std::vector<std::string> lines = FindAliasedModes(modes, 0.2);
+  size_t above = 0;
+  for (size_t k = 0; k < modes.size(); ++k) {
+    const double f = modes[k].frequency_hz();
+    if (f < 2.5) continue;
+    ASSERT_LT(above, lines.size());
+    std::ostringstream alias;
+    alias.precision(4);
+    alias << std::abs(f - 5 * std::round(f / 5));
+    EXPECT_NE(lines[above].find("aliases it to " + alias.str() + " Hz"), std::string::npos)
+        << lines[above];
+    ++above;
+  }
+  EXPECT_GT(above, 0u) << "the crane has a mode above 2.5 Hz";
+  EXPECT_EQ(lines.size(), above);
+}
+
 TEST(SamplingStartTest, RejectsAStartOutsideTheRecord) {
   SampledCrane crane = LoadSampledCrane();
   crane.simulation.duration_s = 1.0;

@@ -55,6 +55,14 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
     }
     throw;
   }
+  if (test.simulation) {
+    // The test as simulated cannot show a mode above its Nyquist frequency but as an alias.
+    for (const std::string& line : simulation::FindAliasedModes(model::CalcModes(model.Linearize()),
+                                                                test.measured.sample_interval_s)) {
+      test.identified.reasons.push_back(line);
+      test.identified.reliable = false;
+    }
+  }
   say(fmt::format("identified {} modes ({}), K = {:.3f}", test.identified.modes.size(),
                   test.identified.method, test.identified.correlation.minCoeff()));
   if (identified) identified(test);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "mbid/common/measurement.h"
+#include "mbid/model/linear_model.h"
 
 namespace mbid::simulation {
 
@@ -36,5 +37,12 @@ inline constexpr double kWholeSampleTolerance = kTimeUniformityTolerance;
 // Noise is drawn channel by channel, sample by sample, from a 64-bit Mersenne twister seeded
 // with `seed`.
 Measurement ApplySensor(const Measurement& clean, const SensorOptions& options);
+
+// One line per mode of `modes` at or above the Nyquist frequency of `sample_interval_s`: the
+// record shows it at its alias |f - k / tau|, as a mode of its own that the data cannot tell
+// from a real one ("the model's mode 3 at 7.107 Hz lies above the Nyquist frequency 5 Hz: the
+// record aliases it to 2.893 Hz; sampling at 15 Hz or more records it").
+std::vector<std::string> FindAliasedModes(const std::vector<model::Mode>& modes,
+                                          double sample_interval_s);
 
 }  // namespace mbid::simulation
