@@ -114,8 +114,39 @@ MultibodyModel::Impl::Impl(MachineDescription description, std::string model_typ
   }
   PrepareKinematics();
   ResolveOutputs();
+  CheckMassMatrix();
   unloaded_gravity_force = CalcUnloadedGravityForce();
   CheckFreeCoordinates();
+}
+
+void MultibodyModel::Impl::CheckMassMatrix() const {
+  // A coordinate that moves no mass (a massless frame turning about the axis its only child
+  // turns about) makes M singular: no dynamics, no modes.
+  SimTK::State s = default_state;
+  system.realize(s, SimTK::Stage::Position);
+  SimTK::Matrix M;
+  matter.calcM(s, M);
+  const Eigen::MatrixXd m = ToEigen(M);
+  const Eigen::LLT<Eigen::MatrixXd> cholesky(m);
+  const Eigen::VectorXd diagonal = m.diagonal();
+  if (m.allFinite() && cholesky.info() == Eigen::Success &&
+      (cholesky.matrixL().toDenseMatrix().diagonal().array().square() >
+       1e-12 * diagonal.cwiseAbs().maxCoeff())
+          .all()) {
+    return;
+  }
+  std::string coordinate = coordinates.front();
+  for (Eigen::Index i = 0; i < diagonal.size(); ++i) {
+    if (!(diagonal[i] > 1e-12 * diagonal.cwiseAbs().maxCoeff())) {
+      coordinate = coordinates[static_cast<size_t>(i)];
+      break;
+    }
+  }
+  throw InputError("machine description", "bodies",
+                   "the mass matrix is singular at q = 0 (near coordinate '" + coordinate +
+                       "'): some motion of the joints moves no mass",
+                   "every coordinate moving some mass or inertia (a massless frame may not turn "
+                   "about or slide along the axis of its only child's joint)");
 }
 
 std::vector<bool> MultibodyModel::Impl::FindMergeableFrames() const {

@@ -212,6 +212,9 @@ struct MultibodyModel::Impl {
         s, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(coordinates.size())), lift);
   }
 
+  // InputError when M at q = 0 is singular or not finite.
+  void CheckMassMatrix() const;
+
   // A free coordinate has no spring to carry a dead weight: q = 0 is a rest position only if
   // gravity does not drive it there.
   void CheckFreeCoordinates() const {

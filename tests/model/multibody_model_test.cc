@@ -494,6 +494,33 @@ outputs: {x: {type: displacement, point: p, direction: [1, 0, 0]}}
   EXPECT_EQ(FromYaml(text)->coordinate_count(), 4);
 }
 
+// A massless frame turning about z that carries a body turning about the same axis: the two
+// coordinates' difference moves no mass, M is singular. It ended as "CalcModes: eigensolver
+// failed" (exit 1) or Simbody's "Inertia matrix contains a NaN" (exit 3); now it is refused on
+// reading.
+TEST(MultibodyModelTest, ASingularMassMatrixIsRefused) {
+  try {
+    FromYaml(R"(
+type: multibody
+bodies:
+  f: {parent: ground, joint: {type: revolute, coordinates: [q1], axis: [0, 0, 1]}, mass_kg: 0.0,
+      inertia_kgm2: [0, 0, 0]}
+  b: {parent: f, joint: {type: revolute, coordinates: [q2], axis: [0, 0, 1]}, mass_kg: 10.0,
+      inertia_kgm2: [1.0, 1.0, 2.0]}
+springs:
+  q1: {stiffness_Nm_per_rad: 1000.0, damping_Nms_per_rad: 2.0}
+  q2: {stiffness_Nm_per_rad: 3000.0, damping_Nms_per_rad: 1.0}
+outputs:
+  w: {type: angular_velocity, body: b, axis: [0, 0, 1]}
+)");
+    FAIL() << "a singular mass matrix was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.source(), "machine.yaml") << error.what();
+    EXPECT_EQ(error.field(), "model.bodies") << error.what();
+    EXPECT_NE(std::string(error.what()).find("mass matrix is singular"), std::string::npos);
+  }
+}
+
 struct BadCase {
   const char* name;
   const char* replace;  // text of kEveryJoint to replace
