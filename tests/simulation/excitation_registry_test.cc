@@ -64,6 +64,45 @@ TEST(ExcitationRegistryTest, EachReaderGivesItsOwnType) {
   EXPECT_EQ(burst.CalcForcingEndTime(), 1.5);
 }
 
+// The generalized force on a coordinate has the coordinate's unit in its key: torque_Nm on a
+// turning one, force_N (a number) on a sliding one. A slide's force had to be given as
+// torque_Nm, and force_N with a coordinate was "needs exactly one target".
+TEST(ExcitationRegistryTest, ACoordinatesForceIsNamedInItsUnit) {
+  const auto slide = model::MakeModel(YamlReader::FromString(R"(model:
+  type: multibody
+  bodies:
+    cart: {parent: ground, joint: {type: prismatic, coordinates: [x], axis: [1, 0, 0]},
+           mass_kg: 10, inertia_kgm2: [1, 1, 1]}
+  springs:
+    x: {stiffness_N_per_m: 1000, damping_Ns_per_m: 1}
+  outputs:
+    x: {type: coordinate, coordinate: x}
+)",
+                                                             "slide.yaml")
+                                          .Child("model"));
+  const auto read = [&](const std::string& yaml) {
+    const YamlReader root = YamlReader::FromString("excitation: " + yaml + "\n", "inline.yaml");
+    return ReadExcitation(root.Child("excitation"), *slide);
+  };
+  const Excitation pushed = read("{type: impulse, coordinate: x, force_N: 50, duration_s: 0.1}");
+  ASSERT_NE(pushed.force_target(), nullptr);
+  EXPECT_EQ(pushed.force_target()->coordinate, "x");
+  EXPECT_EQ(pushed.force_target()->torque_Nm, 50.0);  // the generalized force, here in N
+  try {
+    read("{type: impulse, coordinate: x, torque_Nm: 50, duration_s: 0.1}");
+    FAIL() << "a torque on a slide was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.field(), "excitation.torque_Nm");
+    EXPECT_NE(std::string(error.what()).find("coordinate 'x' slides"), std::string::npos);
+  }
+  try {
+    Read("{type: impulse, coordinate: gamma, force_N: 50, duration_s: 0.1}");
+    FAIL() << "a force on a turning coordinate was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.field(), "excitation.force_N");
+  }
+}
+
 TEST(ExcitationRegistryTest, UnknownTypeListsTheRegisteredOnes) {
   try {
     Read("{type: initial_deflexion}");
