@@ -145,7 +145,8 @@ SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalM
   }
   node.ExpectMap(keys);
   options.sample_rate_hz = node.PositiveDouble("sample_rate_hz", options.sample_rate_hz);
-  if (node.Has("channels")) options.channels = node.StringList("channels");
+  // Without a list, every output of the model (the crane's psi and phi).
+  options.channels = node.Has("channels") ? node.StringList("channels") : model.output_names();
   if (options.channels.empty()) node.FailAt("channels", "no channel", "at least one channel");
   std::vector<std::string> known = model.output_names();
   known.insert(known.end(), model.coordinate_names().begin(), model.coordinate_names().end());

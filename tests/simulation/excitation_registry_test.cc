@@ -84,6 +84,13 @@ TEST(ExcitationRegistryTest, ACoordinatesForceIsNamedInItsUnit) {
     const YamlReader root = YamlReader::FromString("excitation: " + yaml + "\n", "inline.yaml");
     return ReadExcitation(root.Child("excitation"), *slide);
   };
+  // Sensors without a channel list record every output of the model (not the crane's psi, phi).
+  EXPECT_EQ(
+      ReadSensorOptions(
+          YamlReader::FromString("sensors: {sample_rate_hz: 50}\n", "s.yaml").Child("sensors"),
+          *slide)
+          .channels,
+      std::vector<std::string>{"x"});
   const Excitation pushed = read("{type: impulse, coordinate: x, force_N: 50, duration_s: 0.1}");
   ASSERT_NE(pushed.force_target(), nullptr);
   EXPECT_EQ(pushed.force_target()->coordinate, "x");
