@@ -152,14 +152,26 @@ Measurement H5Reader::ReadMeasurement() const {
   }
 
   const std::string time_path = group + "/time";
-  const double tau = CheckUniformTime(time, path, [&time_path](Eigen::Index) { return time_path; });
-  if (!std::isfinite(interval) || !(std::abs(interval - tau) < kTimeUniformityTolerance * tau)) {
+  // Times stored in single precision, or as epoch seconds, are uniform only to their last bit:
+  // that is their resolution, as a printed digit is a text file's.
+  const bool single = (time.array() == time.array().cast<float>().cast<double>()).all();
+  const double resolution = time.cwiseAbs().maxCoeff() * (single ? 0x1p-23 : 0x1p-52);
+  double fitted_start = 0;
+  const double tau = CheckUniformTime(
+      time, path, [&time_path](Eigen::Index) { return time_path; }, resolution, &fitted_start);
+  // The stated interval is exact (mbid's round trips) when it agrees; a writer that took it
+  // from two stored times has their resolution in it, and the fitted step is the better value.
+  // The fit's own uncertainty from times rounded to `resolution`: res / sqrt(12) * sqrt(12 / n^3).
+  const double fit_std = resolution / std::pow(static_cast<double>(time.size()), 1.5);
+  const bool exact =
+      std::abs(interval - tau) < std::max(kTimeUniformityTolerance * tau, 4 * fit_std);
+  if (!std::isfinite(interval) || !(exact || std::abs(interval - tau) <= 2 * resolution)) {
     throw InputError(path, AttributeField(group, "sample_interval_s"),
                      fmt::format("is {} s but {} has a step of {} s", interval, time_path, tau),
                      "the step of the time dataset");
   }
-  m.start_time_s = time[0];
-  m.sample_interval_s = interval;
+  m.start_time_s = std::abs(time[0] - fitted_start) <= resolution ? time[0] : fitted_start;
+  m.sample_interval_s = exact ? interval : tau;
   m.Validate(path);
   return m;
 }
