@@ -274,7 +274,8 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
   }
   if (options.sample_rate_hz > 0 && table.printed_resolution > 0 &&
       (time.array().isFinite().all()) && time.size() > 1 &&
-      ((time.tail(time.size() - 1) - time.head(time.size() - 1)).array() > 0).all()) {
+      // Non-decreasing: at 2 kHz a time printed to 1 ms repeats every other value.
+      ((time.tail(time.size() - 1) - time.head(time.size() - 1)).array() >= 0).all()) {
     StatedRateGrid(time, path, table, options.sample_rate_hz, table.printed_resolution * to_s.scale,
                    m, report);
     return;

@@ -260,6 +260,14 @@ TEST(DateAndLayoutTest, AStatedRateSettlesACoarselyPrintedTimeColumn) {
   // A stated rate that is not the column's is refused too.
   options.sample_rate_hz = 81;
   EXPECT_THROW(ImportMeasurement(path, options), InputError);
+  // 200 Hz printed to 0.01 s: every other time repeats the one before (0.00, 0.01, 0.01, ...),
+  // which the stated rate reads as its grid (it was refused as a repeated time).
+  const std::string repeats = dir.File("repeats.csv");
+  WriteText(repeats, MakeExport("t [s],psi [deg]\n", 400, [&](int j) {
+              return fmt::format("{:.2f},{}", j / 200.0, Print(psi(j / 200.0)));
+            }));
+  options.sample_rate_hz = 200;
+  EXPECT_EQ(ImportMeasurement(repeats, options).sample_interval_s, 1.0 / 200);
 }
 
 TEST(DateAndLayoutTest, AColumnOfTextIsNoChannel) {
