@@ -129,7 +129,9 @@ std::string ApplyUserUnits(const RawTable& table, const std::string& path,
                            const ImportOptions& options, std::vector<Selected>* selected) {
   std::set<std::string> used;
   for (Selected& s : *selected) {
-    for (const std::string& key : {s.column->name, s.channel}) {
+    // By name, by channel, or by number among the data columns (as --channel takes it).
+    const std::string number = std::to_string(s.column - table.columns.data() + 1);
+    for (const std::string& key : {number, s.column->name, s.channel}) {
       const auto unit = options.units.find(key);
       if (unit == options.units.end()) continue;
       s.unit = unit->second;

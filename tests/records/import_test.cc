@@ -153,6 +153,10 @@ TEST(ImportTest, UnitsFromOptionsAndTimeSuffix) {
   EXPECT_NEAR(m.sample_interval_s, 2e-3, 1e-17);  // us -> s factor's rounding
   EXPECT_EQ(m.units, std::vector<std::string>{"m"});
   ExpectChannel(m, 0, x, 1e-3);
+  // By the column's number among the data columns, as the error for an unknown key lists them.
+  ImportOptions by_number;
+  by_number.units["1"] = "mm";
+  ExpectChannel(ImportMeasurement(path, by_number), 0, x, 1e-3);
 }
 
 TEST(ImportTest, ChannelMappingByNameAndNumberWithModelTargets) {
