@@ -190,8 +190,10 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
         FindMethod(options.method.name())->requirement(options, static_cast<int>(columns.size()));
     throw InputError(
         origin, "samples",
-        fmt::format("{} samples in the window [{}, {}] s{}", count, options.window_start_s,
-                    options.window_end_s,
+        fmt::format("{} samples {}{}", std::max(count, 0),
+                    count > 0 ? fmt::format("from {:.6g} s to {:.6g} s", t0 + first * tau,
+                                            t0 + window.last * tau)
+                              : fmt::format("in the window from {:.6g} s", options.window_start_s),
                     q == 1 ? "" : fmt::format(", {} after decimation by {}", available, q)),
         fmt::format("at least {} for {}", required, order));
   }
