@@ -17,10 +17,13 @@ int RunModesCommand(const std::string& scenario_path, const CommonOptions& commo
   const auto model = scenario.MakeModel();
   const model::LinearModel linear = model->Linearize();
   const std::vector<model::Mode> modes = model::CalcModes(linear);
+  for (const std::string& line : model::FindGrowingModes(modes)) {
+    std::cerr << "mbid: warning: " << line << "\n";
+  }
   if (!common.json_path.empty()) WriteJson(LinearModelToJson(linear, modes), common.json_path);
   if (common.json_path != "-") {
-    std::cout << fmt::format("{}: {} coordinates, {} outputs, linearized at rest\n",
-                             scenario.name, linear.coordinates.size(), linear.outputs.size());
+    std::cout << fmt::format("{}: {} coordinates, {} outputs, linearized at rest\n", scenario.name,
+                             linear.coordinates.size(), linear.outputs.size());
     std::cout << fmt::format("{:>4} {:>14} {:>16} {:>13} {:>15}\n", "mode", "frequency_hz",
                              "decay_rate_per_s", "damping_ratio", "undamped_hz");
     for (size_t k = 0; k < modes.size(); ++k) {

@@ -69,9 +69,13 @@ int RunSimulateCommand(const std::string& scenario_path, const std::string& outp
   const simulation::SimulationResult result =
       simulation::Simulate(*model, excitation, scenario.simulation, scenario.sensors);
 
-  const std::vector<std::string> aliased = simulation::FindAliasedModes(
-      model::CalcModes(model->Linearize()), result.measured.sample_interval_s);
-  for (const std::string& line : aliased) std::cerr << "mbid: warning: " << line << "\n";
+  const std::vector<model::Mode> exact = model::CalcModes(model->Linearize());
+  std::vector<std::string> warnings = model::FindGrowingModes(exact);
+  for (const std::string& line :
+       simulation::FindAliasedModes(exact, result.measured.sample_interval_s)) {
+    warnings.push_back(line);
+  }
+  for (const std::string& line : warnings) std::cerr << "mbid: warning: " << line << "\n";
   H5Writer file(output_path);
   file.WriteMeasurement(result.measured);
   file.WriteScenarioYaml(scenario.yaml_text);
@@ -94,7 +98,7 @@ int RunSimulateCommand(const std::string& scenario_path, const std::string& outp
     }
     summary["initial_q"] = initial_q;
     summary["modes"] = LinearModelToJson(linear, model::CalcModes(linear))["modes"];
-    summary["warnings"] = aliased;
+    summary["warnings"] = warnings;
     WriteJson(summary, common.json_path);
   }
   // Each export appears complete or not at all; the HDF5 file only when everything else has

@@ -1,5 +1,7 @@
 #include "mbid/model/linear_model.h"
 
+#include <fmt/format.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -15,6 +17,18 @@ double Mode::damping_ratio() const { return -lambda.real() / std::abs(lambda); }
 double Mode::undamped_frequency_hz() const { return std::abs(lambda) / (2 * M_PI); }
 double Mode::log_decrement() const { return 2 * M_PI * decay_rate_per_s() / lambda.imag(); }
 double Mode::half_life_s() const { return std::log(2.0) / decay_rate_per_s(); }
+
+std::vector<std::string> FindGrowingModes(const std::vector<Mode>& modes) {
+  std::vector<std::string> lines;
+  for (size_t k = 0; k < modes.size(); ++k) {
+    if (!(modes[k].lambda.real() > 0)) continue;
+    lines.push_back(fmt::format(
+        "mode {} grows at {:.4g} 1/s: the machine is unstable at rest (a spring weaker than "
+        "gravity's overturning stiffness?)",
+        k + 1, modes[k].lambda.real()));
+  }
+  return lines;
+}
 
 std::string StiffnessUnits(const std::string& coordinate_unit) {
   return coordinate_unit == "m" ? "N/m" : "N*m/rad";

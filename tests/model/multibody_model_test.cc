@@ -3,6 +3,7 @@
 // truck crane.
 #include "mbid/model/multibody_model.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -53,6 +54,30 @@ outputs:
               1e-10);
   // Hanging straight down, gravity has no torque: the spring carries nothing.
   EXPECT_NEAR(static_cast<const MultibodyModel&>(*pendulum).neutral_positions()[0], 0.0, 1e-15);
+}
+
+// Standing up (com at +L z), gravity takes m g L = 29.4 N*m/rad of stiffness away: a spring of
+// 20 cannot hold it, and the pole sqrt((m g L - c) / (m L^2 + I)) grows; one of 300 can.
+TEST(MultibodyModelTest, AnInvertedPendulumOnAWeakSpringIsSaidToBeUnstable) {
+  const auto inverted = [](const std::string& stiffness) {
+    return CalcModes(FromYaml(R"(
+type: multibody
+bodies:
+  bob: {parent: ground, joint: {type: revolute, coordinates: [q], axis: [0, 1, 0]},
+        mass_kg: 2.0, com_m: [0, 0, 1.5], inertia_kgm2: [0.01, 0.01, 0.01]}
+springs:
+  q: {stiffness_Nm_per_rad: )" +
+                              stiffness + R"(, damping_Nms_per_rad: 0}
+outputs:
+  angle: {type: coordinate, coordinate: q}
+)")
+                         ->Linearize());
+  };
+  const std::vector<std::string> weak = FindGrowingModes(inverted("20.0"));
+  ASSERT_EQ(weak.size(), 1u);
+  const double rate = std::sqrt((2.0 * 9.81 * 1.5 - 20.0) / (2.0 * 1.5 * 1.5 + 0.01));
+  EXPECT_NE(weak[0].find(fmt::format("grows at {:.4g} 1/s", rate)), std::string::npos) << weak[0];
+  EXPECT_TRUE(FindGrowingModes(inverted("300.0")).empty());
 }
 
 // A horizontal arm (com at +L x): gravity's torque m g L at q = 0 is carried by the spring's

@@ -51,6 +51,7 @@ nlohmann::json LinearModelToJson(const model::LinearModel& linear,
                       {"C", MatrixToJson(linear.C)},       {"H", MatrixToJson(linear.H)}};
   json["modes"] = nlohmann::json::array();
   for (const model::Mode& mode : modes) json["modes"].push_back(ModelModeToJson(mode, linear));
+  json["warnings"] = model::FindGrowingModes(modes);
   return json;
 }
 

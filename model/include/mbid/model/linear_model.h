@@ -53,4 +53,9 @@ struct Mode {
 // ascending damped frequency, followed by real (overdamped) poles sorted by decay.
 std::vector<Mode> CalcModes(const LinearModel& linear);
 
+// One line per mode that grows (Re(lambda) > 0): the machine is unstable at rest, and a test
+// of it topples instead of decaying ("mode 1 grows at 2.31 1/s: the machine is unstable at rest
+// (a spring weaker than gravity's overturning stiffness?)").
+std::vector<std::string> FindGrowingModes(const std::vector<Mode>& modes);
+
 }  // namespace mbid::model
