@@ -194,6 +194,18 @@ TEST(ReleaseTest, OversampledRecordIsDecimatedAutomatically) {
   EXPECT_TRUE(result.reliable) << (result.reasons.empty() ? "" : result.reasons.front());
 }
 
+// The modes of `spec` with white noise of 1e-3 in every channel (seeded), without the
+// stabilization data (long records).
+ModalResult IdentifyWithNoise(const testing::SignalSpec& spec, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const Eigen::MatrixXd values = testing::AddNoise(
+      testing::Synthesize(spec),
+      Eigen::VectorXd::Constant(static_cast<Eigen::Index>(spec.channels.size()), 1e-3), &rng);
+  IdentificationOptions options;
+  options.compute_stabilization = false;
+  return Identify(testing::MakeRecord(spec, values), options);
+}
+
 // The same ring-down recorded for 19.5 s (1e6 samples): the 420 and 980 Hz modes are gone after
 // the first second and sink into the whole record's noise floor. Choosing the band from the
 // whole record's spectrum decimated them away (one mode found, exit 0); the band now comes from
@@ -205,12 +217,7 @@ TEST(ReleaseTest, FastDecayingHighModeKeepsItsBand) {
   spec.samples = 1000000;
   spec.modes = {
       {151.6, 3.0, {1.0}, {0.3}}, {420.0, 8.0, {0.5}, {-1.0}}, {980.0, 20.0, {0.3}, {2.0}}};
-  std::mt19937_64 rng(6);
-  const Eigen::MatrixXd values =
-      testing::AddNoise(testing::Synthesize(spec), Eigen::VectorXd::Constant(1, 1e-3), &rng);
-  IdentificationOptions options;
-  options.compute_stabilization = false;
-  const ModalResult result = Identify(testing::MakeRecord(spec, values), options);
+  const ModalResult result = IdentifyWithNoise(spec, 6);
   ASSERT_EQ(result.modes.size(), 3u);
   EXPECT_GT(result.max_frequency_hz, 980 / 0.76);  // the top mode in the flat part
   for (size_t k = 0; k < 3; ++k) {
@@ -232,12 +239,7 @@ TEST(ReleaseTest, AShortHighBurstAboveTheChosenBandIsNotDecimatedAway) {
   spec.modes = {{1.3, 0.0817, {1.0, 0.3, 0.7}, {0.0, 0.5, 1.2}},
                 {4.7, 0.5907, {0.5, 1.0, -0.6}, {0.3, 1.0, -0.4}},
                 {960.0, 30.16, {0.3, 0.3, 0.3}, {0.1, 0.7, -1.0}}};
-  std::mt19937_64 rng(11);
-  const Eigen::MatrixXd values =
-      testing::AddNoise(testing::Synthesize(spec), Eigen::VectorXd::Constant(3, 1e-3), &rng);
-  IdentificationOptions options;
-  options.compute_stabilization = false;
-  const ModalResult result = Identify(testing::MakeRecord(spec, values), options);
+  const ModalResult result = IdentifyWithNoise(spec, 11);
   ASSERT_EQ(result.modes.size(), 3u);
   for (size_t k = 0; k < 3; ++k) {
     // 1e-3 noise against amplitudes 0.3-1: each to 1e-4 of its frequency, 2 % of its decay.
@@ -249,11 +251,7 @@ TEST(ReleaseTest, AShortHighBurstAboveTheChosenBandIsNotDecimatedAway) {
   EXPECT_TRUE(testing::Mentions(result.warnings, "holds a decaying component up to"));
   // Without the burst the same record keeps its decimation and says nothing of the kind.
   spec.modes.pop_back();
-  std::mt19937_64 same(11);
-  const ModalResult plain = Identify(
-      testing::MakeRecord(spec, testing::AddNoise(testing::Synthesize(spec),
-                                                  Eigen::VectorXd::Constant(3, 1e-3), &same)),
-      options);
+  const ModalResult plain = IdentifyWithNoise(spec, 11);
   EXPECT_GE(plain.decimation, 20);
   EXPECT_EQ(plain.modes.size(), 2u);
   EXPECT_FALSE(testing::Mentions(plain.warnings, "decaying component"));
