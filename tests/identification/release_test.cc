@@ -165,6 +165,29 @@ TEST(ReleaseTest, LeadingZerosNoLongerGiveWrongModes) {
   EXPECT_TRUE(right || !zeros.reliable);
 }
 
+// The modes of `spec`, each within 1e-4 of its frequency and 2 % of its decay rate.
+void ExpectTheModes(const ModalResult& result, const testing::SignalSpec& spec) {
+  ASSERT_EQ(result.modes.size(), spec.modes.size());
+  for (size_t k = 0; k < spec.modes.size(); ++k) {
+    EXPECT_NEAR(result.modes[k].frequency_hz, spec.modes[k].frequency_hz,
+                1e-4 * spec.modes[k].frequency_hz);
+    EXPECT_NEAR(result.modes[k].decay_rate_per_s, spec.modes[k].decay_per_s,
+                0.02 * spec.modes[k].decay_per_s);
+  }
+}
+
+// The modes of `spec` with white noise of 1e-3 in every channel (seeded), without the
+// stabilization data (long records).
+ModalResult IdentifyWithNoise(const testing::SignalSpec& spec, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const Eigen::MatrixXd values = testing::AddNoise(
+      testing::Synthesize(spec),
+      Eigen::VectorXd::Constant(static_cast<Eigen::Index>(spec.channels.size()), 1e-3), &rng);
+  IdentificationOptions options;
+  options.compute_stabilization = false;
+  return Identify(testing::MakeRecord(spec, values), options);
+}
+
 // An oversampled record: three modes (151.6, 420 and 980 Hz, as an impact ring-down of a
 // machine part) at 51.2 kHz, 1e5 samples. The band is chosen from the spectrum and the poles
 // estimated on the decimated record; all three modes are found, the band holds them in the
@@ -182,28 +205,10 @@ TEST(ReleaseTest, OversampledRecordIsDecimatedAutomatically) {
   const ModalResult result = Identify(testing::MakeRecord(spec, values), IdentificationOptions());
   // The spectrum's top (about 1 kHz) x 1.25 inside 0.76 of the new Nyquist frequency: q = 15.
   EXPECT_GE(result.decimation, 10);
-  ASSERT_EQ(result.modes.size(), 3u);
-  for (size_t k = 0; k < 3; ++k) {
-    // 1e-3 noise on amplitudes 0.3-1 over 2 s: the frequencies to 1e-4 (the bound is ~1e-6).
-    EXPECT_NEAR(result.modes[k].frequency_hz, spec.modes[k].frequency_hz,
-                1e-4 * spec.modes[k].frequency_hz);
-    EXPECT_NEAR(result.modes[k].decay_rate_per_s, spec.modes[k].decay_per_s,
-                0.02 * spec.modes[k].decay_per_s);
-  }
+  // 1e-3 noise on amplitudes 0.3-1 over 2 s: the frequencies to 1e-4 (the bound is ~1e-6).
+  ExpectTheModes(result, spec);
   EXPECT_GT(result.max_frequency_hz, 980 / 0.76);  // the top mode in the flat part
   EXPECT_TRUE(result.reliable) << (result.reasons.empty() ? "" : result.reasons.front());
-}
-
-// The modes of `spec` with white noise of 1e-3 in every channel (seeded), without the
-// stabilization data (long records).
-ModalResult IdentifyWithNoise(const testing::SignalSpec& spec, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  const Eigen::MatrixXd values = testing::AddNoise(
-      testing::Synthesize(spec),
-      Eigen::VectorXd::Constant(static_cast<Eigen::Index>(spec.channels.size()), 1e-3), &rng);
-  IdentificationOptions options;
-  options.compute_stabilization = false;
-  return Identify(testing::MakeRecord(spec, values), options);
 }
 
 // The same ring-down recorded for 19.5 s (1e6 samples): the 420 and 980 Hz modes are gone after
@@ -240,14 +245,8 @@ TEST(ReleaseTest, AShortHighBurstAboveTheChosenBandIsNotDecimatedAway) {
                 {4.7, 0.5907, {0.5, 1.0, -0.6}, {0.3, 1.0, -0.4}},
                 {960.0, 30.16, {0.3, 0.3, 0.3}, {0.1, 0.7, -1.0}}};
   const ModalResult result = IdentifyWithNoise(spec, 11);
-  ASSERT_EQ(result.modes.size(), 3u);
-  for (size_t k = 0; k < 3; ++k) {
-    // 1e-3 noise against amplitudes 0.3-1: each to 1e-4 of its frequency, 2 % of its decay.
-    EXPECT_NEAR(result.modes[k].frequency_hz, spec.modes[k].frequency_hz,
-                1e-4 * spec.modes[k].frequency_hz);
-    EXPECT_NEAR(result.modes[k].decay_rate_per_s, spec.modes[k].decay_per_s,
-                0.02 * spec.modes[k].decay_per_s);
-  }
+  // 1e-3 noise against amplitudes 0.3-1: each to 1e-4 of its frequency, 2 % of its decay.
+  ExpectTheModes(result, spec);
   EXPECT_TRUE(testing::Mentions(result.warnings, "holds a decaying component up to"));
   // Without the burst the same record keeps its decimation and says nothing of the kind.
   spec.modes.pop_back();
