@@ -7,6 +7,7 @@
 
 #include "clipped_start.h"
 #include "combination_tones.h"
+#include "dead_channels.h"
 #include "estimate.h"
 #include "free_decay.h"
 #include "internal.h"
@@ -31,6 +32,7 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   bool from_rest = false;
   IdentificationOptions applied = ApplyRelease(measurement, options, &result, &from_rest);
   if (options.skip_clipped) SkipClippedStart(measurement, &applied, &result);
+  LeaveOutDeadChannels(measurement, &applied, &result);
   const AnalysisRecord record = PrepareRecord(measurement, applied, origin);
   result.channels = record.channels;
   result.units = record.units;

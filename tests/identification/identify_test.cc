@@ -580,13 +580,22 @@ TEST(IdentifyTest, NonFiniteSampleNamesChannelAndSample) {
             std::string::npos);
 }
 
-TEST(IdentifyTest, ConstantOrZeroChannelIsAnInputError) {
+// A dead sensor among live ones is left out with a warning (it stopped the whole analysis with
+// exit 2); named on purpose, or alone, it is an input error.
+TEST(IdentifyTest, AConstantChannelIsLeftOutUnlessItIsNamedOrAlone) {
   const SignalSpec spec = ThreeModes();
   Measurement record = MakeRecord(spec, Synthesize(spec));
   record.values.col(0).setConstant(0.25);
-  const InputError constant = Catch<InputError>(record, IdentificationOptions());
+  const ModalResult without_a = Identify(record, IdentificationOptions(), "record.h5");
+  EXPECT_EQ(without_a.channels, std::vector<std::string>{"b"});
+  EXPECT_TRUE(testing::Mentions(without_a.warnings, "channel a is constant (0.25 in every"));
+  EXPECT_EQ(without_a.modes.size(), spec.modes.size());  // channel b sees all three
+  IdentificationOptions named;
+  named.channels = {"a", "b"};
+  const InputError constant = Catch<InputError>(record, named);
   EXPECT_EQ(constant.field(), "a");
   EXPECT_NE(constant.problem().find("constant"), std::string::npos) << constant.what();
+  record.values.col(1).setZero();
   record.values.col(0).setZero();
   const InputError zero = Catch<InputError>(record, IdentificationOptions());
   EXPECT_NE(zero.problem().find("zero"), std::string::npos) << zero.what();
