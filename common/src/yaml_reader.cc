@@ -296,6 +296,7 @@ std::string YamlReader::Choice(const std::string& key, const std::vector<std::st
   const std::string value = String(key, fallback);
   if (std::find(choices.begin(), choices.end(), value) != choices.end()) return value;
   std::string expected = "one of " + internal::Join(choices, ", ");
+  if (!Has(key)) FailAt(key, "missing", expected);  // no usable default: a required key
   const std::string suggestion = Suggestion(value, choices);
   if (!suggestion.empty()) expected += "; " + suggestion;
   FailAt(key, "unknown choice '" + value + "'", expected);

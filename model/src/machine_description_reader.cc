@@ -255,7 +255,9 @@ MachineDescription ReadMachineDescription(const YamlReader& model) {
       if (std::find(coordinates.begin(), coordinates.end(), coordinate) == coordinates.end()) {
         std::string known;
         for (const std::string& c : coordinates) known += (known.empty() ? "" : ", ") + c;
-        springs.FailAt(coordinate, "unknown coordinate '" + coordinate + "'", "one of " + known);
+        springs.FailAt(
+            coordinate, "unknown coordinate '" + coordinate + "'",
+            known.empty() ? "a coordinate of a joint in bodies (none has one)" : "one of " + known);
       }
       machine.springs.push_back(ReadSpring(coordinate, machine.IsTranslational(coordinate),
                                            springs.Child(coordinate), context));

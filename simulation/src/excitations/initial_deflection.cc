@@ -1,5 +1,6 @@
 #include "mbid/simulation/excitations/initial_deflection.h"
 
+#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -22,6 +23,18 @@ InitialDeflection InitialDeflection::Read(const YamlReader& node,
       if (units[i] == unit) coordinates.push_back(model.coordinate_names()[i]);
     }
     const YamlReader deflection = node.Child(key);
+    // A coordinate of the other unit: name the key it belongs under.
+    for (const std::string& coordinate : deflection.Keys()) {
+      const auto& names = model.coordinate_names();
+      const auto at = std::find(names.begin(), names.end(), coordinate);
+      if (at != names.end() && units[static_cast<size_t>(at - names.begin())] != unit) {
+        deflection.FailAt(
+            coordinate,
+            "coordinate '" + coordinate + (std::string(unit) == "rad" ? "' slides" : "' turns"),
+            std::string("its deflection under ") +
+                (std::string(unit) == "rad" ? "deflection_m (in m)" : "deflection_rad (in rad)"));
+      }
+    }
     deflection.ExpectMap(coordinates);
     for (const std::string& coordinate : deflection.Keys()) {
       excitation.deflection_rad[coordinate] = deflection.Double(coordinate);
