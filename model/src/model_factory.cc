@@ -127,6 +127,12 @@ TorsionalOscillatorParameters ReadTorsionalOscillatorParameters(const YamlReader
 }
 
 std::unique_ptr<MechanicalModel> MakeModel(const YamlReader& model) {
+  // The default type is the crane's shorthand; a description by bodies without its type would
+  // otherwise be refused key by key against the crane's.
+  if (!model.Has("type") && model.Has("bodies")) {
+    model.FailAt("type", "missing in a machine described by bodies",
+                 "type: multibody (the default, truck_crane, takes the crane's keys)");
+  }
   const std::string type =
       model.Choice("type", {"truck_crane", "multibody", "torsional_oscillator"}, "truck_crane");
   if (type == "torsional_oscillator") {
