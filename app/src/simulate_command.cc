@@ -69,21 +69,20 @@ int RunSimulateCommand(const std::string& scenario_path, const std::string& outp
   const simulation::SimulationResult result =
       simulation::Simulate(*model, excitation, scenario.simulation, scenario.sensors);
 
-  const std::vector<model::Mode> exact = model::CalcModes(model->Linearize());
-  std::vector<std::string> warnings = model::FindGrowingModes(exact);
+  const validation::ModelTruth truth = validation::CalcModelTruth(*model);
+  std::vector<std::string> warnings = model::FindGrowingModes(truth.modes);
   for (const std::string& line :
-       simulation::FindAliasedModes(exact, result.measured.sample_interval_s)) {
+       simulation::FindAliasedModes(truth.modes, result.measured.sample_interval_s)) {
     warnings.push_back(line);
   }
   for (const std::string& line : warnings) std::cerr << "mbid: warning: " << line << "\n";
   H5Writer file(output_path);
   file.WriteMeasurement(result.measured);
   file.WriteScenarioYaml(scenario.yaml_text);
-  WriteTruth(file, *model, result);
+  WriteTruth(file, truth, result);
   WriteSimulationInfo(file, excitation, scenario.simulation, result);
 
   if (!common.json_path.empty()) {
-    const model::LinearModel linear = model->Linearize();
     nlohmann::json summary{
         {"scenario", scenario.name},
         {"output", output_path},
@@ -97,7 +96,7 @@ int RunSimulateCommand(const std::string& scenario_path, const std::string& outp
       initial_q[model->coordinate_names()[i]] = result.initial_q[i];
     }
     summary["initial_q"] = initial_q;
-    summary["modes"] = LinearModelToJson(linear, model::CalcModes(linear))["modes"];
+    summary["modes"] = LinearModelToJson(truth.linear, truth.modes)["modes"];
     summary["warnings"] = warnings;
     WriteJson(summary, common.json_path);
   }

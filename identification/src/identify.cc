@@ -66,11 +66,9 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   }
   if (options.decimation == 0 && record.decimation > 1) {
     // What the band chosen from the spectrum left out: a decaying mode above it is a burst at
-    // the full-rate residual's start (out_of_band.h). Analysed again with a band that holds it.
-    const Eigen::MatrixXd residual =
-        record.centered - FitAmplitudes(record.centered, record.sample_interval_s, estimate.lambda,
-                                        options.offset == OffsetRemoval::kFit)
-                              .reconstruction;
+    // the start of what the modes' full-rate fit leaves (out_of_band.h). Analysed again with a
+    // band that holds it.
+    const Eigen::MatrixXd residual = record.values - result.reconstruction;
     const double top_hz =
         FindDecayingContentTop(record.centered, residual, record.sample_interval_s);
     if (top_hz > record.flat_frequency_hz) {

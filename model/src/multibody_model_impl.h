@@ -110,9 +110,10 @@ struct MultibodyModel::Impl {
     double rest_angle_rad = 0.0;                              // azimuth or elevation at q = 0
     Eigen::Vector3d rest_position = Eigen::Vector3d::Zero();  // the point at q = 0
   };
-  // M, the geometric stiffness and H at q = 0 depend on the inertial data alone, not on c and d;
-  // computed once and shared with clones (they cost about 30 right-hand sides).
-  // The linearization point: q = 0, or the rest an attached payload deflects the machine to.
+  // M, the geometric stiffness and H at the linearization point: q = 0, where they depend on the
+  // inertial data alone, or the rest an attached payload deflects the machine to, which moves
+  // with the stiffness (SetParameter starts a new set). Computed once and shared with clones
+  // (they cost about 30 right-hand sides).
   struct RestMatrices {
     std::once_flag once;
     Eigen::VectorXd q;  // the rest
@@ -198,11 +199,7 @@ struct MultibodyModel::Impl {
   // Gravity's generalized force at q = 0 on the machine without the attached payload: the dead
   // weight the springs carry (the preload rule).
   Eigen::VectorXd CalcUnloadedGravityForce() const {
-    SimTK::State s = default_state;
-    for (size_t k = 0; k < springs.size(); ++k) {
-      springs[k].setStiffness(s, 0.0);
-      dampers[k].setDamping(s, 0.0);
-    }
+    SimTK::State s = MakeStaticState();
     std::vector<PointLoad> lift;
     if (machine.attached_payload_kg > 0) {
       lift.push_back({machine.payload_point,

@@ -307,11 +307,16 @@ class LvmReader {
     return s;
   }
 
+  // A number's text with a decimal point where the file writes a decimal comma.
+  std::string WithDecimalPoint(std::string text) const {
+    if (decimal_comma_) std::replace(text.begin(), text.end(), ',', '.');
+    return text;
+  }
+
   // The coarsest last digit of the X column's texts (a writer that drops trailing zeros prints
   // "0.02" beside "0.025"; zero itself says nothing).
   void UpdatePlace(const std::string& text) {
-    std::string copy = text;
-    if (decimal_comma_) std::replace(copy.begin(), copy.end(), ',', '.');
+    const std::string copy = WithDecimalPoint(text);
     double value = 0;
     if (!ParseNumber(copy, &value) || value == 0.0) return;
     time_place_ = std::max(time_place_, PrintedPlace(copy));
@@ -393,9 +398,8 @@ class LvmReader {
     if (x_columns_ == XColumns::kNone) {
       table.start = GridNumber(first, "X0", 0);
       table.interval = GridNumber(first, "Delta_X", 0);
-      std::string delta_x = KeyValue(first, "Delta_X", 0);
-      if (decimal_comma_) std::replace(delta_x.begin(), delta_x.end(), ',', '.');
-      table.interval_resolution = std::pow(10.0, PrintedPlace(delta_x));
+      table.interval_resolution =
+          std::pow(10.0, PrintedPlace(WithDecimalPoint(KeyValue(first, "Delta_X", 0))));
       table.time_where = LineField(first.key_lines.count("Delta_X") ? first.key_lines["Delta_X"]
                                                                     : first.header_line);
       if (!(table.interval > 0)) {

@@ -32,6 +32,13 @@ SignalSpec ArmWithTone(double tone_decay_per_s) {
   return spec;
 }
 
+// The component at the sum's pole with `amplitude` in both accelerometers.
+SignalSpec ArmWithSumTone(double amplitude) {
+  SignalSpec spec = ArmWithTone(1.2215 + 3.5092);
+  spec.modes[2].amplitude = {0.0, 0.0, amplitude, amplitude};
+  return spec;
+}
+
 ModalResult IdentifyArm(const SignalSpec& spec, int seed) {
   std::mt19937_64 rng(seed);
   const Eigen::VectorXd noise = Eigen::Vector4d(2e-3, 2e-3, 2e-3, 2e-3);
@@ -67,8 +74,7 @@ TEST(CombinationTonesTest, AModeAtASumWithAToneTooStrongIsAModeWithAWarning) {
   // The component at the sum's pole with 0.3 in the accelerometers: weaker than both modes
   // (largest 2.0 and 1.5) but 15 % of the stronger's amplitude, more than a tone of even large
   // vibrations has (10 %; the reference crane's third mode sits near f1 + f2 with 5-18 %).
-  SignalSpec spec = ArmWithTone(1.2215 + 3.5092);
-  spec.modes[2].amplitude = {0.0, 0.0, 0.3, 0.3};
+  const SignalSpec spec = ArmWithSumTone(0.3);
   for (int seed = 1; seed <= 3; ++seed) {
     const ModalResult result = IdentifyArm(spec, seed);
     ASSERT_EQ(result.modes.size(), 3u) << "seed " << seed;
@@ -84,8 +90,7 @@ TEST(CombinationTonesTest, AStrongToneOfLargeVibrationsAtTheExactSumIsATone) {
   // from 10 mrad has f1 + f3 at 3.5 %): above a tone of small vibrations, but at 30 times the
   // noise its pole is the sum's to 0.5 % in frequency (3 standard deviations), a precision no
   // chance neighbour has.
-  SignalSpec spec = ArmWithTone(1.2215 + 3.5092);
-  spec.modes[2].amplitude = {0.0, 0.0, 0.06, 0.06};
+  const SignalSpec spec = ArmWithSumTone(0.06);
   for (int seed = 1; seed <= 3; ++seed) {
     const ModalResult result = IdentifyArm(spec, seed);
     ASSERT_EQ(result.modes.size(), 3u) << "seed " << seed;

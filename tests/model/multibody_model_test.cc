@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "../common/test_util.h"
 #include "mbid/common/error.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/model_factory.h"
@@ -489,7 +490,7 @@ TEST(MultibodyModelTest, MatrixUnitsFollowTheCoordinates) {
 // setup and the eigensolver with exit 139). Universal axes typed to 7 digits are perpendicular
 // enough (Simbody makes the second perpendicular to the first).
 TEST(MultibodyModelTest, AWeldOnlyMachineIsRefusedTypedAxesAreAccepted) {
-  try {
+  const InputError welded = testing::CatchInputError([] {
     FromYaml(R"(
 type: multibody
 bodies:
@@ -497,11 +498,9 @@ bodies:
 points: {p: {body: a, at_m: [0, 0, 0]}}
 outputs: {x: {type: displacement, point: p, direction: [1, 0, 0]}}
 )");
-    FAIL() << "a weld-only machine was accepted";
-  } catch (const InputError& error) {
-    EXPECT_EQ(error.field(), "model.bodies") << error.what();
-    EXPECT_NE(std::string(error.what()).find("every joint is a weld"), std::string::npos);
-  }
+  });
+  EXPECT_EQ(welded.field(), "model.bodies") << welded.what();
+  EXPECT_NE(std::string(welded.what()).find("every joint is a weld"), std::string::npos);
   std::string text = kEveryJoint;
   const std::string axes = "axes: [[0, 0, 1], [0, 1, 0]]";
   text.replace(text.find(axes), axes.size(), "axes: [[0, 0, 1], [0, 1, 3e-7]]");
@@ -513,7 +512,7 @@ outputs: {x: {type: displacement, point: p, direction: [1, 0, 0]}}
 // failed" (exit 1) or Simbody's "Inertia matrix contains a NaN" (exit 3); now it is refused on
 // reading.
 TEST(MultibodyModelTest, ASingularMassMatrixIsRefused) {
-  try {
+  const InputError error = testing::CatchInputError([] {
     FromYaml(R"(
 type: multibody
 bodies:
@@ -527,12 +526,10 @@ springs:
 outputs:
   w: {type: angular_velocity, body: b, axis: [0, 0, 1]}
 )");
-    FAIL() << "a singular mass matrix was accepted";
-  } catch (const InputError& error) {
-    EXPECT_EQ(error.source(), "machine.yaml") << error.what();
-    EXPECT_EQ(error.field(), "model.bodies") << error.what();
-    EXPECT_NE(std::string(error.what()).find("mass matrix is singular"), std::string::npos);
-  }
+  });
+  EXPECT_EQ(error.source(), "machine.yaml") << error.what();
+  EXPECT_EQ(error.field(), "model.bodies") << error.what();
+  EXPECT_NE(std::string(error.what()).find("mass matrix is singular"), std::string::npos);
 }
 
 struct BadCase {

@@ -66,10 +66,7 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
                       "t = 0 of the test",
                       test.name, test.release->release_time_s, test.release->how));
       if (test.release->clipped_until_s) {
-        say(
-            fmt::format("test {}: {}; the test is analysed from t = {:.6g} s, after its last "
-                        "clipped sample",
-                        test.name, test.release->clipped, *test.release->clipped_until_s));
+        say(fmt::format("test {}: {}", test.name, test.release->DescribeClipped()));
       }
     }
     say(fmt::format("test {}: {} ({} samples x {} channels)", test.name, test.origin,

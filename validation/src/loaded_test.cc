@@ -68,9 +68,7 @@ void DescribeLoadedTest(const LoadedTest& test) {
   std::cerr << fmt::format("mbid: {}: free decay from {:.6g} s of the record ({}); t = 0 there\n",
                            test.path, test.release.release_time_s, test.release.how);
   if (test.release.clipped_until_s) {
-    std::cerr << fmt::format(
-        "mbid: {}: {}; the test is analysed from t = {:.6g} s, after its last clipped sample\n",
-        test.path, test.release.clipped, *test.release.clipped_until_s);
+    std::cerr << fmt::format("mbid: {}: {}\n", test.path, test.release.DescribeClipped());
   }
   std::cerr << fmt::format("mbid: {}: {} samples x {} channels, {} ({}), {} modes identified\n",
                            test.path, test.record.samples(), test.record.channel_count(),

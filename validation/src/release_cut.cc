@@ -32,6 +32,12 @@ nlohmann::json AppliedRelease::ToJson() const {
   return json;
 }
 
+std::string AppliedRelease::DescribeClipped() const {
+  if (!clipped_until_s) return "";
+  return fmt::format("{}; the test is analysed from t = {:.6g} s, after its last clipped sample",
+                     clipped, *clipped_until_s);
+}
+
 namespace {
 
 AppliedRelease CutAtReleaseOnly(Measurement* record, const std::string& origin,

@@ -1,9 +1,7 @@
 #include "mbid/simulation/excitations/force_target.h"
 
-#include <algorithm>
 #include <array>
 #include <string>
-#include <vector>
 
 #include "mbid/common/yaml_reader.h"
 
@@ -27,10 +25,7 @@ ForceTarget ForceTarget::Read(const YamlReader& node, const model::MechanicalMod
     target.coordinate = node.Choice("coordinate", model.coordinate_names(), "");
     // The generalized force has the coordinate's unit: a torque on a turning one, a force on a
     // sliding one.
-    const std::vector<std::string>& names = model.coordinate_names();
-    const size_t index = static_cast<size_t>(
-        std::find(names.begin(), names.end(), target.coordinate) - names.begin());
-    const bool slides = model.coordinate_units()[index] == "m";
+    const bool slides = model.coordinate_unit(target.coordinate) == "m";
     const std::string key = slides ? "force_N" : "torque_Nm";
     const std::string other = slides ? "torque_Nm" : "force_N";
     if (node.Has(other)) {

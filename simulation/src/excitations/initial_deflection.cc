@@ -1,6 +1,5 @@
 #include "mbid/simulation/excitations/initial_deflection.h"
 
-#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -25,9 +24,8 @@ InitialDeflection InitialDeflection::Read(const YamlReader& node,
     const YamlReader deflection = node.Child(key);
     // A coordinate of the other unit: name the key it belongs under.
     for (const std::string& coordinate : deflection.Keys()) {
-      const auto& names = model.coordinate_names();
-      const auto at = std::find(names.begin(), names.end(), coordinate);
-      if (at != names.end() && units[static_cast<size_t>(at - names.begin())] != unit) {
+      const std::string coordinate_unit = model.coordinate_unit(coordinate);
+      if (!coordinate_unit.empty() && coordinate_unit != unit) {
         deflection.FailAt(
             coordinate,
             "coordinate '" + coordinate + (std::string(unit) == "rad" ? "' slides" : "' turns"),

@@ -54,6 +54,8 @@ class MechanicalModel {
     return std::vector<std::string>(coordinate_names().size(), "rad");
   }
   int coordinate_count() const { return static_cast<int>(coordinate_names().size()); }
+  // The unit of coordinate `name` ("rad" or "m"), or "" when the model has none of that name.
+  std::string coordinate_unit(const std::string& name) const;
   int output_count() const { return static_cast<int>(output_names().size()); }
   // Names of points that accept external loads.
   virtual std::vector<std::string> load_points() const = 0;

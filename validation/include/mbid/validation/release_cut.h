@@ -37,6 +37,8 @@ struct AppliedRelease {
   std::optional<double> clipped_until_s;
   std::string clipped;
   nlohmann::json ToJson() const;
+  // "<clipped>; the test is analysed from t = 0.55 s, after its last clipped sample", or "".
+  std::string DescribeClipped() const;
 };
 
 // Cuts `record` at its release with the release as time origin (start_time_s in [0, tau)):
