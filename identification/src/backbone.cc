@@ -1,5 +1,7 @@
 #include "mbid/identification/backbone.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -89,6 +91,20 @@ Backbone CalcBackbone(const Eigen::MatrixXd& mode_alone, double sample_interval_
                                               lambda.imag() / (2 * M_PI), noise_std);
   if (!hilbert.frequency_hz.empty()) backbone.hilbert = std::move(hilbert);
   return backbone;
+}
+
+std::string DescribeDrift(const BackboneCurve& backbone) {
+  if (backbone.frequency_hz.empty()) return "no windows";
+  const auto [low, high] =
+      std::minmax_element(backbone.frequency_hz.begin(), backbone.frequency_hz.end());
+  // Four digits hide a drift of a few parts in 1e4 that the windows' spread still shows.
+  int digits = 4;
+  while (digits < 9 &&
+         fmt::format("{:.{}g}", *low, digits) == fmt::format("{:.{}g}", *high, digits)) {
+    ++digits;
+  }
+  return fmt::format("{:.{}g} to {:.{}g} Hz, {:.2g} %", *low, digits, *high, digits,
+                     100 * (*high - *low) / *high);
 }
 
 }  // namespace mbid::identification

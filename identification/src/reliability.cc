@@ -121,12 +121,12 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   }
   for (const IdentifiedMode& mode : result->modes) {
     if (mode.backbone && mode.backbone->amplitude_dependent) {
-      const auto [low, high] = std::minmax_element(mode.backbone->frequency_hz.begin(),
-                                                   mode.backbone->frequency_hz.end());
       reasons.push_back(fmt::format(
-          "the mode at {:.4g} Hz is amplitude dependent ({:.4g} to {:.4g} Hz): its constant "
-          "frequency and damping hold at no amplitude; use its backbone",
-          mode.frequency_hz, *low, *high));
+          "the mode at {:.4g} Hz is amplitude dependent ({}, {:.2g} times the scatter its "
+          "windows' standard deviations allow): its constant frequency and damping hold at no "
+          "amplitude; use its backbone",
+          mode.frequency_hz, DescribeDrift(*mode.backbone),
+          std::sqrt(mode.backbone->spread_chi_square_per_dof)));
     }
   }
   // Modes within 3 % of each other: one mode whose frequency drifts with amplitude, or two the

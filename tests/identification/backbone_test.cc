@@ -192,5 +192,16 @@ TEST(BackboneOptionTest, NamesRoundTrip) {
   EXPECT_EQ(mode, BackboneMode::kAlways);
 }
 
+TEST(BackboneDriftTest, ADriftOfAFewPartsInTenThousandIsPrintedSoItShows) {
+  BackboneCurve curve;
+  // 1.32913 .. 1.32941 Hz: equal to 4 digits ("1.329 to 1.329 Hz" told the user nothing), apart
+  // at 5; the drift is 0.00028 / 1.32941 = 0.021 %.
+  curve.frequency_hz = {1.32941, 1.32930, 1.32913};
+  EXPECT_EQ(DescribeDrift(curve), "1.3291 to 1.3294 Hz, 0.021 %");
+  // A drift that four digits show keeps four.
+  curve.frequency_hz = {16.12, 15.9};
+  EXPECT_EQ(DescribeDrift(curve), "15.9 to 16.12 Hz, 1.4 %");
+}
+
 }  // namespace
 }  // namespace mbid::identification

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <complex>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "mbid/identification/options.h"
@@ -41,5 +42,9 @@ struct Backbone : BackboneCurve {
 Backbone CalcBackbone(const Eigen::MatrixXd& mode_alone, double sample_interval_s,
                       double start_time_s, std::complex<double> lambda,
                       const Eigen::VectorXd& channel_weights, const RefinementOptions& options);
+
+// "1.3286 to 1.3294 Hz, 0.06 %": the windows' lowest and highest frequency, printed to as many
+// digits as tell them apart, and the drift relative to the highest.
+std::string DescribeDrift(const BackboneCurve& backbone);
 
 }  // namespace mbid::identification
