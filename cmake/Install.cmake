@@ -25,6 +25,9 @@ install(EXPORT mbidTargets NAMESPACE mbid:: DESTINATION "${CMAKE_INSTALL_LIBDIR}
 
 install(DIRECTORY "${MBID_SOURCE_DIR}/scenarios" DESTINATION "${CMAKE_INSTALL_DATADIR}/mbid")
 install(DIRECTORY "${MBID_SOURCE_DIR}/docs" DESTINATION "${CMAKE_INSTALL_DATADIR}/mbid")
+# docs/library.md and docs/python.md link the examples beside them.
+install(DIRECTORY "${MBID_SOURCE_DIR}/examples" DESTINATION "${CMAKE_INSTALL_DATADIR}/mbid"
+  REGEX "examples/CMakeLists.txt$" EXCLUDE)
 install(FILES "${MBID_SOURCE_DIR}/README.md" DESTINATION "${CMAKE_INSTALL_DATADIR}/mbid")
 
 # The package's own dependencies are found again in the consumer (the static libraries carry

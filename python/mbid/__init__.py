@@ -17,7 +17,7 @@ _DATA_DIR = _os.path.normpath(
 
 
 def default_scenario_path():
-    """The built-in reference scenario (the truck crane's load drop)."""
+    """The built-in reference scenario (the truck crane's initial-deflection test)."""
     return _default_scenario_path(_DATA_DIR)
 
 

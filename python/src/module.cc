@@ -3,6 +3,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <cmath>
 #include <map>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "mbid/mbid.h"
+#include "mbid/records/records.h"
 
 namespace py = pybind11;
 
@@ -78,6 +80,8 @@ mbid::Measurement MakeRecord(
     }
   }
   m.source = "import";
+  // Units as a file would state them ("deg", "mm", "g"): to SI as a read record is.
+  mbid::records::ConvertToSi(&m, "identify_arrays");
   m.Validate("identify_arrays");
   return m;
 }
@@ -280,7 +284,11 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readonly("identified", &mbid::ValidationResult::identified)
       .def_readonly("updated", &mbid::ValidationResult::updated);
 
-  m.def("load_scenario", &mbid::LoadScenario, py::arg("path"), "Reads a scenario file.");
+  // Paths as str or os.PathLike (pathlib.Path).
+  m.def(
+      "load_scenario",
+      [](const std::filesystem::path& path) { return mbid::LoadScenario(path.string()); },
+      py::arg("path"), "Reads a scenario file.");
   m.def("load_scenario_text", &mbid::LoadScenarioFromText, py::arg("yaml"),
         py::arg("source") = "scenario", "A scenario from YAML text.");
   m.def(
@@ -290,7 +298,8 @@ PYBIND11_MODULE(_mbid, m) {
   m.def("simulate", &mbid::Simulate, py::arg("scenario"), py::call_guard<py::gil_scoped_release>(),
         "Simulates the scenario's test: a Record.");
   m.def(
-      "read_record", [](const std::string& path) { return mbid::ReadRecord(path); },
+      "read_record",
+      [](const std::filesystem::path& path) { return mbid::ReadRecord(path.string()); },
       py::arg("path"), "Reads a record file (CSV, HDF5, MAT, UFF58, LVM), SI units.");
   m.def(
       "identify",
@@ -326,15 +335,16 @@ PYBIND11_MODULE(_mbid, m) {
       "Tunes the scenario's model to the records: .parameters['c_alpha'].value, .std.");
   m.def(
       "run",
-      [](const mbid::Scenario& scenario, const std::string& output_folder, bool overwrite,
-         bool quiet) {
+      [](const mbid::Scenario& scenario, const std::optional<std::filesystem::path>& output_folder,
+         bool overwrite, bool quiet) {
         mbid::ValidationOptions options;
-        options.output_folder = output_folder;
+        // None: in memory (a default path would come back from Python as ".").
+        if (output_folder) options.output_folder = output_folder->string();
         options.overwrite = overwrite;
         options.quiet = quiet;
         return mbid::RunValidationCycle(scenario, options);
       },
-      py::arg("scenario"), py::arg("output_folder") = "", py::arg("overwrite") = false,
+      py::arg("scenario"), py::arg("output_folder") = py::none(), py::arg("overwrite") = false,
       py::arg("quiet") = true, py::call_guard<py::gil_scoped_release>(),
       "The validation cycle in memory: .verdict is 'passed', 'failed' or 'inconclusive'.");
 }

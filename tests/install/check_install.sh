@@ -11,11 +11,15 @@ trap 'rm -rf "$work"' EXIT
 prefix="$work/prefix"
 cmake --install "$build" --prefix "$prefix" > "$work/install.log"
 for path in bin/mbid include/mbid/mbid.h lib/cmake/mbid/mbidConfig.cmake \
-            share/mbid/scenarios/reference-crane.yaml share/mbid/docs/python.md; do
+            share/mbid/scenarios/reference-crane.yaml share/mbid/docs/python.md \
+            share/mbid/examples/cpp/crane_cycle.cc share/mbid/examples/python/crane_cycle.py; do
   [[ -e "$prefix/$path" ]] || { echo "not installed: $path"; exit 1; }
 done
+# The example is a C++-only project (no C compiler enabled for FindHDF5) that asks for C++14:
+# mbid::mbid must raise it to the C++17 its headers need.
 cmake -S "$source/examples/cpp" -B "$work/example" -DCMAKE_PREFIX_PATH="$prefix" \
-      -DCMAKE_BUILD_TYPE=Release > "$work/configure.log" || { cat "$work/configure.log"; exit 1; }
+      -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_STANDARD=14 -DCMAKE_CXX_EXTENSIONS=OFF \
+      > "$work/configure.log" || { cat "$work/configure.log"; exit 1; }
 cmake --build "$work/example" > "$work/build.log" || { cat "$work/build.log"; exit 1; }
 # Run from elsewhere: the default scenario must come from the installed share folder.
 cd "$work"

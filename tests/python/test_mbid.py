@@ -4,6 +4,7 @@ command line's own numbers, and errors with the command line's messages.
 Run by ctest with PYTHONPATH=<build>/python; argv[1:]: the mbid binary and the source tree."""
 import json
 import math
+import pathlib
 import os
 import subprocess
 import sys
@@ -234,6 +235,25 @@ class ErrorTest(unittest.TestCase):
         with self.assertRaises(mbid.InputError) as raised:
             mbid.identify_arrays(np.arange(10) * 0.1, {"x": np.ones(9)})
         self.assertIn("channels/x", str(raised.exception))
+
+    def test_paths_may_be_pathlib_paths(self):
+        scenario = mbid.load_scenario(pathlib.Path(mbid.default_scenario_path()))
+        self.assertEqual(scenario.name, "reference-crane")
+        with self.assertRaises(mbid.InputError) as raised:
+            mbid.read_record(pathlib.Path("/nonexistent/record.csv"))
+        self.assertIn("/nonexistent/record.csv", str(raised.exception))
+
+    def test_units_are_converted_to_si_or_refused(self):
+        # A unit decay stated in deg comes back with amplitude pi / 180 rad, as a file's would;
+        # a unit udunits2 does not know, and the ambiguous 'g', are refused with the channel.
+        t = np.arange(2000) * 0.01
+        y = np.exp(-0.1 * t) * np.cos(2 * np.pi * 1.5 * t)
+        result = mbid.identify_arrays(t, {"x": y}, {"x": "deg"})
+        self.assertAlmostEqual(result.modes[0].amplitude[0], math.pi / 180, delta=1e-9)
+        for unit in ["furlongs_per_bogus", "g"]:
+            with self.assertRaises(mbid.InputError) as raised:
+                mbid.identify_arrays(t, {"x": y}, {"x": unit})
+            self.assertIn("units/x", str(raised.exception))
 
 
 if __name__ == "__main__":

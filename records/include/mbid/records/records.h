@@ -48,6 +48,13 @@ struct ImportReport {
 Measurement ImportMeasurement(const std::string& path, const ImportOptions& options = {},
                               ImportReport* report = nullptr);
 
+// Converts `measurement`'s channels in place from their units (Measurement::units, as a file
+// would state them: "deg", "mm/s^2", "g") to the SI unit of each one's dimension, through
+// udunits2 as ImportMeasurement does; the units become the SI ones. An unknown unit is an
+// InputError naming `source` and "units/<channel>". Returns the conversions made, as
+// ImportReport::conversions.
+std::vector<std::string> ConvertToSi(Measurement* measurement, const std::string& source);
+
 // The file name extensions ImportMeasurement reads (".csv", ".h5", ...), and whether `path`
 // has one of them (case ignored).
 std::vector<std::string> SupportedExtensions();
