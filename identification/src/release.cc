@@ -41,6 +41,9 @@ struct OnsetFit {
   int first = 0, last = 0;
 
   bool jump_everywhere = false;  // a jump in every channel, not only in rate channels
+  // A slope in every channel (moving off: an impact) or only in rate channels (a release from
+  // rest, whose positions start with curvature alone; a slope there fits noise as onset).
+  bool slope_everywhere = true;
 
   double Cost(double t0) const {
     double cost = 0;
@@ -48,7 +51,8 @@ struct OnsetFit {
     for (Eigen::Index c = 0; c < values->cols(); ++c) {
       // Unknowns: constant, jump (rate channels), slope, curvature, cubic term.
       const bool jump = rate[c] || jump_everywhere;
-      const int p = jump ? 5 : 4;
+      const bool slope = rate[c] || jump_everywhere || slope_everywhere;
+      const int p = 3 + (jump ? 1 : 0) + (slope ? 1 : 0);
       Eigen::MatrixXd basis(n, p);
       for (int i = 0; i < n; ++i) {
         const double s = std::max(0.0, static_cast<double>(first + i) - t0);
@@ -56,7 +60,7 @@ struct OnsetFit {
         int k = 0;
         basis(i, k++) = 1;
         if (jump) basis(i, k++) = after ? 1.0 : 0.0;
-        basis(i, k++) = s;
+        if (slope) basis(i, k++) = s;
         basis(i, k++) = s * s;
         basis(i, k++) = s * s * s;
       }
@@ -204,8 +208,20 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   OnsetFit fit{&y, {}, range, first, last};
   for (const std::string& unit : record.units) fit.rate.push_back(IsRate(unit));
   fit.rate.resize(static_cast<size_t>(m), false);
+  // Set off from rest (positions with curvature alone) unless moving off with a velocity fits
+  // better by more than noise: 25 is a change of 5 noise standard deviations.
+  fit.slope_everywhere = false;
   double cost = 0;
   double t0 = FindOnset(fit, early, &cost);
+  fit.slope_everywhere = true;
+  double slope_cost = 0;
+  const double slope_t0 = FindOnset(fit, early, &slope_cost);
+  bool moving_off = false;
+  if (cost - slope_cost > 25 * noise_variance) {
+    t0 = slope_t0;
+    cost = slope_cost;
+    moving_off = true;
+  }
   // A position that jumps (an impact, a record that starts abruptly after zeros) fits the
   // jump model better by far more than noise: 25 is a change of 5 noise standard deviations.
   fit.jump_everywhere = true;
@@ -234,7 +250,7 @@ ReleaseDetection DetectRelease(const Measurement& record) {
     if ((y.col(c).head(rest).array() - level).abs().maxCoeff() > bound) return detection;
   }
   detection.detected = true;
-  detection.from_rest = !jumps;
+  detection.from_rest = !jumps && !moving_off;
   detection.rest_samples = rest;
   detection.release_time_s = record.start_time_s + t0 * record.sample_interval_s;
   detection.description = fmt::format("free decay starts at {:.6g} s after {} samples at rest",
@@ -269,10 +285,30 @@ double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s) {
     }
     return sum;
   };
+  // How far to look: 3 samples, or an eighth of the period of the fastest mode that carries a
+  // tenth of some channel's velocity, whichever is longer. A finely sampled onset is found late
+  // by several samples (the motion stays within the noise while it grows as t^2: 6 samples at
+  // 2 kHz on the crane), and within an eighth of a period the velocities vanish together only
+  // at the release.
+  double top_hz = 0;
+  for (const IdentifiedMode& mode : modes.modes) {
+    for (size_t c = 0; c < channels; ++c) {
+      const double share = mode.amplitude(static_cast<Eigen::Index>(c)) * std::abs(mode.lambda);
+      if (share >= 0.1 * scale[c]) top_hz = std::max(top_hz, mode.frequency_hz);
+    }
+  }
+  const double reach = top_hz > 0 ? std::max(3 * tau, 0.125 / top_hz) : 3 * tau;
+  // A quarter-sample grid, then a hundredth of a sample about its best point.
+  const int coarse_steps = static_cast<int>(std::ceil(8 * reach / tau));
   double best = coarse_time_s, best_value = velocity_norm(coarse_time_s);
-  constexpr int kSteps = 600;  // a hundredth of a sample over +-3 samples
-  for (int i = 0; i <= kSteps; ++i) {
-    const double t = coarse_time_s + (6.0 * i / kSteps - 3.0) * tau;
+  for (int i = 0; i <= coarse_steps; ++i) {
+    const double t = coarse_time_s - reach + 2 * reach * i / coarse_steps;
+    const double value = velocity_norm(t);
+    if (value < best_value) best_value = value, best = t;
+  }
+  const double centre = best;
+  for (int i = 0; i <= 50; ++i) {
+    const double t = centre + (i / 50.0 - 0.5) * 0.5 * tau;
     const double value = velocity_norm(t);
     if (value < best_value) best_value = value, best = t;
   }

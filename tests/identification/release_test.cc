@@ -69,18 +69,42 @@ struct Release {
 
 // Eight noise draws: the position's onset is curvature only (at rest at the release), which
 // 1e-5 rad of noise lets show after about a sample: measured within 0.97 samples (9.7 ms; the
-// issue's failed update had a 64 ms cut error). The acceleration jumps at the release: it is
+// issue's failed update had a 64 ms cut error) by an onset with a slope, within 0.19 by one
+// that sets off from rest. The acceleration jumps at the release: it is
 // placed between the two samples around it, reported at their middle (0.5 sample at most).
 TEST(ReleaseTest, LoadReleaseFoundToAboutASample) {
   const Release test;
   for (unsigned seed = 1; seed < 9; ++seed) {
     const ReleaseDetection position = DetectRelease(test.Record("rad", seed));
     EXPECT_TRUE(position.detected);
-    EXPECT_NEAR(position.release_time_s, test.release_s, 1.2 * test.interval_s) << seed;
+    EXPECT_NEAR(position.release_time_s, test.release_s, 0.3 * test.interval_s) << seed;
+    RecordProperty("position_error_samples_" + std::to_string(seed),
+                   std::to_string((position.release_time_s - test.release_s) / test.interval_s));
     const ReleaseDetection acceleration = DetectRelease(test.Record("rad/s^2", seed));
     EXPECT_TRUE(acceleration.detected);
     EXPECT_NEAR(acceleration.release_time_s, test.release_s, 0.5 * test.interval_s) << seed;
     EXPECT_EQ(acceleration.rest_samples, 124);  // samples 0..123 are before 1.2345 s
+  }
+}
+
+// At 2 kHz the onset stays within the noise for many samples while it grows as t^2 (1 noise
+// standard deviation after 8 samples on the crane): the onset fit alone placed the release up
+// to 55 samples off, beyond the reach of the modes' refinement (3 samples then). Measured with
+// the refinement's reach of an eighth of a period: within 1.1 samples over these seeds.
+TEST(ReleaseTest, AFinelySampledReleaseFromRestIsPlacedByTheWholeDecay) {
+  Release test;
+  test.interval_s = 0.0005;  // 2 kHz
+  test.release_s = 2.00013;  // between samples
+  test.samples = 12000;      // 6 s
+  IdentificationOptions options;
+  options.compute_spectrum = false;
+  options.compute_stabilization = false;
+  for (unsigned seed = 1; seed < 7; ++seed) {
+    const ModalResult result = Identify(test.Record("rad", seed), options);
+    EXPECT_EQ(result.release, "detected");
+    EXPECT_NEAR(result.release_time_s, test.release_s, 2 * test.interval_s) << seed;
+    ASSERT_EQ(result.modes.size(), 1u) << seed;
+    EXPECT_NEAR(result.modes[0].frequency_hz, test.frequency_hz, 1e-3) << seed;
   }
 }
 
