@@ -49,10 +49,12 @@ struct OnsetFit {
     double cost = 0;
     const int n = last - first + 1;
     for (Eigen::Index c = 0; c < values->cols(); ++c) {
-      // Unknowns: constant, jump (rate channels), slope, curvature, cubic term.
+      // Unknowns: constant, jump (rate channels), slope, curvature, cubic term; set off from
+      // rest, a position has the constant and the curvature alone (a cubic term from an earlier
+      // t0 mimics a later quadratic onset: at 1e-4 rad the release came 7 samples early).
       const bool jump = rate[c] || jump_everywhere;
       const bool slope = rate[c] || jump_everywhere || slope_everywhere;
-      const int p = 3 + (jump ? 1 : 0) + (slope ? 1 : 0);
+      const int p = 2 + (jump ? 1 : 0) + (slope ? 2 : 0);
       Eigen::MatrixXd basis(n, p);
       for (int i = 0; i < n; ++i) {
         const double s = std::max(0.0, static_cast<double>(first + i) - t0);
@@ -62,7 +64,7 @@ struct OnsetFit {
         if (jump) basis(i, k++) = after ? 1.0 : 0.0;
         if (slope) basis(i, k++) = s;
         basis(i, k++) = s * s;
-        basis(i, k++) = s * s * s;
+        if (slope) basis(i, k++) = s * s * s;
       }
       const Eigen::VectorXd y = values->col(c).segment(first, n) / range(c);
       const Eigen::MatrixXd normal = basis.transpose() * basis;
@@ -73,6 +75,26 @@ struct OnsetFit {
     return cost;
   }
 };
+
+// Least-squares cost of one cubic per channel over samples [0, last], channels weighted by their
+// range as in OnsetFit: a record in motion from its first sample.
+double SmoothCost(const Eigen::MatrixXd& y, const Eigen::VectorXd& range, int last) {
+  const int n = last + 1;
+  Eigen::MatrixXd basis(n, 4);
+  for (int i = 0; i < n; ++i) {
+    const double s = static_cast<double>(i) / n;  // scaled: a well-conditioned normal matrix
+    basis.row(i) << 1, s, s * s, s * s * s;
+  }
+  const Eigen::MatrixXd normal = basis.transpose() * basis;
+  const auto solver = normal.ldlt();
+  double cost = 0;
+  for (Eigen::Index c = 0; c < y.cols(); ++c) {
+    const Eigen::VectorXd v = y.col(c).head(n) / range(c);
+    const Eigen::VectorXd x = solver.solve(basis.transpose() * v);
+    cost += (v - basis * x).squaredNorm();
+  }
+  return cost;
+}
 
 // The release instant (in samples) that minimizes fit.Cost: every sample up to `early`, then a
 // golden section between the neighbours of the best.
@@ -201,7 +223,13 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   }
   int early = 0;
   while (early < onset && deviation(early) <= early_fraction) ++early;
-  const int first = std::max(0, early - std::max(20, 3 * (onset - early)));
+  // The window reaches back to where the release may be. A motion from rest grows as t^2, so
+  // the release lies about (onset - early) / (1 - sqrt(early_fraction / kOnsetFraction)) before
+  // the onset; where the noise puts the first clear motion near the onset (early_fraction 24 %
+  // of the range) that is 50 times onset - early, and 3 times placed the release 94 ms late.
+  const double ratio = std::min(0.95, std::sqrt(early_fraction / kOnsetFraction));
+  const int back = static_cast<int>(std::ceil(1.5 * (onset - early) / (1 - ratio)));
+  const int first = std::max(0, early - std::max({20, 3 * (onset - early), back}));
   // A few samples past the first clear motion: the polynomial holds a fraction of a period, and
   // a jump (rate channels) needs samples after it to be told from a slope.
   const int last = std::min(n - 1, early + 3);
@@ -234,6 +262,14 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   }
   const int rest = static_cast<int>(std::ceil(t0));  // samples before the release
   if (rest < kMinRestSamples + 1) return detection;
+  // A rest segment must be needed: where one smooth cubic from the record's first sample fits
+  // the samples up to the onset window's end about as well (within 25 noise variances), the
+  // record was moving from its start (a logger started after the release: at 2 kHz, 50 ms
+  // into the crane's decay, the first 35 samples moved less than 10 % of the range and were
+  // taken for a rest).
+  OnsetFit whole = fit;
+  whole.first = 0;
+  if (SmoothCost(y, range, last) <= whole.Cost(t0) + 25 * noise_variance) return detection;
   // The segment before must really be at rest: within kRestFraction of its own median. A short
   // "rest" at the record's very start may be the first samples of a release from rest that the
   // cubic cannot follow over its window (the crane's load drop recorded from the release: 5
@@ -246,7 +282,10 @@ ReleaseDetection DetectRelease(const Measurement& record) {
     std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
     const double level = before[before.size() / 2];
     double bound = kRestFraction * range(c);
-    if (rest < kShortRestSamples) bound = std::min(bound, 6 * ThirdDifferenceNoise(y.col(c)));
+    const double noise = ThirdDifferenceNoise(y.col(c));
+    // A long rest in a channel whose noise is a few % of its range holds 4-sigma samples beyond
+    // a tenth of the range (2 kHz, 4000 samples: the release of a 0.0155 rad swing was missed).
+    bound = rest < kShortRestSamples ? std::min(bound, 6 * noise) : std::max(bound, 6 * noise);
     if ((y.col(c).head(rest).array() - level).abs().maxCoeff() > bound) return detection;
   }
   detection.detected = true;
@@ -299,12 +338,23 @@ double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s) {
   }
   const double reach = top_hz > 0 ? std::max(3 * tau, 0.125 / top_hz) : 3 * tau;
   // A quarter-sample grid, then a hundredth of a sample about its best point.
-  const int coarse_steps = static_cast<int>(std::ceil(8 * reach / tau));
-  double best = coarse_time_s, best_value = velocity_norm(coarse_time_s);
+  // The onset of a release from rest comes late, never early (the motion grows out of the noise
+  // as t^2): twice the reach before it, once after.
+  const int coarse_steps = static_cast<int>(std::ceil(12 * reach / tau));
+  double best = coarse_time_s, best_value = velocity_norm(coarse_time_s), top_value = best_value;
+  int best_step = -1;
   for (int i = 0; i <= coarse_steps; ++i) {
-    const double t = coarse_time_s - reach + 2 * reach * i / coarse_steps;
+    const double t = coarse_time_s - 2 * reach + 3 * reach * i / coarse_steps;
     const double value = velocity_norm(t);
-    if (value < best_value) best_value = value, best = t;
+    top_value = std::max(top_value, value);
+    if (value < best_value) best_value = value, best = t, best_step = i;
+  }
+  // The velocities vanish together inside the reach, far below their size at its ends; a least
+  // value at an end, or one not a tenth of the largest, is no release the modes know (a mode the
+  // noise hid: at 1e-4 rad on the crane at 2 kHz, the 2.2 Hz mode, and the least value sat at
+  // the reach's end, 16 ms early): the onset stands.
+  if (best_step == 0 || best_step == coarse_steps || !(best_value < 0.1 * top_value)) {
+    return coarse_time_s;
   }
   const double centre = best;
   for (int i = 0; i <= 50; ++i) {

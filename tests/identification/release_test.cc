@@ -120,6 +120,48 @@ TEST(ReleaseTest, RecordStartingInTheDecayHasNoRestSegment) {
   EXPECT_EQ(found.release_time_s, 0.0);
 }
 
+// At 2 kHz a record that starts 50 ms into the decay moves less than a tenth of its range in
+// its first 35 samples: those were taken for a rest and the release put 18 ms after the record's
+// start. One cubic from the first sample fits them as well, so no rest is needed: none is found.
+// The same for a record that starts exactly at the release.
+TEST(ReleaseTest, AFinelySampledRecordStartingInTheDecayHasNoRestSegment) {
+  Release test;
+  test.interval_s = 0.0005;
+  test.samples = 8000;
+  for (const double release_s : {-0.05, -0.01, 0.0}) {
+    test.release_s = release_s;
+    for (unsigned seed = 1; seed < 4; ++seed) {
+      const ReleaseDetection found = DetectRelease(test.Record("rad", seed));
+      EXPECT_FALSE(found.detected) << release_s << " " << seed << ": " << found.description;
+    }
+  }
+}
+
+// A long rest in a channel whose noise is a few % of the release's swing holds samples beyond a
+// tenth of the range (4000 samples: 4-sigma excursions): the rest was refused and the release
+// missed. The noise (6 standard deviations) now bounds a long rest as well.
+TEST(ReleaseTest, ANoisyLongRestIsStillARest) {
+  Release test;
+  test.interval_s = 0.0005;
+  test.release_s = 2.0;
+  test.samples = 12000;
+  test.noise = 8e-4;  // 4 % of the 0.02 rad range: a tenth of the range is 2.5 sigma
+  IdentificationOptions options;
+  options.compute_spectrum = false;
+  options.compute_stabilization = false;
+  for (unsigned seed = 1; seed < 5; ++seed) {
+    const Measurement record = test.Record("rad", seed);
+    const ReleaseDetection found = DetectRelease(record);
+    EXPECT_TRUE(found.detected) << seed << ": " << found.description;
+    // The onset grows out of the noise as 0.57 rad/s^2 t^2 / 2 (the 1.7 Hz mode): 6 noise
+    // standard deviations after 130 ms, so the onset fit alone is tens of ms off; the decay's
+    // vanishing velocity places it.
+    const ModalResult result = Identify(record, options);
+    EXPECT_NEAR(result.release_time_s, test.release_s, 2 * test.interval_s) << seed;
+    RecordProperty("noisy_" + std::to_string(seed), std::to_string(result.release_time_s));
+  }
+}
+
 // A glitch (one sample 10 times the deflection off, an electrical spike) is no release: not in
 // the rest before the true one, nor in a record that starts in the decay. The acceleration's
 // release, a jump that sets the structure ringing, is still found to half a sample.

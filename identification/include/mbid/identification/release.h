@@ -31,11 +31,13 @@ struct ReleaseDetection {
 ReleaseDetection DetectRelease(const Measurement& record);
 
 // A release from rest is where the velocity of every channel vanishes: the reconstruction of
-// `modes` (identified on the decay after `coarse_time_s`) differentiated in time, searched
-// within 3 samples of the coarse instant or an eighth of the period of the fastest mode that
-// carries a tenth of some channel's velocity, whichever is longer. Uses the whole record's
-// information instead of the few samples around the onset: on the crane at 1e-5 rad noise, a
-// tenth of a sample.
+// `modes` (identified on the decay after `coarse_time_s`) differentiated in time. Searched from
+// twice the reach before the coarse instant to once after it (an onset comes late), the reach
+// being 3 samples or an eighth of the period of the fastest mode that carries a tenth of some
+// channel's velocity, whichever is longer. Uses the whole record's information instead of the
+// few samples around the onset: on the crane at 1e-5 rad noise, a tenth of a sample at 100 Hz.
+// Where the least sum of squared velocities is at an end of the range or not below a tenth of
+// the largest (the modes miss one that the noise hid), the coarse instant is returned.
 double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s);
 
 // The part of `record` from `release_time_s` on, with the release as time origin: samples at
