@@ -79,6 +79,7 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
   updating::TestRecord record =
       updating::MakeTestRecord(test.name, test.measured, excitation, updating);
   WeighByIdentifiedNoise(test.identified, record);
+  record.release_detected = test.release && test.release->how == "detected";
   std::string start;
   std::string start_note;
   test.search = TuneModel(model, {record}, updating, test.algebraic.get(), &start, &start_note,

@@ -8,6 +8,8 @@
 #include <complex>
 #include <vector>
 
+#include "mbid/validation/release_profile.h"
+
 namespace mbid::validation {
 
 std::vector<size_t> SelectMainModes(const identification::ModalResult& identified, size_t count) {
@@ -114,8 +116,11 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
   if (algebraic != nullptr) {
     updating::MarkAlgebraicAmbiguity(*algebraic, search.best, 0.1, search.judged_starts);
   }
+  // A release found in a record is placed by the fit too (release_profile.h).
+  std::vector<updating::TestRecord> placed = records;
+  PlaceDetectedReleases(model, &placed, settings.options, &search.best);
   if (settings.profile.enabled) {
-    updating::ProfileLikelihood(model, records, settings.options, settings.profile, search.best,
+    updating::ProfileLikelihood(model, placed, settings.options, settings.profile, search.best,
                                 say);
   }
   return search;

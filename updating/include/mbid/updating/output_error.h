@@ -56,6 +56,9 @@ struct TestRecord {
   // field records; fit_drift needs fit_offsets.
   bool fit_offsets = false;
   bool fit_drift = false;
+  // The record was cut at a release found in it (not given, not simulated): known to a fraction
+  // of a sample, so the fit places it too (validation/release_profile.h).
+  bool release_detected = false;
 };
 
 struct UpdateOptions {
