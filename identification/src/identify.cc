@@ -62,7 +62,28 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   }
   if (from_rest) {
     // The whole decay knows the release better than its first samples (release.h).
-    result.release_time_s = RefineReleaseFromModes(result, result.release_time_s);
+    const double onset_s = result.release_time_s;
+    result.release_time_s = RefineReleaseFromModes(result, onset_s);
+    if (result.release_time_s != onset_s) {
+      // One release for the user: the line names the refined instant, the onset and where the
+      // analysis starts (the first sample after the onset).
+      for (std::string& line : result.warnings) {
+        if (line.rfind("free decay starts at ", 0) != 0) continue;
+        const size_t after = line.find(" after ");
+        const size_t rest = line.find(" samples at rest");
+        const std::string samples =
+            after != std::string::npos && rest != std::string::npos && rest > after
+                ? line.substr(after + 7, rest - after - 7)
+                : "the";
+        line = fmt::format(
+            "free decay starts at {:.6g} s, where the identified modes' velocities vanish "
+            "together (the onset after {} samples at rest: {:.6g} s); the analysis starts at "
+            "the first sample after the onset, {:.6g} s (--release none to analyse the whole "
+            "record)",
+            result.release_time_s, samples, onset_s, result.start_time_s);
+        break;
+      }
+    }
   }
   if (options.decimation == 0 && record.decimation > 1) {
     // What the band chosen from the spectrum left out: a decaying mode above it is a burst at

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -103,6 +104,11 @@ TEST(ReleaseTest, AFinelySampledReleaseFromRestIsPlacedByTheWholeDecay) {
     const ModalResult result = Identify(test.Record("rad", seed), options);
     EXPECT_EQ(result.release, "detected");
     EXPECT_NEAR(result.release_time_s, test.release_s, 2 * test.interval_s) << seed;
+    // One release for the user: the warning names the refined instant, not the onset.
+    char refined[64];
+    std::snprintf(refined, sizeof refined, "free decay starts at %.6g s,", result.release_time_s);
+    ASSERT_FALSE(result.warnings.empty()) << seed;
+    EXPECT_EQ(result.warnings.front().rfind(refined, 0), 0u) << result.warnings.front();
     ASSERT_EQ(result.modes.size(), 1u) << seed;
     EXPECT_NEAR(result.modes[0].frequency_hz, test.frequency_hz, 1e-3) << seed;
   }
