@@ -23,7 +23,28 @@ namespace fs = std::filesystem;
 
 const std::string kScenarios = std::string(MBID_SOURCE_DIR) + "/scenarios/";
 
-class RunRecordsTest : public mbid::testing::CommandTest {};
+class RunRecordsTest : public mbid::testing::CommandTest {
+ protected:
+  // The record `base` simulates (`mbid simulate`), as a logger keeps it: `rest` samples at rest
+  // at the deflection it starts from (its noise-free value is the first simulated sample less
+  // that sample's noise, within 1e-5), with 1e-5 of noise (the scenario's sensors) from `seed`.
+  mbid::Measurement FieldRecord(const fs::path& base, int rest, unsigned seed) const {
+    EXPECT_EQ(Run("simulate " + base.string() + " -o " + (dir_ / "sim.h5").string()).exit_code, 0);
+    const mbid::Measurement simulated = mbid::ReadMeasurementH5((dir_ / "sim.h5").string());
+    mbid::Measurement field = simulated;
+    field.source = "import";
+    field.values.resize(rest + simulated.samples(), simulated.channel_count());
+    field.values.bottomRows(simulated.samples()) = simulated.values;
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0.0, 1e-5);
+    for (int j = 0; j < rest; ++j) {
+      for (int c = 0; c < field.channel_count(); ++c) {
+        field.values(j, c) = simulated.values(0, c) + noise(rng);
+      }
+    }
+    return field;
+  }
+};
 
 // The identification and Route 1 are the point here: Route 2 runs one local fit from the
 // scenario's values (2 s) instead of the global search (11 s), which docs/user-guide.md's example
@@ -151,20 +172,7 @@ TEST_F(RunRecordsTest, AFinelySampledRecordHasItsReleasePlacedByTheFit) {
   const fs::path rate = WriteVariant(kScenarios + "reference-crane.yaml", "rate.yaml",
                                      "sample_rate_hz: 100", "sample_rate_hz: 2000");
   const fs::path base = WriteVariant(rate, "base.yaml", "  duration_s: 8", "  duration_s: 2");
-  ASSERT_EQ(Run("simulate " + base.string() + " -o " + (dir_ / "sim.h5").string()).exit_code, 0);
-  const mbid::Measurement simulated = mbid::ReadMeasurementH5((dir_ / "sim.h5").string());
-  constexpr int kRest = 1000;  // 0.5 s at 2 kHz
-  mbid::Measurement field = simulated;
-  field.source = "import";
-  field.values.resize(kRest + simulated.samples(), simulated.channel_count());
-  field.values.bottomRows(simulated.samples()) = simulated.values;
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> noise(0.0, 1e-5);  // the scenario's sensor noise
-  for (int j = 0; j < kRest; ++j) {
-    for (int c = 0; c < field.channel_count(); ++c) {
-      field.values(j, c) = simulated.values(0, c) + noise(rng);
-    }
-  }
+  const mbid::Measurement field = FieldRecord(base, 1000, 5);  // 0.5 s at rest at 2 kHz
   mbid::WriteMeasurementCsv(field, (dir_ / "field.csv").string());
   const CommandResult result = Run("update " + base.string() + " " + (dir_ / "field.csv").string() +
                                    " --json " + (dir_ / "update.json").string());
@@ -186,22 +194,8 @@ TEST_F(RunRecordsTest, AFinelySampledRecordHasItsReleasePlacedByTheFit) {
 TEST_F(RunRecordsTest, FieldRecordIsCutAtTheReleaseAndItsOffsetsFitted) {
   const fs::path base = WriteVariant(kScenarios + "reference-crane.yaml", "base.yaml",
                                      "  duration_s: 8", "  duration_s: 5");
-  ASSERT_EQ(Run("simulate " + base.string() + " -o " + (dir_ / "sim.h5").string()).exit_code, 0);
-  const mbid::Measurement simulated = mbid::ReadMeasurementH5((dir_ / "sim.h5").string());
   constexpr int kRest = 100;  // 1 s at 100 Hz
-  mbid::Measurement field = simulated;
-  field.source = "import";
-  field.values.resize(kRest + simulated.samples(), simulated.channel_count());
-  field.values.bottomRows(simulated.samples()) = simulated.values;
-  std::mt19937_64 rng(11);
-  std::normal_distribution<double> noise(0.0, 1e-5);  // the scenario's sensor noise
-  for (int j = 0; j < kRest; ++j) {
-    for (int c = 0; c < field.channel_count(); ++c) {
-      // At rest at the deflection the record starts from (its noise-free value is the first
-      // simulated sample less that sample's noise, within 1e-5).
-      field.values(j, c) = simulated.values(0, c) + noise(rng);
-    }
-  }
+  mbid::Measurement field = FieldRecord(base, kRest, 11);
   const Eigen::Vector2d offset(2e-3, -1e-3);  // rad: a fifth of the deflection
   field.values.rowwise() += offset.transpose();
   mbid::WriteMeasurementCsv(field, (dir_ / "field.csv").string());
