@@ -5,6 +5,7 @@
 #include "../updating/crane_fixture.h"
 #include "mbid/model/linear_model.h"
 #include "mbid/updating/settings.h"
+#include "mbid/validation/release_profile.h"
 #include "mbid/validation/two_route_update.h"
 
 namespace mbid::app {
@@ -77,6 +78,44 @@ TEST(UpdatingGlueTest, RouteOneRunsOnTheMainModesAndNamesTheOthers) {
       SolveAlgebraicRoute(*crane.model, identified, record, crane.excitation, settings, &note),
       nullptr);
   EXPECT_NE(note.find("3 identified modes for 4 coordinates"), std::string::npos) << note;
+}
+
+// Placing a detected release refits the best (release_profile.h): what the global search or
+// Route 1 judged of it must survive. A parameter marked undetermined (here by hand, as the search
+// marks those its alternative minima differ in) stays undetermined with its reason; the exact
+// record's release is placed where it is (noise-free: within a hundredth of a sample).
+TEST(UpdatingGlueTest, APlacedReleaseKeepsWhatTheSearchLeftUndetermined) {
+  const updating::testing::Crane crane =
+      updating::testing::LoadCrane(updating::testing::kReferenceScenario);
+  const Measurement record = updating::testing::SimulateExact(crane, 2.0, 100.0);
+  const updating::UpdatingSettings settings =
+      updating::MakeDefaultUpdatingSettings(*crane.model, crane.simulation.integrator);
+  updating::TestRecord test = updating::MakeTestRecord("rec", record, crane.excitation, settings);
+  test.noise_std = {{"psi", 1e-5}, {"phi", 1e-5}};
+  test.release_detected = true;
+  updating::UpdateResult best = updating::UpdateModel(*crane.model, {test}, settings.options);
+  ASSERT_NE(best.termination, updating::UpdateResult::Termination::kFailure);
+  for (updating::ParameterEstimate& p : best.parameters) {
+    if (p.name != "c_gamma") continue;
+    p.determined = false;
+    p.why_undetermined = "the alternative minima differ in it";
+  }
+  best.undetermined.push_back("c_gamma");
+  std::vector<updating::TestRecord> records{test};
+  const std::vector<std::string> lines =
+      validation::PlaceDetectedReleases(*crane.model, &records, settings.options, &best);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("the fit places the release"), std::string::npos) << lines[0];
+  EXPECT_NEAR(records[0].record.start_time_s, record.start_time_s, 0.01 * record.sample_interval_s);
+  EXPECT_FALSE(best.Find("c_gamma").determined);
+  EXPECT_EQ(best.Find("c_gamma").why_undetermined, "the alternative minima differ in it");
+  EXPECT_TRUE(best.Find("c_alpha").determined);
+  EXPECT_NE(std::find(best.undetermined.begin(), best.undetermined.end(), "c_gamma"),
+            best.undetermined.end());
+  // Moving the release half a sample later leaves out the sample it puts before the release.
+  const Measurement later = validation::MoveRelease(record, 0.5 * record.sample_interval_s);
+  EXPECT_EQ(later.samples(), record.samples() - 1);
+  EXPECT_NEAR(later.start_time_s, record.start_time_s + 0.5 * record.sample_interval_s, 1e-12);
 }
 
 }  // namespace

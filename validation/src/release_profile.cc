@@ -30,6 +30,45 @@ updating::UpdateResult FitFrom(const model::MechanicalModel& model,
   return updating::UpdateModel(*clone, tests, options);
 }
 
+// The fit at the placed release, with the judgments made of `judged` kept: parameters the
+// global search or Route 1 left undetermined (alternative minima, ambiguous sets) stay so, and
+// neither credibility nor warnings are lost.
+updating::UpdateResult Merge(const updating::UpdateResult& judged,
+                             const updating::UpdateResult& placed) {
+  updating::UpdateResult merged = placed;
+  for (updating::ParameterEstimate& p : merged.parameters) {
+    for (const updating::ParameterEstimate& q : judged.parameters) {
+      if (q.name != p.name || q.determined) continue;
+      p.determined = false;
+      if (p.why_undetermined.empty()) p.why_undetermined = q.why_undetermined;
+    }
+  }
+  for (const std::string& name : judged.undetermined) {
+    if (std::find(merged.undetermined.begin(), merged.undetermined.end(), name) ==
+        merged.undetermined.end()) {
+      merged.undetermined.push_back(name);
+    }
+  }
+  merged.credible = judged.credible && placed.credible;
+  for (const std::string& line : judged.credibility) {
+    if (std::find(merged.credibility.begin(), merged.credibility.end(), line) ==
+        merged.credibility.end()) {
+      merged.credibility.push_back(line);
+    }
+  }
+  merged.warnings = judged.warnings;
+  for (const std::string& line : placed.warnings) {
+    if (std::find(merged.warnings.begin(), merged.warnings.end(), line) == merged.warnings.end()) {
+      merged.warnings.push_back(line);
+    }
+  }
+  // The path from the start is the global search's (the convergence figure).
+  merged.initial_cost = judged.initial_cost;
+  merged.iterations = judged.iterations;
+  merged.history = judged.history;
+  return merged;
+}
+
 bool Usable(const updating::UpdateResult& fit) {
   return fit.termination != updating::UpdateResult::Termination::kFailure &&
          std::isfinite(fit.final_cost);
@@ -126,7 +165,7 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
         }
       }
     }
-    *best = placed_fit;
+    *best = Merge(*best, placed_fit);
     lines.push_back(fmt::format(
         "{}: the fit places the release {:.3g} ms {} the detected instant (+- {:.2g} ms, {:.2g} "
         "samples); the standard deviations include what that uncertainty moves",
