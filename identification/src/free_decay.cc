@@ -11,8 +11,8 @@ namespace mbid::identification {
 // Where the free decay starts, and the options with the analysis window starting there.
 IdentificationOptions ApplyRelease(const Measurement& measurement,
                                    const IdentificationOptions& options, ModalResult* result,
-                                   bool* from_rest) {
-  *from_rest = false;
+                                   ReleaseDetection* detection) {
+  *detection = ReleaseDetection();
   IdentificationOptions applied = options;
   result->release_time_s = measurement.start_time_s;
   switch (options.release) {
@@ -24,14 +24,13 @@ IdentificationOptions ApplyRelease(const Measurement& measurement,
       result->release_time_s = options.release_time_s;
       break;
     case ReleaseMode::kDetect: {
-      const ReleaseDetection detection = DetectRelease(measurement);
-      result->release = detection.detected ? "detected" : "record start";
-      result->release_time_s = detection.release_time_s;
-      *from_rest = detection.from_rest;
-      if (detection.detected) {
+      *detection = DetectRelease(measurement);
+      result->release = detection->detected ? "detected" : "record start";
+      result->release_time_s = detection->release_time_s;
+      if (detection->detected) {
         result->warnings.push_back(fmt::format(
             "{}; the analysis starts there (--release none to analyse the whole record)",
-            detection.description));
+            detection->description));
       }
       break;
     }

@@ -29,8 +29,8 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   if (options.remove_drift) return IdentifyRemovingDrift(measurement, options, origin);
   ModalResult result;
   options.Validate("identification options");
-  bool from_rest = false;
-  IdentificationOptions applied = ApplyRelease(measurement, options, &result, &from_rest);
+  ReleaseDetection detection;
+  IdentificationOptions applied = ApplyRelease(measurement, options, &result, &detection);
   if (options.skip_clipped) SkipClippedStart(measurement, &applied, &result);
   LeaveOutDeadChannels(measurement, &applied, &result);
   const AnalysisRecord record = PrepareRecord(measurement, applied, origin);
@@ -60,29 +60,18 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
     for (const std::string& fault : RecordFaults(record)) reason += "; " + fault;
     throw NumericalError(e.stage(), reason);
   }
-  if (from_rest) {
+  if (detection.detected && detection.from_rest) {
     // The whole decay knows the release better than its first samples (release.h).
     const double onset_s = result.release_time_s;
     result.release_time_s = RefineReleaseFromModes(result, onset_s);
     if (result.release_time_s != onset_s) {
-      // One release for the user: the line names the refined instant, the onset and where the
-      // analysis starts (the first sample after the onset).
-      for (std::string& line : result.warnings) {
-        if (line.rfind("free decay starts at ", 0) != 0) continue;
-        const size_t after = line.find(" after ");
-        const size_t rest = line.find(" samples at rest");
-        const std::string samples =
-            after != std::string::npos && rest != std::string::npos && rest > after
-                ? line.substr(after + 7, rest - after - 7)
-                : "the";
-        line = fmt::format(
-            "free decay starts at {:.6g} s, where the identified modes' velocities vanish "
-            "together (the onset after {} samples at rest: {:.6g} s); the analysis starts at "
-            "the first sample after the onset, {:.6g} s (--release none to analyse the whole "
-            "record)",
-            result.release_time_s, samples, onset_s, result.start_time_s);
-        break;
-      }
+      // One release for the user: ApplyRelease's line (the first warning) names the refined
+      // instant, the onset and where the analysis starts (the first sample after the onset).
+      result.warnings.front() = fmt::format(
+          "free decay starts at {:.6g} s, where the identified modes' velocities vanish "
+          "together (the onset after {} samples at rest: {:.6g} s); the analysis starts at the "
+          "first sample after the onset, {:.6g} s (--release none to analyse the whole record)",
+          result.release_time_s, detection.rest_samples, onset_s, result.start_time_s);
     }
   }
   if (options.decimation == 0 && record.decimation > 1) {

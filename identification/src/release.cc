@@ -350,9 +350,9 @@ double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s) {
     }
   }
   const double reach = top_hz > 0 ? std::max(3 * tau, 0.125 / top_hz) : 3 * tau;
-  // A quarter-sample grid, then a hundredth of a sample about its best point.
   // The onset of a release from rest comes late, never early (the motion grows out of the noise
-  // as t^2): twice the reach before it, once after.
+  // as t^2): twice the reach before it, once after, on a quarter-sample grid; then a hundredth of
+  // a sample about the grid's best point.
   const int coarse_steps = static_cast<int>(std::ceil(12 * reach / tau));
   double best = coarse_time_s, best_value = velocity_norm(coarse_time_s), top_value = best_value;
   int best_step = -1;

@@ -1,5 +1,3 @@
-#include <fmt/format.h>
-
 #include "mbid/records/records.h"
 #include "units.h"
 
@@ -16,8 +14,8 @@ std::vector<std::string> ConvertToSi(Measurement* measurement, const std::string
     if (!conversion.identity()) {
       auto column = measurement->values.col(static_cast<Eigen::Index>(c));
       column = (column.array() * conversion.scale + conversion.offset).matrix();
-      conversions.push_back(fmt::format("{}: {} -> {} (x {:g})", measurement->channels[c], unit,
-                                        target, conversion.scale));
+      conversions.push_back(
+          internal::DescribeConversion(measurement->channels[c], unit, target, conversion));
     }
     measurement->units[c] = target;
   }

@@ -385,11 +385,7 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
     const internal::UnitConversion conversion = internal::FindConversion(unit, target, path, field);
     internal::Convert(conversion, &values[c]);
     if (!conversion.identity()) {
-      r.conversions.push_back(
-          conversion.offset == 0.0
-              ? fmt::format("{}: {} -> {} (x {:g})", s.channel, unit, target, conversion.scale)
-              : fmt::format("{}: {} -> {} (x {:g} + {:g})", s.channel, unit, target,
-                            conversion.scale, conversion.offset));
+      r.conversions.push_back(internal::DescribeConversion(s.channel, unit, target, conversion));
     }
     m.channels.push_back(s.channel);
     m.units.push_back(target);

@@ -216,4 +216,12 @@ void Convert(const UnitConversion& conversion, std::vector<double>* values) {
   for (double& v : *values) v = conversion.scale * v + conversion.offset;
 }
 
+std::string DescribeConversion(const std::string& channel, const std::string& from,
+                               const std::string& to, const UnitConversion& conversion) {
+  return conversion.offset == 0.0
+             ? fmt::format("{}: {} -> {} (x {:g})", channel, from, to, conversion.scale)
+             : fmt::format("{}: {} -> {} (x {:g} + {:g})", channel, from, to, conversion.scale,
+                           conversion.offset);
+}
+
 }  // namespace mbid::records::internal

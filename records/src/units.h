@@ -40,4 +40,9 @@ UnitConversion FindConversion(const std::string& from, const std::string& to,
 // Applies `conversion` in place (NaN gap markers stay NaN).
 void Convert(const UnitConversion& conversion, std::vector<double>* values);
 
+// The import report's line for a channel's conversion: "theta: deg -> rad (x 0.0174533)", with
+// "+ offset" where there is one.
+std::string DescribeConversion(const std::string& channel, const std::string& from,
+                               const std::string& to, const UnitConversion& conversion);
+
 }  // namespace mbid::records::internal

@@ -8,6 +8,8 @@
 #include <map>
 #include <memory>
 
+#include "mbid/identification/release.h"
+
 namespace mbid::validation {
 namespace {
 
@@ -72,16 +74,8 @@ bool Usable(const updating::UpdateResult& fit) {
 }  // namespace
 
 Measurement MoveRelease(const Measurement& record, double delta_s) {
-  Measurement moved = record;
-  moved.start_time_s = record.start_time_s - delta_s;
-  const double tau = record.sample_interval_s;
-  Eigen::Index skip = 0;
-  while (moved.start_time_s < -1e-9 * tau && skip + 2 < record.values.rows()) {
-    moved.start_time_s += tau;
-    ++skip;
-  }
-  if (skip > 0) moved.values = record.values.bottomRows(record.values.rows() - skip).eval();
-  return moved;
+  // The record's times are from the release: a release delta_s later is a cut at delta_s.
+  return identification::CutAtRelease(record, delta_s, record.source);
 }
 
 std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& model,
@@ -89,7 +83,13 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
                                                const updating::UpdateOptions& options,
                                                updating::UpdateResult* best) {
   std::vector<std::string> lines;
-  if (best->termination == updating::UpdateResult::Termination::kFailure) return lines;
+  std::vector<size_t> detected;
+  for (size_t t = 0; t < records->size(); ++t) {
+    if ((*records)[t].release_detected) detected.push_back(t);
+  }
+  if (detected.empty() || best->termination == updating::UpdateResult::Termination::kFailure) {
+    return lines;
+  }
   // The weights the best fit used, kept for every fit of the profile: costs must compare.
   for (size_t t = 0; t < records->size() && t < best->tests.size(); ++t) {
     const updating::TestFit& fit = best->tests[t];
@@ -97,11 +97,6 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
       (*records)[t].noise_std[fit.channels[c]] = fit.noise_std[static_cast<Eigen::Index>(c)];
     }
   }
-  std::vector<size_t> detected;
-  for (size_t t = 0; t < records->size(); ++t) {
-    if ((*records)[t].release_detected) detected.push_back(t);
-  }
-  if (detected.empty()) return lines;
   std::vector<Measurement> as_detected;
   for (size_t t : detected) as_detected.push_back((*records)[t].record);
   std::vector<double> shift(detected.size(), 0.0), sigma(detected.size(), NAN);

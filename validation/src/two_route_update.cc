@@ -116,12 +116,17 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
   if (algebraic != nullptr) {
     updating::MarkAlgebraicAmbiguity(*algebraic, search.best, 0.1, search.judged_starts);
   }
-  // A release found in a record is placed by the fit too (release_profile.h).
-  std::vector<updating::TestRecord> placed = records;
-  PlaceDetectedReleases(model, &placed, settings.options, &search.best);
+  // A release found in a record is placed by the fit too (release_profile.h); records cut
+  // elsewhere are fitted as they are, without a copy.
+  std::vector<updating::TestRecord> placed;
+  if (std::any_of(records.begin(), records.end(),
+                  [](const updating::TestRecord& r) { return r.release_detected; })) {
+    placed = records;
+    PlaceDetectedReleases(model, &placed, settings.options, &search.best);
+  }
   if (settings.profile.enabled) {
-    updating::ProfileLikelihood(model, placed, settings.options, settings.profile, search.best,
-                                say);
+    updating::ProfileLikelihood(model, placed.empty() ? records : placed, settings.options,
+                                settings.profile, search.best, say);
   }
   return search;
 }
