@@ -99,7 +99,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   const identification::IdentificationOptions identification_options = scenario.identification;
 
   // Every record is read and checked before any long work starts.
-  const std::vector<LoadedTest> tests =
+  std::vector<LoadedTest> tests =
       LoadTests(data_paths, scenario, *model, identification_options, common.import, !common.quiet);
 
   const RecordedUpdate update =
@@ -111,6 +111,10 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   const std::string& note = update.note;
   const updating::GlobalSearchResult& search = update.search;
   const updating::UpdateResult& result = search.best;
+  // A detected release is reported where the fit placed it.
+  for (size_t i = 0; i < tests.size() && i < result.tests.size(); ++i) {
+    tests[i].release.Place(result.tests[i]);
+  }
 
   const bool converged = result.termination == updating::UpdateResult::Termination::kConverged;
   nlohmann::json summary = updating::UpdateResultToJson(result, algebraic.get());
@@ -147,6 +151,15 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
       files.push_back(tests[i].path);
     }
     file.WriteVector("/release", "release_time_s", release_s, "s");
+    // Where a detected release was before the fit placed it (NaN: not placed).
+    Eigen::VectorXd detected_s(release_s.size());
+    for (size_t i = 0; i < tests.size(); ++i) {
+      detected_s(static_cast<Eigen::Index>(i)) =
+          tests[i].release.detected_time_s.value_or(std::nan(""));
+    }
+    if (detected_s.array().isFinite().any()) {
+      file.WriteVector("/release", "detected_release_time_s", detected_s, "s");
+    }
     file.WriteStrings("/release", "release", how);
     file.WriteStrings("/release", "file", files);
     file.Commit();

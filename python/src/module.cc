@@ -6,6 +6,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -41,21 +42,35 @@ py::dict Units(const mbid::Measurement& m) {
 
 // identify_arrays: a uniformly sampled record from a time array and named channel arrays.
 mbid::Measurement MakeRecord(
-    py::array_t<double, py::array::c_style | py::array::forcecast> time,
+    const py::object& time_object,
     const std::map<std::string, py::array_t<double, py::array::c_style | py::array::forcecast>>&
         channels,
     const std::map<std::string, std::string>& units) {
-  if (time.ndim() != 1) {
+  const py::array given = py::array::ensure(time_object);
+  if (!given) {
+    throw mbid::InputError("identify_arrays", "time", "not an array",
+                           "a one-dimensional array of times in s");
+  }
+  using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  const Doubles time = Doubles::ensure(given);
+  if (!time || time.ndim() != 1) {
     throw mbid::InputError("identify_arrays", "time",
                            "an array of dimension " + std::to_string(time.ndim()),
                            "a one-dimensional array of times in s");
   }
   const Eigen::Index n = time.shape(0);
   const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(time.data(), n);
+  // Single (or half) precision times are rounded to their last bit, as a printed column is to
+  // its last digit: a 10 kHz float32 clock at 100 s is off the grid by up to 4 us.
+  double resolution_s = 0;
+  if (given.dtype().kind() == 'f' && given.itemsize() < 8 && n > 0) {
+    const int digits = given.itemsize() == 4 ? std::numeric_limits<float>::digits : 11;
+    resolution_s = std::ldexp(1.0, std::ilogb(t.cwiseAbs().maxCoeff()) + 1 - digits);
+  }
   mbid::Measurement m;
   m.sample_interval_s = mbid::CheckUniformTime(
-      t, "identify_arrays", [](Eigen::Index j) { return "time[" + std::to_string(j) + "]"; }, 0.0,
-      &m.start_time_s);
+      t, "identify_arrays", [](Eigen::Index j) { return "time[" + std::to_string(j) + "]"; },
+      resolution_s, &m.start_time_s);
   if (channels.empty()) {
     throw mbid::InputError("identify_arrays", "channels", "no channel",
                            "a dict {name: array} with at least one channel");
@@ -236,6 +251,7 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readonly("channels", &mbid::ModalResult::channels)
       .def_readonly("release_time_s", &mbid::ModalResult::release_time_s)
       .def_readonly("start_time_s", &mbid::ModalResult::start_time_s)
+      .def_readonly("sample_interval_s", &mbid::ModalResult::sample_interval_s)
       .def_readonly("model_order", &mbid::ModalResult::model_order)
       .def_property_readonly("correlation",
                              [](const mbid::ModalResult& r) { return ToArray(r.correlation); })
@@ -314,7 +330,7 @@ PYBIND11_MODULE(_mbid, m) {
       "scenario of its test, after an impulse or burst from where the forcing ends.");
   m.def(
       "identify_arrays",
-      [](py::array_t<double, py::array::c_style | py::array::forcecast> time,
+      [](const py::object& time,
          const std::map<std::string,
                         py::array_t<double, py::array::c_style | py::array::forcecast>>& channels,
          const std::map<std::string, std::string>& units, const IdentificationOptions& options) {

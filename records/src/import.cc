@@ -231,7 +231,20 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
   }
   std::string unit = user_time_unit.empty() ? table.time_unit : user_time_unit;
   // mbid's contract: a column named `time` without a unit is in seconds.
-  if (unit.empty() && (table.time_name == "time" || table.si_by_contract)) unit = "s";
+  const bool seconds_by_contract =
+      unit.empty() && (table.time_name == "time" || table.si_by_contract);
+  if (seconds_by_contract) unit = "s";
+  // A logger's `time` in ms read as s makes every frequency 1000 times too low: a step of
+  // 0.1 s or more (10 Hz or slower, where a ms clock of 10 kHz or slower lands) is said.
+  const auto say_if_slow = [&] {
+    if (!seconds_by_contract || !(m->sample_interval_s >= 0.1)) return;
+    report->warnings.push_back(fmt::format(
+        "the time column '{}' has no unit and is read in s, as mbid's contract says: a step of "
+        "{:g} s ({:.3g} Hz); if it is in ms, write '{} [ms]' or '{}_ms', or `time_unit: ms` in "
+        "the scenario's record entry",
+        table.time_name, m->sample_interval_s, 1 / m->sample_interval_s, table.time_name,
+        table.time_name));
+  };
   const std::string field = table.time_name.empty()
                                 ? table.time_where
                                 : Describe({table.time_name, "", table.time_where, {}, {}});
@@ -267,6 +280,7 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
           0.5 * resolution / (m->sample_interval_s * m->sample_interval_s), *rate));
       m->sample_interval_s = 1 / *rate;
     }
+    say_if_slow();
     return;
   }
   Eigen::VectorXd time(static_cast<Eigen::Index>(table.time.size()));
@@ -306,6 +320,7 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
                                  options.sample_rate_hz, tau),
                      "no sample rate for files with a time column, or the rate of that column");
   }
+  say_if_slow();
 }
 
 // Gaps in the kept columns: refused naming the first, or filled (counted in the report).

@@ -44,6 +44,11 @@ void WriteTestGroups(H5Writer& run, const RunTest& test, const std::string& root
     // Where the record was cut: the release in the file's own time, t = 0 of the test.
     run.WriteScalar(root + "/release", "release_time_s", test.release->release_time_s, "s");
     run.WriteStringAttribute(root + "/release", "release", test.release->how);
+    if (test.release->detected_time_s) {
+      run.WriteScalar(root + "/release", "detected_release_time_s", *test.release->detected_time_s,
+                      "s");
+      run.WriteScalar(root + "/release", "release_std_s", *test.release->std_s, "s");
+    }
   }
   identification::WriteModalResult(run, test.identified, root + "/identification");
   updating::WriteUpdatingGroup(run, test.tuned, test.algebraic.get(), root + "/updating");

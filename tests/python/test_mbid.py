@@ -231,6 +231,22 @@ class ErrorTest(unittest.TestCase):
             mbid.identify_arrays(t, {"x": np.ones(5)})
         self.assertIn("time[", str(raised.exception))
 
+    def test_single_precision_times_are_read_to_their_last_bit(self):
+        # A logger's float32 clock: 20 s at 1 kHz is off the grid by up to half a float32 ulp
+        # of 20 (1 us, a thousandth of the step; 7e-7 relative to the step in the worst sample,
+        # which the double-precision test would refuse). The 2 Hz decay comes back as with
+        # exact times, and a dropped sample is still found.
+        t64 = np.arange(20000) * 0.001
+        y = np.exp(-0.3 * t64) * np.cos(2 * np.pi * 2.0 * t64)
+        t32 = t64.astype(np.float32)
+        result = mbid.identify_arrays(t32, {"x": y}, {"x": "m"})
+        self.assertAlmostEqual(result.modes[0].frequency_hz, 2.0, delta=1e-5)
+        self.assertAlmostEqual(result.sample_interval_s, 0.001, delta=1e-9)
+        dropped = np.delete(t32, 5000)
+        with self.assertRaises(mbid.InputError) as raised:
+            mbid.identify_arrays(dropped, {"x": np.delete(y, 5000)})
+        self.assertIn("time[5000]", str(raised.exception))
+
     def test_a_channel_of_the_wrong_length_is_refused(self):
         with self.assertRaises(mbid.InputError) as raised:
             mbid.identify_arrays(np.arange(10) * 0.1, {"x": np.ones(9)})

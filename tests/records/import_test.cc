@@ -159,6 +159,37 @@ TEST(ImportTest, UnitsFromOptionsAndTimeSuffix) {
   ExpectChannel(ImportMeasurement(path, by_number), 0, x, 1e-3);
 }
 
+// A column named `time` without a unit is in s (the contract), so a logger's ms clock is read
+// 1000 times too slow: said beside the import when its step is 0.1 s or more; a 100 Hz record
+// in s is not.
+TEST(ImportTest, AUnitlessTimeColumnSlowerThanTenHertzIsSaidToMaybeBeMilliseconds) {
+  TempDir dir;
+  const std::string ms = dir.File("ms.csv");
+  WriteText(ms, MakeExport("time,x [m]\n", 101, [&](int j) {  // 1 kHz in ms: steps of 1
+              return fmt::format("{},{}", j, Print(std::cos(0.1 * j)));
+            }));
+  ImportReport report;
+  const Measurement m = ImportMeasurement(ms, {}, &report);
+  EXPECT_EQ(m.sample_interval_s, 1.0);  // as the contract reads it
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_THAT(report.warnings[0], HasSubstr("if it is in ms, write 'time [ms]'"));
+  const std::string s = dir.File("s.csv");
+  WriteText(s, MakeExport("time,x [m]\n", 101, [&](int j) {  // 100 Hz in s
+              return fmt::format("{},{}", Print(0.01 * j), Print(std::cos(0.1 * j)));
+            }));
+  ImportReport seconds;
+  ImportMeasurement(s, {}, &seconds);
+  EXPECT_TRUE(seconds.warnings.empty());
+  // Stated, the unit is not doubted.
+  const std::string stated = dir.File("stated.csv");
+  WriteText(stated, MakeExport("time [s],x [m]\n", 101, [&](int j) {
+              return fmt::format("{},{}", j, Print(std::cos(0.1 * j)));
+            }));
+  ImportReport given;
+  ImportMeasurement(stated, {}, &given);
+  EXPECT_TRUE(given.warnings.empty());
+}
+
 TEST(ImportTest, ChannelMappingByNameAndNumberWithModelTargets) {
   TempDir dir;
   const std::string path = dir.File("map.csv");

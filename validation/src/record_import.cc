@@ -90,6 +90,7 @@ std::string DescribeImport(const records::ImportReport& report) {
     parts.push_back(fmt::format("{} gap sample{} filled linearly", report.filled_samples,
                                 report.filled_samples == 1 ? "" : "s"));
   }
+  for (const std::string& warning : report.warnings) parts.push_back("WARNING: " + warning);
   return fmt::format("{}", fmt::join(parts, ", "));
 }
 
@@ -100,6 +101,7 @@ nlohmann::json ImportReportToJson(const records::ImportReport& report) {
   json["mapping"] = report.mapping;
   json["conversions"] = report.conversions;
   json["filled_samples"] = report.filled_samples;
+  if (!report.warnings.empty()) json["warnings"] = report.warnings;
   return json;
 }
 

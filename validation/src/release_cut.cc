@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "mbid/common/clipping.h"
 #include "mbid/common/error.h"
 #include "mbid/identification/identify.h"
@@ -29,7 +31,16 @@ ReleaseChoice OverrideRelease(const ReleaseChoice& entry, const ImportOverrides&
 nlohmann::json AppliedRelease::ToJson() const {
   nlohmann::json json = {{"release_time_s", release_time_s}, {"release", how}};
   if (clipped_until_s) json["clipped_until_s"] = *clipped_until_s;
+  if (detected_time_s) json["detected_release_time_s"] = *detected_time_s;
+  if (std_s) json["release_std_s"] = *std_s;
   return json;
+}
+
+void AppliedRelease::Place(const updating::TestFit& fit) {
+  if (how != "detected" || !std::isfinite(fit.release_shift_std_s)) return;
+  if (!detected_time_s) detected_time_s = release_time_s;
+  release_time_s = *detected_time_s + fit.release_shift_s;
+  std_s = fit.release_shift_std_s;
 }
 
 std::string AppliedRelease::DescribeClipped() const {

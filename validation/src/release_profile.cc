@@ -186,6 +186,10 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
   }
   for (size_t i = 0; i < detected.size(); ++i) {
     const std::string& name = (*records)[detected[i]].name;
+    if (detected[i] < best->tests.size() && placed[i]) {
+      best->tests[detected[i]].release_shift_s = shift[i];
+      best->tests[detected[i]].release_shift_std_s = sigma[i];
+    }
     if (!placed[i]) {
       lines.push_back(fmt::format(
           "{}: the fit does not place the release (its cost has no least point near the "

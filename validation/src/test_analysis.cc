@@ -85,6 +85,7 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
   test.search = TuneModel(model, {record}, updating, test.algebraic.get(), &start, &start_note,
                           [&say](const std::string& line) { say(line); });
   test.tuned = test.search.best;
+  if (test.release && !test.tuned.tests.empty()) test.release->Place(test.tuned.tests.front());
   test.start_note = start == "route1" ? "Route 1 (eq. 7)" : "the scenario's values";
   if (!test.search.minima.empty() && test.search.minima.front().starts.front() != start) {
     test.start_note += "; best minimum from " + test.search.minima.front().starts.front();

@@ -40,6 +40,9 @@ struct ImportReport {
   std::vector<std::string> mapping;      // e.g. "psi <- column 3 (Boom angle)"
   int filled_samples = 0;                // cells interpolated by GapFill::kLinear
   std::vector<std::string> conversions;  // e.g. "theta: deg -> rad (x 0.0174533)"
+  // What the file does not say and may have been misread: a column named `time` without a unit
+  // is in seconds by the contract, and a step of 0.1 s or more is then more likely ms.
+  std::vector<std::string> warnings;
 };
 
 // Reads any supported file (chosen by its extension and contents), converts it to SI and

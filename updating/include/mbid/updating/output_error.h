@@ -196,6 +196,11 @@ struct TestFit {
   // whiteness_lags lags, its p-value (chi-square), and the integrated autocorrelation time
   // 1 + 2 sum rho_k (1 for white noise; how many samples one independent one is worth).
   Eigen::VectorXd whiteness_q, whiteness_p, correlation_time;
+  // A release found in the record (TestRecord::release_detected) is placed by the fit
+  // (validation/release_profile.h): how much later than the cut it put the release (s), and that
+  // instant's standard deviation; NaN when the fit did not place it.
+  double release_shift_s = 0;
+  double release_shift_std_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct UpdateResult {

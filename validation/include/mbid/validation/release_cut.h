@@ -10,6 +10,7 @@
 #include "mbid/common/measurement.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/simulation/excitation.h"
+#include "mbid/updating/output_error.h"
 #include "mbid/validation/record_import.h"
 
 namespace mbid::validation {
@@ -36,6 +37,12 @@ struct AppliedRelease {
   // clipped one, this many seconds after the release; `clipped` says which channel and how.
   std::optional<double> clipped_until_s;
   std::string clipped;
+  // A detected release the fit placed (Place): the instant as detected, and the placed one's
+  // standard deviation; release_time_s is then the placed instant.
+  std::optional<double> detected_time_s;
+  std::optional<double> std_s;
+  // Takes the fit's placement of a detected release (TestFit::release_shift_s) when it made one.
+  void Place(const updating::TestFit& fit);
   nlohmann::json ToJson() const;
   // "<clipped>; the test is analysed from t = 0.55 s, after its last clipped sample", or "".
   std::string DescribeClipped() const;

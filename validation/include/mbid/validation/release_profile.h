@@ -16,7 +16,8 @@ namespace mbid::validation {
 // tests as they are); the parabola's least point (at most two samples on, twice) is where the
 // test's record is moved, and `best` is refitted there. Its curvature gives the instant's
 // standard deviation, and each shared parameter's std gains what that uncertainty moves it by
-// (the two fits' slope times it). `records` are moved in place; returns one line per test.
+// (the two fits' slope times it). `records` are moved in place; each placed test's shift and
+// its std go to best->tests[t] (TestFit::release_shift_s); returns one line per test.
 std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& model,
                                                std::vector<updating::TestRecord>* records,
                                                const updating::UpdateOptions& options,
