@@ -23,6 +23,7 @@
 #include "mbid/updating/structure.h"
 #include "mbid/validation/loaded_test.h"
 #include "mbid/validation/recorded_tests.h"
+#include "mbid/validation/release_profile.h"
 #include "mbid/validation/scenario.h"
 #include "mbid/validation/two_route_update.h"
 
@@ -104,7 +105,7 @@ int RunStructureCommand(const std::string& scenario_path,
 
   const updating::UpdatingSettings& settings = scenario.updating;
   const identification::IdentificationOptions identification_options = scenario.identification;
-  const std::vector<LoadedTest> tests =
+  std::vector<LoadedTest> tests =
       LoadTests(data_paths, scenario, *model, identification_options, common.import, !common.quiet);
   const std::vector<updating::TestRecord> records = MakeWeightedRecords(tests, settings);
 
@@ -164,7 +165,14 @@ int RunStructureCommand(const std::string& scenario_path,
   options.reference_starts = full.starts;
   options.reference_start = full.start;
   options.quiet = common.quiet;
+  // Detected releases are placed by the full model's fit, as `mbid update` places them; every
+  // candidate is fitted to the placed records.
+  options.after_reference = validation::PlaceDetectedReleases;
   const updating::StructureRanking ranking = updating::RankStructures(candidates, records, options);
+  const updating::UpdateResult& reference = ranking.reference_search.best;
+  for (size_t i = 0; i < tests.size() && i < reference.tests.size(); ++i) {
+    tests[i].release.Place(reference.tests[i]);
+  }
 
   nlohmann::json summary = StructureRankingToJson(ranking, data_paths);
   summary["max_rigid"] = max_rigid;

@@ -195,6 +195,21 @@ TEST_F(RunRecordsTest, AFinelySampledRecordHasItsReleasePlacedByTheFit) {
   EXPECT_GT(std_s, 0);
   EXPECT_NEAR(placed, 0.5, 4 * std_s);
   EXPECT_NE(release["detected_release_time_s"].get<double>(), placed);
+
+  // `mbid structure` places the release with the full model's fit before ranking: the full
+  // model's cost is then the noise's, chi^2 / 2 = N / 2 within 4 of its std sqrt(N / 2)
+  // (N = 2 channels x the placed record's samples).
+  const CommandResult ranked =
+      Run("structure " + base.string() + " " + (dir_ / "field.csv").string() +
+          " --max-rigid 0 --json " + (dir_ / "structure.json").string());
+  ASSERT_EQ(ranked.exit_code, 0) << ranked.err;
+  EXPECT_NE(ranked.err.find("the fit places the release"), std::string::npos) << ranked.err;
+  const nlohmann::json structure = nlohmann::json::parse(ReadText(dir_ / "structure.json"));
+  const nlohmann::json& full = structure["structures"][0];
+  const double n = full["residual_count"].get<double>();
+  EXPECT_NEAR(full["cost"].get<double>(), n / 2, 4 * std::sqrt(n / 2));
+  EXPECT_NEAR(structure["release"][0]["release_time_s"].get<double>(), 0.5,
+              4 * structure["release"][0]["release_std_s"].get<double>());
 }
 
 // A field record as a logger keeps it: one second at rest at the deflection before the release,

@@ -201,9 +201,19 @@ StructureRanking RankStructures(const std::vector<StructureCandidate>& candidate
                      "records of the scenario model's outputs or coordinates");
   }
   StructureRanking ranking;
+  const UpdateOptions reference_options = PrepareOptions(candidates[0], nullptr);
   ranking.reference_search =
-      SearchGlobally(*candidates[0].model, tests, PrepareOptions(candidates[0], nullptr),
-                     options.reference_start, options.reference_starts, options.search);
+      SearchGlobally(*candidates[0].model, tests, reference_options, options.reference_start,
+                     options.reference_starts, options.search);
+  std::vector<TestRecord> weighed = tests;
+  if (options.after_reference &&
+      ranking.reference_search.best.termination != UpdateResult::Termination::kFailure) {
+    for (const std::string& line : options.after_reference(
+             *candidates[0].model, &weighed, reference_options, &ranking.reference_search.best)) {
+      report(line);
+    }
+    for (StructureFit& fit : fits) fit.residual_count = CountResiduals(weighed);
+  }
   fits[0].fit = ranking.reference_search.best;
   report(fmt::format("structure {}: {} after {} iterations, cost {:.6g}", fits[0].name,
                      fits[0].fit.termination_name(), fits[0].fit.iterations,
@@ -214,7 +224,6 @@ StructureRanking RankStructures(const std::vector<StructureCandidate>& candidate
                          "the fit of " + fits[0].name +
                              " (whose noise weighs every candidate) failed: " + reference.message);
   }
-  std::vector<TestRecord> weighed = tests;
   for (size_t t = 0; t < tests.size(); ++t) {
     const TestFit& fit = reference.tests[t];
     for (size_t c = 0; c < fit.channels.size(); ++c) {

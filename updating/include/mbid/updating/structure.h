@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -66,6 +67,13 @@ struct StructureOptions {
   // primary start's label ("route1", "scenario").
   std::vector<SearchStart> reference_starts;
   std::string reference_start = "start";
+  // Called with the reference's fit before the others start from it: may move the records and
+  // refit the reference to them (`mbid structure` places detected releases so,
+  // validation/release_profile.h); every candidate is then fitted to the moved records. Returns
+  // lines for the progress output.
+  std::function<std::vector<std::string>(const model::MechanicalModel&, std::vector<TestRecord>*,
+                                         const UpdateOptions&, UpdateResult*)>
+      after_reference;
 };
 
 struct StructureFit {
