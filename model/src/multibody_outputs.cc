@@ -1,6 +1,8 @@
 // The sensor outputs of a state: positions from the described kinematics, rates from Simbody.
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -10,13 +12,13 @@
 
 namespace mbid::model {
 
-Eigen::VectorXd MultibodyModel::CalcOutputs(const SimTK::State& state) const {
+Eigen::VectorXd MultibodyModel::CalcOutputs(const SimTK::State& state, int max_order) const {
   const Impl& m = *impl_;
   const SimTK::Vector& q_simtk = state.getQ();
   Eigen::VectorXd q(q_simtk.size());
   for (int i = 0; i < q_simtk.size(); ++i) q[i] = q_simtk[i];
   // Positions from the description's kinematics; rates from Simbody, realized as far as needed.
-  const int highest_order = m.highest_output_order;
+  const int highest_order = std::min(m.highest_output_order, max_order);
   const std::vector<Impl::Pose> poses = m.CalcPoses(q, m.pose_count);
   if (highest_order > 0) {
     m.system.realize(state,
@@ -25,6 +27,10 @@ Eigen::VectorXd MultibodyModel::CalcOutputs(const SimTK::State& state) const {
   Eigen::VectorXd y(static_cast<Eigen::Index>(m.outputs.size()));
   for (size_t i = 0; i < m.outputs.size(); ++i) {
     const Impl::Output& output = m.outputs[i];
+    if (m.output_orders[i] > highest_order) {
+      y[static_cast<Eigen::Index>(i)] = std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
     double value = 0;
     switch (output.type) {
       case OutputType::kCoordinate:

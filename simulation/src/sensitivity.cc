@@ -72,7 +72,7 @@ void CalcOutputJacobians(const model::MechanicalModel& simulated, const SimTK::S
       } else {
         scratch->updU()[i - n] += sign * kOutputStep_rad;
       }
-      const Eigen::VectorXd y_step = simulated.CalcOutputs(*scratch);
+      const Eigen::VectorXd y_step = simulated.CalcOutputs(*scratch, highest_order);
       if (sign > 0) {
         dy_dY->col(i) = y_step;
       } else {
@@ -87,9 +87,9 @@ void CalcOutputJacobians(const model::MechanicalModel& simulated, const SimTK::S
   for (int k = 0; k < static_cast<int>(model_parameters.size()); ++k) {
     const double step = 1e-6 * scale[k];
     simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k] + step);
-    const Eigen::VectorXd up = simulated.CalcOutputs(*scratch);
+    const Eigen::VectorXd up = simulated.CalcOutputs(*scratch, highest_order);
     simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k] - step);
-    dy_dp->col(k) = (up - simulated.CalcOutputs(*scratch)) / (2 * step);
+    dy_dp->col(k) = (up - simulated.CalcOutputs(*scratch, highest_order)) / (2 * step);
     simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k]);
   }
 }
@@ -128,9 +128,9 @@ void CalcDirectionalOutputDerivatives(const model::MechanicalModel& simulated,
         simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k] + sign * h);
       }
       if (sign > 0) {
-        plus = simulated.CalcOutputs(*scratch);
+        plus = simulated.CalcOutputs(*scratch, highest_order);
       } else {
-        dy_dtheta->col(k) = (plus - simulated.CalcOutputs(*scratch)) / (2 * h);
+        dy_dtheta->col(k) = (plus - simulated.CalcOutputs(*scratch, highest_order)) / (2 * h);
       }
     }
     if (moves_parameter) simulated.ApplyParameterToState(*scratch, model_parameters[k], p[k]);
@@ -250,12 +250,7 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   // Position outputs depend on q alone; rate outputs (velocities, accelerations) also on u and
   // the time, and accelerations on the parameters through the forces. A scratch state of the
   // same system, carrying the nominal parameters, serves for the output Jacobians.
-  const std::vector<int> orders = simulated.output_derivative_orders();
-  int highest_order = 0;
-  for (const ChannelSource& source : sources) {
-    if (source.is_output)
-      highest_order = std::max(highest_order, orders[static_cast<size_t>(source.index)]);
-  }
+  const int highest_order = internal::HighestOrderRead(simulated, sources);
   const int jacobian_columns = highest_order > 0 ? 2 * n : n;
   SimTK::State scratch = simulated.MakeState(result.initial_q, zero);
   Eigen::MatrixXd dy_dY(simulated.output_count(), jacobian_columns);
@@ -282,7 +277,7 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
         t == 0 ? integrator.state() : integrator.AdvanceTo(t, CvodesIntegrator::Realization::kNone);
     const int j = row - grid.skipped;
     if (j < 0) continue;  // visited for the same steps as a record from t = 0
-    const Eigen::VectorXd y = simulated.CalcOutputs(state);
+    const Eigen::VectorXd y = simulated.CalcOutputs(state, highest_order);
     Eigen::VectorXd q(n);
     for (int i = 0; i < n; ++i) q[i] = state.getQ()[i];
     const Eigen::MatrixXd& s = integrator.sensitivities();

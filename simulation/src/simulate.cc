@@ -24,6 +24,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   }
   const std::vector<internal::ChannelSource> sources =
       internal::ResolveChannels(model, sensors.channels);
+  const int highest_order = internal::HighestOrderRead(model, sources);
   const double tau = sensors.sample_interval_s();
   const internal::SampleGrid grid = internal::MakeSampleGrid(options.duration_s, sensors);
 
@@ -71,7 +72,7 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
     const SimTK::State& state = t == 0 ? integrator.state() : integrator.AdvanceTo(t, kUnrealized);
     const int j = i - grid.skipped;
     if (j < 0) continue;
-    const Eigen::VectorXd y = simulated.CalcOutputs(state);
+    const Eigen::VectorXd y = simulated.CalcOutputs(state, highest_order);
     for (size_t c = 0; c < sources.size(); ++c) {
       exact.values(j, static_cast<Eigen::Index>(c)) =
           sources[c].is_output ? y[sources[c].index] : state.getQ()[sources[c].index];

@@ -54,6 +54,16 @@ std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
   return sources;
 }
 
+int HighestOrderRead(const model::MechanicalModel& model,
+                     const std::vector<ChannelSource>& sources) {
+  const std::vector<int> orders = model.output_derivative_orders();
+  int highest = 0;
+  for (const ChannelSource& source : sources) {
+    if (source.is_output) highest = std::max(highest, orders[static_cast<size_t>(source.index)]);
+  }
+  return highest;
+}
+
 std::unique_ptr<model::MechanicalModel> MakeForcedModel(const model::MechanicalModel& model,
                                                         const Excitation& excitation) {
   if (!(excitation.CalcForcingEndTime() > 0)) return nullptr;

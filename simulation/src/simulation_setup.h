@@ -23,6 +23,10 @@ struct ChannelSource {
 // Throws InputError for a channel that is neither an output nor a coordinate of `model`.
 std::vector<ChannelSource> ResolveChannels(const model::MechanicalModel& model,
                                            const std::vector<std::string>& channels);
+// The highest derivative order of the outputs `sources` read (0 positions, 1 rates, 2
+// accelerations): how far CalcOutputs must go for them.
+int HighestOrderRead(const model::MechanicalModel& model,
+                     const std::vector<ChannelSource>& sources);
 
 // A clone of `model` carrying the excitation's time-dependent load, or null for a free decay:
 // the caller's model stays unchanged.

@@ -378,6 +378,20 @@ TEST(MultibodyModelTest, EnergyConservedAndRatesAreDerivatives) {
       (-y[0][2] + 16 * y[1][2] - 30 * y[2][2] + 16 * y[3][2] - y[4][2]) / (12 * h * h);
   EXPECT_NEAR(r[4], velocity, 1e-5 * std::abs(velocity));
   EXPECT_NEAR(r[5], acceleration, 1e-5 * std::abs(acceleration));
+  // Up to an order: the outputs of that order or lower are the same bits, the others NaN (not
+  // computed: a record of angles needs no forward dynamics).
+  const std::vector<int> orders = rates->output_derivative_orders();
+  ASSERT_EQ(orders[5], 2);
+  for (int max_order : {0, 1}) {
+    const Eigen::VectorXd part = rates->CalcOutputs(at_middle, max_order);
+    for (Eigen::Index i = 0; i < r.size(); ++i) {
+      if (orders[static_cast<size_t>(i)] <= max_order) {
+        EXPECT_EQ(part[i], r[i]) << i;
+      } else {
+        EXPECT_TRUE(std::isnan(part[i])) << i;
+      }
+    }
+  }
 }
 
 // The crane's description against the hand-written TruckCrane class it replaced (removed after

@@ -113,8 +113,11 @@ class MechanicalModel {
                                                   Eigen::VectorXd& generalized_forces)>;
   virtual void SetExternalLoad(ExternalLoadFunction load) = 0;
   // The outputs y (rad) at the state's q and u. The model realizes whatever it needs, so a
-  // state whose Y was just set will do.
-  virtual Eigen::VectorXd CalcOutputs(const SimTK::State& state) const = 0;
+  // state whose Y was just set will do. Outputs of a derivative order above `max_order`
+  // (output_derivative_orders) are NaN and cost nothing: a record of angles alone needs no
+  // forward dynamics for the model's accelerometers.
+  virtual Eigen::VectorXd CalcOutputs(const SimTK::State& state, int max_order) const = 0;
+  Eigen::VectorXd CalcOutputs(const SimTK::State& state) const { return CalcOutputs(state, 2); }
   // Total mechanical energy (J): kinetic + gravity + spring potential.
   virtual double CalcEnergy(const SimTK::State& state) const = 0;
 

@@ -50,7 +50,8 @@ class MultibodyModel final : public MechanicalModel {
   const SimTK::MultibodySystem& system() const override;
   SimTK::State MakeState(const Eigen::VectorXd& q, const Eigen::VectorXd& u) const override;
   void SetExternalLoad(ExternalLoadFunction load) override;
-  Eigen::VectorXd CalcOutputs(const SimTK::State& state) const override;
+  using MechanicalModel::CalcOutputs;
+  Eigen::VectorXd CalcOutputs(const SimTK::State& state, int max_order) const override;
   double CalcEnergy(const SimTK::State& state) const override;
   Eigen::VectorXd SolveStaticEquilibrium(const std::vector<PointLoad>& loads) const override;
   LinearModel Linearize() const override;
