@@ -289,7 +289,9 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readonly("non_unique", &mbid::UpdateResult::non_unique)
       .def_readonly("undetermined", &mbid::UpdateResult::undetermined)
       .def_readonly("start", &mbid::UpdateResult::start)
-      .def_readonly("chi_square_per_dof", &mbid::UpdateResult::chi_square_per_dof);
+      .def_readonly("chi_square_per_dof", &mbid::UpdateResult::chi_square_per_dof)
+      .def_readonly("release_time_s", &mbid::UpdateResult::release_time_s)
+      .def_readonly("release", &mbid::UpdateResult::release);
 
   py::class_<mbid::ValidationResult>(m, "ValidationResult")
       .def_property_readonly(

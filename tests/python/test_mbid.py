@@ -200,6 +200,9 @@ class UpdateAndRunTest(unittest.TestCase):
             self.assertEqual(tuned.parameters[name].value, entry["value"], name)
             self.assertEqual(tuned.parameters[name].std, entry["std"], name)
         self.assertGreater(tuned.parameters["c_alpha"].std, 0.0)
+        # Where the record's free decay starts, as the command reports it.
+        self.assertEqual(tuned.release, [cli["release"][0]["release"]])
+        self.assertEqual(tuned.release_time_s, [cli["release"][0]["release_time_s"]])
         # The scenario does not ask for profile-likelihood intervals: NaN, not a number made up.
         self.assertTrue(math.isnan(tuned.parameters["c_alpha"].profile_lower))
         self.assertFalse(tuned.parameters["c_alpha"].profile_upper_open)

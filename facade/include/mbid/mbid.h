@@ -107,6 +107,10 @@ struct UpdateResult {
   std::vector<std::string> undetermined;  // parameters the records leave open
   std::string start;                      // where the best minimum was reached from
   double chi_square_per_dof = 0;
+  // Per record, where its free decay starts in its own time and how that was found ("detected",
+  // "record start", "none", ...): a detected release where the fit placed it.
+  std::vector<double> release_time_s;
+  std::vector<std::string> release;
   updating::UpdateResult fit;           // the best minimum in full (covariance, history, fits)
   updating::GlobalSearchResult search;  // every minimum the search found
 };
