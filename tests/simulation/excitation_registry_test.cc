@@ -106,6 +106,19 @@ TEST(ExcitationRegistryTest, ACoordinatesForceIsNamedInItsUnit) {
             "excitation.force_N");
 }
 
+// 7 rad is more than a turn: degrees written as radians, refused naming the key; pi itself (a
+// half turn) is the largest accepted.
+TEST(ExcitationRegistryTest, ADeflectionOfMoreThanHalfATurnIsRefused) {
+  const InputError error = testing::CatchInputError(
+      [] { Read("{type: initial_deflection, deflection_rad: {theta: 7}}"); });
+  EXPECT_EQ(error.field(), "excitation.deflection_rad.theta");
+  EXPECT_NE(std::string(error.what()).find("more than half a turn"), std::string::npos)
+      << error.what();
+  EXPECT_NE(std::string(error.what()).find("7 deg is 0.122173 rad"), std::string::npos)
+      << error.what();
+  EXPECT_NO_THROW(Read("{type: initial_deflection, deflection_rad: {theta: -3.14159}}"));
+}
+
 TEST(ExcitationRegistryTest, UnknownTypeListsTheRegisteredOnes) {
   try {
     Read("{type: initial_deflexion}");

@@ -123,7 +123,9 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
       updating::UpdateResult at_centre = *best, before, after;
       double c0 = cost_at(centre, &at_centre);
       bool ok = std::isfinite(c0);
-      for (int round = 0; ok && round < 2; ++round) {
+      // Two rounds, and more (up to 8: 16 samples) while the step is the clamp's: a release
+      // detected several samples off (a noisy onset at 10 kHz) is followed all the way.
+      for (int round = 0; ok && round < 8; ++round) {
         const double cm = cost_at(centre - h, &before), cp = cost_at(centre + h, &after);
         const double curvature = (cm - 2 * c0 + cp) / (h * h);
         if (!(std::isfinite(curvature) && curvature > 0)) {
@@ -136,6 +138,7 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
         c0 = cost_at(centre, &at_centre);
         ok = std::isfinite(c0);
         if (std::abs(step) < 0.1 * h) break;  // the parabola holds this close: no second round
+        if (round >= 1 && std::abs(step) < 4 * h) break;
       }
       placed[i] = ok;
       if (!ok) {

@@ -1,5 +1,8 @@
 #include "mbid/simulation/excitations/initial_deflection.h"
 
+#include <fmt/format.h>
+
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -35,6 +38,14 @@ InitialDeflection InitialDeflection::Read(const YamlReader& node,
     }
     deflection.ExpectMap(coordinates);
     for (const std::string& coordinate : deflection.Keys()) {
+      const double value = deflection.Double(coordinate);
+      // A deflection of more than half a turn is no test of a structure: degrees written as
+      // radians (7 rad for 7 deg) would otherwise simulate a machine spun round.
+      if (std::string(unit) == "rad" && std::abs(value) > M_PI) {
+        deflection.FailAt(coordinate, fmt::format("{:g} rad, more than half a turn", value),
+                          fmt::format("an angle in rad within +-pi ({:g} deg is {:.6g} rad)", value,
+                                      value * M_PI / 180));
+      }
       excitation.deflection_rad[coordinate] = deflection.Double(coordinate);
     }
   }

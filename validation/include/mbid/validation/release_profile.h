@@ -13,11 +13,12 @@ namespace mbid::validation {
 // than that: half a sample at 2 kHz moved the crane's c_theta by 24 of its standard deviations.
 // So the fit places the release too. For each such test the cost is profiled over the instant:
 // local fits from `best` with the test's samples moved half a sample either way (the other
-// tests as they are); the parabola's least point (at most two samples on, twice) is where the
-// test's record is moved, and `best` is refitted there. Its curvature gives the instant's
-// standard deviation, and each shared parameter's std gains what that uncertainty moves it by
-// (the two fits' slope times it). `records` are moved in place; each placed test's shift and
-// its std go to best->tests[t] (TestFit::release_shift_s); returns one line per test.
+// tests as they are); the parabola's least point (at most two samples on per round; two rounds, up
+// to eight while the step is clamped) is where the test's record is moved, and `best` is refitted
+// there. Its curvature gives the instant's standard deviation, and each shared parameter's std
+// gains what that uncertainty moves it by (the two fits' slope times it). `records` are moved in
+// place; each placed test's shift and its std go to best->tests[t] (TestFit::release_shift_s);
+// returns one line per test.
 std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& model,
                                                std::vector<updating::TestRecord>* records,
                                                const updating::UpdateOptions& options,
