@@ -185,7 +185,7 @@ int RunStructureCommand(const std::string& scenario_path,
   }
   if (!common.json_path.empty()) WriteJson(summary, common.json_path);
   if (file) {
-    file->WriteMeasurement(tests.front().record);
+    file->WriteMeasurement(validation::AsFitted(tests.front().record, reference.tests.front()));
     file->WriteScenarioYaml(scenario.yaml_text);
     WriteStructureGroup(*file, ranking);
     WriteStructureReport(ranking, scenario.name, data_paths, *report);

@@ -21,6 +21,7 @@
 #include "mbid/updating/settings.h"
 #include "mbid/validation/loaded_test.h"
 #include "mbid/validation/recorded_tests.h"
+#include "mbid/validation/release_profile.h"
 #include "mbid/validation/scenario.h"
 
 namespace mbid::app {
@@ -138,7 +139,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   }
   if (converged && !output_path.empty()) {
     H5Writer file(output_path);
-    file.WriteMeasurement(tests.front().record);
+    file.WriteMeasurement(validation::AsFitted(tests.front().record, result.tests.front()));
     file.WriteScenarioYaml(scenario.yaml_text);
     updating::WriteUpdatingGroup(file, result, algebraic.get());
     updating::WriteGlobalSearchGroup(file, search);

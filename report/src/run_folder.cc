@@ -13,6 +13,7 @@
 #include "mbid/report/run_report.h"
 #include "mbid/updating/result_io.h"
 #include "mbid/validation/json_summaries.h"
+#include "mbid/validation/release_profile.h"
 #include "mbid/validation/result_writers.h"
 #include "run_document.h"
 
@@ -39,7 +40,8 @@ nlohmann::json ChannelValues(const std::vector<std::string>& channels, const Eig
 // One test's results in run.h5 under `root` ("" for the top-level groups of the contract).
 void WriteTestGroups(H5Writer& run, const RunTest& test, const std::string& root,
                      double threshold) {
-  run.WriteMeasurement(test.measured, root + "/measurement");
+  run.WriteMeasurement(validation::AsFitted(test.measured, test.tuned.tests.front()),
+                       root + "/measurement");
   if (test.release) {
     // Where the record was cut: the release in the file's own time, t = 0 of the test.
     run.WriteScalar(root + "/release", "release_time_s", test.release->release_time_s, "s");

@@ -174,8 +174,9 @@ TEST_F(RunRecordsTest, AFinelySampledRecordHasItsReleasePlacedByTheFit) {
   const fs::path base = WriteVariant(rate, "base.yaml", "  duration_s: 8", "  duration_s: 2");
   const mbid::Measurement field = FieldRecord(base, 1000, 5);  // 0.5 s at rest at 2 kHz
   mbid::WriteMeasurementCsv(field, (dir_ / "field.csv").string());
-  const CommandResult result = Run("update " + base.string() + " " + (dir_ / "field.csv").string() +
-                                   " --json " + (dir_ / "update.json").string());
+  const CommandResult result =
+      Run("update " + base.string() + " " + (dir_ / "field.csv").string() + " --json " +
+          (dir_ / "update.json").string() + " -o " + (dir_ / "update.h5").string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.err.find("the fit places the release"), std::string::npos) << result.err;
   const nlohmann::json update = nlohmann::json::parse(ReadText(dir_ / "update.json"));
@@ -195,6 +196,11 @@ TEST_F(RunRecordsTest, AFinelySampledRecordHasItsReleasePlacedByTheFit) {
   EXPECT_GT(std_s, 0);
   EXPECT_NEAR(placed, 0.5, 4 * std_s);
   EXPECT_NE(release["detected_release_time_s"].get<double>(), placed);
+  // The stored record is the one fitted, its time from the placed release: its samples fall on
+  // the file's grid (j / 2 kHz) when shifted by the placed instant.
+  const mbid::Measurement stored = mbid::ReadMeasurementH5((dir_ / "update.h5").string());
+  const double on_grid = (stored.start_time_s + placed) / stored.sample_interval_s;
+  EXPECT_NEAR(on_grid, std::round(on_grid), 1e-6);
 
   // `mbid structure` places the release with the full model's fit before ranking: the full
   // model's cost is then the noise's, chi^2 / 2 = N / 2 within 4 of its std sqrt(N / 2)

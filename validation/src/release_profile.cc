@@ -78,6 +78,10 @@ Measurement MoveRelease(const Measurement& record, double delta_s) {
   return identification::CutAtRelease(record, delta_s, record.source);
 }
 
+Measurement AsFitted(const Measurement& cut, const updating::TestFit& fit) {
+  return fit.release_shift_s == 0 ? cut : MoveRelease(cut, fit.release_shift_s);
+}
+
 std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& model,
                                                std::vector<updating::TestRecord>* records,
                                                const updating::UpdateOptions& options,

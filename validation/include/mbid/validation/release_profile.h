@@ -28,4 +28,9 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
 // `delta_s`; samples that would come before the release are left out.
 Measurement MoveRelease(const Measurement& record, double delta_s);
 
+// The record as `fit` used it: `cut` (as cut at its detected release) moved to where the fit
+// placed the release (TestFit::release_shift_s), or `cut` itself. What the outputs store
+// beside the re-simulation, so that both have the same samples.
+Measurement AsFitted(const Measurement& cut, const updating::TestFit& fit);
+
 }  // namespace mbid::validation
