@@ -47,25 +47,37 @@ mbid::Measurement MakeRecord(
         channels,
     const std::map<std::string, std::string>& units) {
   const py::array given = py::array::ensure(time_object);
-  if (!given) {
-    throw mbid::InputError("identify_arrays", "time", "not an array",
+  const char kind = given ? given.dtype().kind() : '?';
+  if (kind != 'f' && kind != 'i' && kind != 'u') {
+    throw mbid::InputError(
+        "identify_arrays", "time",
+        given ? "an array of " + std::string(py::str(given.dtype())) + " values" : "not an array",
+        "a one-dimensional array of times in s (floats or integers)");
+  }
+  if (given.ndim() != 1) {
+    throw mbid::InputError("identify_arrays", "time",
+                           "an array of dimension " + std::to_string(given.ndim()),
                            "a one-dimensional array of times in s");
   }
   using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
   const Doubles time = Doubles::ensure(given);
-  if (!time || time.ndim() != 1) {
-    throw mbid::InputError("identify_arrays", "time",
-                           "an array of dimension " + std::to_string(time.ndim()),
+  if (!time) {
+    throw mbid::InputError("identify_arrays", "time", "not convertible to float64",
                            "a one-dimensional array of times in s");
   }
   const Eigen::Index n = time.shape(0);
   const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(time.data(), n);
-  // Single (or half) precision times are rounded to their last bit, as a printed column is to
-  // its last digit: a 10 kHz float32 clock at 100 s is off the grid by up to 4 us.
+  // Floating-point times are rounded to their last bit, as a printed column is to its last
+  // digit: a 10 kHz float32 clock at 100 s is off the grid by up to 4 us, float64 epoch times
+  // (1.7e9 s) by 0.1 us. Allowed where that is more than the uniformity tolerance leaves.
   double resolution_s = 0;
-  if (given.dtype().kind() == 'f' && given.itemsize() < 8 && n > 0) {
-    const int digits = given.itemsize() == 4 ? std::numeric_limits<float>::digits : 11;
-    resolution_s = std::ldexp(1.0, std::ilogb(t.cwiseAbs().maxCoeff()) + 1 - digits);
+  if (kind == 'f' && n > 1) {
+    const int digits = given.itemsize() == 2   ? 11
+                       : given.itemsize() == 4 ? std::numeric_limits<float>::digits
+                                               : std::numeric_limits<double>::digits;
+    const double last_bit = std::ldexp(1.0, std::ilogb(t.cwiseAbs().maxCoeff()) + 1 - digits);
+    const double step = std::abs(t[n - 1] - t[0]) / static_cast<double>(n - 1);
+    if (last_bit > 0.1 * mbid::kTimeUniformityTolerance * step) resolution_s = last_bit;
   }
   mbid::Measurement m;
   m.sample_interval_s = mbid::CheckUniformTime(

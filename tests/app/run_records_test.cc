@@ -186,7 +186,11 @@ TEST_F(RunRecordsTest, AFinelySampledRecordHasItsReleasePlacedByTheFit) {
   for (const auto& [name, value] : truth) {
     const nlohmann::json& p = update["parameters"][name];
     EXPECT_NEAR(p["value"].get<double>(), value, 4 * p["std"].get<double>()) << name;
+    // The fit at the detected instant was not credible (a structured residual); the placed one
+    // is, and so are its parameters.
+    EXPECT_TRUE(p["determined"].get<bool>()) << name << ": " << p.dump();
   }
+  EXPECT_TRUE(update["credibility"]["credible"].get<bool>()) << update["credibility"].dump();
   // The release is reported where the fit placed it, with its std and the detected instant
   // beside it: the truth is sample 1000, 0.5 s (measured: 0.0065 ms off, std 0.013 samples).
   const nlohmann::json& release = update["release"][0];

@@ -96,11 +96,20 @@ TEST(UpdatingGlueTest, APlacedReleaseKeepsWhatTheSearchLeftUndetermined) {
   updating::UpdateResult best = updating::UpdateModel(*crane.model, {test}, settings.options);
   ASSERT_NE(best.termination, updating::UpdateResult::Termination::kFailure);
   for (updating::ParameterEstimate& p : best.parameters) {
-    if (p.name != "c_gamma") continue;
-    p.determined = false;
-    p.why_undetermined = "the alternative minima differ in it";
+    if (p.name == "c_gamma") {
+      p.determined = false;
+      p.rival_differs = true;
+      p.why_undetermined = "the alternative minima differ in it";
+    } else if (p.name == "d_eta") {
+      // What the credibility check says of a fit at a misplaced release: the placed fit judges
+      // that again from its own residual.
+      p.determined = false;
+      p.why_undetermined =
+          "the fit does not explain the records (a residual above the noise, "
+          "not white)";
+    }
   }
-  best.undetermined.push_back("c_gamma");
+  best.undetermined = {"c_gamma", "d_eta"};
   std::vector<updating::TestRecord> records{test};
   const std::vector<std::string> lines =
       validation::PlaceDetectedReleases(*crane.model, &records, settings.options, &best);
@@ -110,6 +119,9 @@ TEST(UpdatingGlueTest, APlacedReleaseKeepsWhatTheSearchLeftUndetermined) {
   EXPECT_FALSE(best.Find("c_gamma").determined);
   EXPECT_EQ(best.Find("c_gamma").why_undetermined, "the alternative minima differ in it");
   EXPECT_TRUE(best.Find("c_alpha").determined);
+  EXPECT_TRUE(best.Find("d_eta").determined) << best.Find("d_eta").why_undetermined;
+  EXPECT_EQ(std::find(best.undetermined.begin(), best.undetermined.end(), "d_eta"),
+            best.undetermined.end());
   EXPECT_NE(std::find(best.undetermined.begin(), best.undetermined.end(), "c_gamma"),
             best.undetermined.end());
   // Moving the release half a sample later leaves out the sample it puts before the release.

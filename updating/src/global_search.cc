@@ -451,6 +451,7 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     for (ParameterEstimate& p : result.best.parameters) {
       if (differing.count(p.name) == 0) continue;
       p.determined = false;
+      p.rival_differs = true;
       p.why_undetermined = "the alternative minima differ in it";
       if (std::find(result.best.undetermined.begin(), result.best.undetermined.end(), p.name) ==
           result.best.undetermined.end()) {

@@ -411,6 +411,7 @@ std::vector<std::string> MarkAlgebraicAmbiguity(const CharacteristicResult& alge
     for (ParameterEstimate& estimate : result.parameters) {
       if (estimate.name != name) continue;
       estimate.determined = false;
+      estimate.rival_differs = true;
       if (estimate.why_undetermined.empty()) {
         estimate.why_undetermined =
             "Route 1 found another set of joint parameters that reproduces the test's initial "

@@ -33,23 +33,24 @@ updating::UpdateResult FitFrom(const model::MechanicalModel& model,
   return updating::UpdateModel(*clone, tests, options);
 }
 
-// The fit at the placed release, with the judgments made of `judged` kept: parameters the
-// global search or Route 1 left undetermined (alternative minima, ambiguous sets) stay so, and
-// no warning is lost. Credibility is judged from the placed fit's residual.
+// The fit at the placed release, with the judgments made of `judged` from outside its fit kept:
+// parameters the global search or Route 1 left undetermined (alternative minima, ambiguous
+// sets: ParameterEstimate::rival_differs) stay so, and no warning is lost. What the fit judges
+// itself (its std, its credibility from the residual) is the placed fit's: a record cut half a
+// sample off leaves a structured residual that the placed fit no longer has.
 updating::UpdateResult Merge(const updating::UpdateResult& judged,
                              const updating::UpdateResult& placed) {
   updating::UpdateResult merged = placed;
   for (updating::ParameterEstimate& p : merged.parameters) {
     for (const updating::ParameterEstimate& q : judged.parameters) {
-      if (q.name != p.name || q.determined) continue;
+      if (q.name != p.name || !q.rival_differs) continue;
       p.determined = false;
-      if (p.why_undetermined.empty()) p.why_undetermined = q.why_undetermined;
-    }
-  }
-  for (const std::string& name : judged.undetermined) {
-    if (std::find(merged.undetermined.begin(), merged.undetermined.end(), name) ==
-        merged.undetermined.end()) {
-      merged.undetermined.push_back(name);
+      p.rival_differs = true;
+      p.why_undetermined = q.why_undetermined;
+      if (std::find(merged.undetermined.begin(), merged.undetermined.end(), p.name) ==
+          merged.undetermined.end()) {
+        merged.undetermined.push_back(p.name);
+      }
     }
   }
   // Credibility is the fit's own (credibility.cc, judged from its residual): the placed fit's.

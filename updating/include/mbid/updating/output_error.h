@@ -161,6 +161,10 @@ struct ParameterEstimate {
   std::string why_undetermined;  // empty when determined
   // Profile-likelihood interval of a shared parameter, when asked for (profile.h).
   ParameterProfile profile;
+  // Undetermined because another minimum fits as well and differs in it (the global search's
+  // alternatives, a Route-1 set): a judgment from outside this fit, which a refit of the same
+  // minimum (a placed release, validation/release_profile.h) keeps.
+  bool rival_differs = false;
 };
 
 struct IterationRecord {
