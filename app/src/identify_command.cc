@@ -55,6 +55,9 @@ int RunIdentifyCommand(const std::string& data_path,
                              data_path, measurement.samples(), measurement.channel_count(),
                              1.0 / measurement.sample_interval_s,
                              identification::MethodName(options.method));
+  } else {
+    for (const std::string& w : import.warnings)
+      std::cerr << "mbid: warning: " + data_path + ": " + w + "\n";
   }
   const identification::ModalResult result =
       identification::Identify(measurement, options, data_path);
@@ -74,7 +77,7 @@ int RunIdentifyCommand(const std::string& data_path,
   if (file) file->Commit();  // only when everything else succeeded
 
   for (const std::string& warning : result.warnings) {
-    if (!common.quiet) std::cerr << "mbid: warning: " << warning << "\n";
+    std::cerr << "mbid: warning: " << warning << "\n";  // also under --quiet
   }
   // Unreliable results are said even with --quiet: dampers get sized on these numbers.
   for (const std::string& reason : result.reasons) {

@@ -166,7 +166,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     file.Commit();
   }
   for (const std::string& warning : result.warnings) {
-    if (!common.quiet) std::cerr << "mbid: warning: " << warning << "\n";
+    std::cerr << "mbid: warning: " << warning << "\n";  // also under --quiet
   }
   if (common.json_path != "-") PrintSummary(result, algebraic.get(), start, search);
   if (!converged) {

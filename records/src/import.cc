@@ -237,7 +237,10 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
   // A logger's `time` in ms read as s makes every frequency 1000 times too low: a step of
   // 0.1 s or more (10 Hz or slower, where a ms clock of 10 kHz or slower lands) is said.
   const auto say_if_slow = [&] {
-    if (!seconds_by_contract || !(m->sample_interval_s >= 0.1)) return;
+    // (0.1 itself: a fitted step of 0.09999999999999999 s is 0.1 s.)
+    if (!seconds_by_contract || !(m->sample_interval_s * (1 + kTimeUniformityTolerance) >= 0.1)) {
+      return;
+    }
     report->warnings.push_back(fmt::format(
         "the time column '{}' has no unit and is read in s, as mbid's contract says: a step of "
         "{:g} s ({:.3g} Hz); if it is in ms, write '{} [ms]' or '{}_ms', or `time_unit: ms` in "

@@ -135,7 +135,14 @@ int WriteRunReport(const std::string& folder, const Scenario& scenario,
     report << fmt::format("{}: {} samples at {} Hz on channels {}.\n\n", test.origin,
                           test.measured.samples(), 1.0 / test.measured.sample_interval_s,
                           fmt::join(test.measured.channels, ", "));
-    if (test.recorded && test.release) {
+    if (test.recorded && test.release && test.release->detected_time_s) {
+      // The record figure was drawn at identification, before the fit placed the release.
+      report << fmt::format(
+          "The free decay starts at {:.6g} s of the record (detected at {:.6g} s{}, placed by the "
+          "fit, +- {:.2g} ms): that instant is t = 0 of the test.\n\n",
+          test.release->release_time_s, *test.release->detected_time_s,
+          draw ? ", the dashed line on the record figure" : "", 1e3 * *test.release->std_s);
+    } else if (test.recorded && test.release) {
       report << fmt::format(
           "The free decay starts at {:.6g} s of the record ({}): the record is cut there and that "
           "instant is t = 0 of the test{}.\n\n",

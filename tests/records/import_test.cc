@@ -180,6 +180,14 @@ TEST(ImportTest, AUnitlessTimeColumnSlowerThanTenHertzIsSaidToMaybeBeMillisecond
   ImportReport seconds;
   ImportMeasurement(s, {}, &seconds);
   EXPECT_TRUE(seconds.warnings.empty());
+  // A step of 0.1 s itself (fitted as 0.09999999999999999 s) is doubted too.
+  const std::string tenth = dir.File("tenth.csv");
+  WriteText(tenth, MakeExport("time,x [m]\n", 3000, [&](int j) {  // 0 to 299.9 s
+              return fmt::format("{:.10g},{}", 0.1 * j, Print(std::cos(0.1 * j)));
+            }));
+  ImportReport ten_hertz;
+  ImportMeasurement(tenth, {}, &ten_hertz);
+  EXPECT_EQ(ten_hertz.warnings.size(), 1u);
   // Stated, the unit is not doubted.
   const std::string stated = dir.File("stated.csv");
   WriteText(stated, MakeExport("time [s],x [m]\n", 101, [&](int j) {

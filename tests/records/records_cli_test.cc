@@ -121,6 +121,24 @@ TEST_F(RecordsCliTest, IdentifyFillsGapsAndReportsTheImport) {
 // --sample-rate-hz gives a file without a time column its time base, --time-unit overrides the
 // time column's unit: the 1.5 Hz decay comes out at the frequency the stated time base makes of
 // it (x rate / 100 Hz; x 1000 when the logger's ms are read as us).
+// A unitless `time` column in ms (read in s by the contract) is doubted even under --quiet, as
+// every warning is (interfaces.md: --quiet drops progress lines, not warnings); the doubt is in
+// the JSON's import item too.
+TEST_F(RecordsCliTest, AMillisecondClockReadAsSecondsIsDoubtedEvenWhenQuiet) {
+  std::string text = "time,x [m]\n";
+  for (int j = 0; j < 801; ++j) text += fmt::format("{},{:.9g}\n", 10 * j, Decay(j * 0.01));
+  const fs::path data = Write("ms_clock.csv", text);
+  const CommandResult quiet = Run("identify " + data.string() + " -q --json -");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_NE(quiet.err.find("mbid: warning: " + data.string() +
+                           ": the time column 'time' has no "
+                           "unit and is read in s"),
+            std::string::npos)
+      << quiet.err;
+  const nlohmann::json summary = nlohmann::json::parse(quiet.out);
+  ASSERT_EQ(summary["import"]["warnings"].size(), 1u) << summary["import"].dump();
+}
+
 TEST_F(RecordsCliTest, TimeBaseFlagsSetTheSampleRateAndTheTimeUnit) {
   std::string text = "Boom angle;Slew\ndeg;deg\n";
   for (int j = 0; j < 801; ++j) {

@@ -84,7 +84,14 @@ std::vector<LoadedTest> LoadTests(
   std::vector<LoadedTest> tests;
   for (const std::string& path : paths) {
     tests.push_back(LoadTest(path, scenario, model, identification_options, overrides));
-    if (describe) DescribeLoadedTest(tests.back());
+    if (describe) {
+      DescribeLoadedTest(tests.back());
+    } else {
+      // Under --quiet the import's doubts are still said (the progress line carries them).
+      for (const std::string& warning : tests.back().import.warnings) {
+        std::cerr << fmt::format("mbid: warning: {}: {}\n", tests.back().path, warning);
+      }
+    }
   }
   return tests;
 }
