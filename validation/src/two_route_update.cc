@@ -8,6 +8,7 @@
 #include <complex>
 #include <vector>
 
+#include "mbid/updating/credibility.h"
 #include "mbid/validation/release_profile.h"
 
 namespace mbid::validation {
@@ -123,6 +124,9 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
                   [](const updating::TestRecord& r) { return r.release_detected; })) {
     placed = records;
     PlaceDetectedReleases(model, &placed, settings.options, &search.best);
+  }
+  if (search.best.termination != updating::UpdateResult::Termination::kFailure) {
+    updating::MarkUnseenParameters(model, records, search.best);
   }
   if (settings.profile.enabled) {
     updating::ProfileLikelihood(model, placed.empty() ? records : placed, settings.options,

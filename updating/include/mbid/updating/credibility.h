@@ -14,4 +14,15 @@ namespace mbid::updating {
 void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& tests,
                        const UpdateOptions& options);
 
+// Shared parameters the records can tell only through the model's nonlinear coupling: in the
+// tuned model's linearization every mode the parameter moves is invisible in the records'
+// channels (a swing mode of a symmetric arm in its inclinometers). A fit then reads the
+// parameter off a second-order effect near the noise, where the cost is far from the quadratic
+// its standard deviation assumes: an excavator's c_swing came out 27 standard deviations off,
+// "determined". Such parameters are marked undetermined with the reason (and a warning);
+// returns their names.
+std::vector<std::string> MarkUnseenParameters(const model::MechanicalModel& model,
+                                              const std::vector<TestRecord>& tests,
+                                              UpdateResult& result);
+
 }  // namespace mbid::updating
