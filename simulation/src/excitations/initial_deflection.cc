@@ -42,7 +42,7 @@ InitialDeflection InitialDeflection::Read(const YamlReader& node,
       // A deflection of more than half a turn is no test of a structure: degrees written as
       // radians (7 rad for 7 deg) would otherwise simulate a machine spun round.
       if (std::string(unit) == "rad" && std::abs(value) > M_PI) {
-        deflection.FailAt(coordinate, fmt::format("{:g} rad, more than half a turn", value),
+        deflection.FailAt(coordinate, fmt::format("{:.17g} rad, more than half a turn", value),
                           fmt::format("an angle in rad within +-pi ({:g} deg is {:.6g} rad)", value,
                                       value * M_PI / 180));
       }
