@@ -5,6 +5,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <vector>
+
 #include "clipped_start.h"
 #include "combination_tones.h"
 #include "dead_channels.h"
@@ -63,7 +66,18 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   if (detection.detected && detection.from_rest) {
     // The whole decay knows the release better than its first samples (release.h).
     const double onset_s = result.release_time_s;
-    result.release_time_s = RefineReleaseFromModes(result, onset_s);
+    // Each analysed channel's level at rest: the median before the release.
+    std::vector<double> rest_level;
+    for (const std::string& channel : result.channels) {
+      const auto column =
+          std::find(measurement.channels.begin(), measurement.channels.end(), channel) -
+          measurement.channels.begin();
+      std::vector<double> before(detection.rest_samples);
+      for (int j = 0; j < detection.rest_samples; ++j) before[j] = measurement.values(j, column);
+      std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
+      rest_level.push_back(before.empty() ? 0.0 : before[before.size() / 2]);
+    }
+    result.release_time_s = RefineReleaseFromModes(result, onset_s, rest_level);
     if (result.release_time_s != onset_s) {
       // One release for the user: ApplyRelease's line (the first warning) names the refined
       // instant, the onset and where the analysis starts (the first sample after the onset).

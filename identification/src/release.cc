@@ -310,7 +310,8 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   return detection;
 }
 
-double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s) {
+double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s,
+                              const std::vector<double>& rest_level) {
   const double tau = modes.sample_interval_s;
   const size_t channels = modes.channels.size();
   if (modes.modes.empty() || channels == 0 || !(tau > 0)) return coarse_time_s;
@@ -374,6 +375,19 @@ double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s) {
     const double t = centre + (i / 50.0 - 0.5) * 0.5 * tau;
     const double value = velocity_norm(t);
     if (value < best_value) best_value = value, best = t;
+  }
+  // Released from rest, the modes start from the level at rest: where they do not, they miss
+  // part of the motion, and where their velocities vanish together says nothing of the release.
+  for (size_t c = 0; c < channels && c < rest_level.size(); ++c) {
+    const auto k = static_cast<Eigen::Index>(c);
+    const double s = best - modes.start_time_s;
+    double y = modes.offset.size() > k ? modes.offset(k) : 0.0, amplitude = 0;
+    for (const IdentifiedMode& mode : modes.modes) {
+      y += mode.amplitude(k) * std::exp(-mode.decay_rate_per_s * s) *
+           std::cos(2 * M_PI * mode.frequency_hz * s + mode.phase_rad(k));
+      amplitude += std::abs(mode.amplitude(k));
+    }
+    if (std::abs(y - rest_level[c]) > 0.1 * amplitude) return coarse_time_s;
   }
   return best;
 }

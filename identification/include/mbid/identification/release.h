@@ -37,8 +37,13 @@ ReleaseDetection DetectRelease(const Measurement& record);
 // channel's velocity, whichever is longer. Uses the whole record's information instead of the
 // few samples around the onset: on the crane at 1e-5 rad noise, a tenth of a sample at 100 Hz.
 // Where the least sum of squared velocities is at an end of the range or not below a tenth of
-// the largest (the modes miss one that the noise hid), the coarse instant is returned.
-double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s);
+// the largest (the modes miss one that the noise hid), the coarse instant is returned; so too
+// where the modes (with the offset) are not back at `rest_level` (per channel of `modes`, the
+// record's level before the release; empty: not checked) there within a tenth of their summed
+// amplitudes: modes that miss one (two of the crane's four heavily damped ones in a 1 s record)
+// have velocities that vanish together elsewhere (6 samples early at 1 kHz).
+double RefineReleaseFromModes(const ModalResult& modes, double coarse_time_s,
+                              const std::vector<double>& rest_level = {});
 
 // The part of `record` from `release_time_s` on, with the release as time origin: samples at
 // t >= release_time_s (less a millionth of a sample for round-off) keep their values, and
