@@ -15,6 +15,7 @@
 #include "mbid/common/error.h"
 #include "mbid/common/interrupt_cleanup.h"
 #include "mbid/identification/options.h"
+#include "mbid/records/records.h"
 #include "mbid/validation/scenario.h"
 
 namespace {
@@ -97,6 +98,7 @@ int Main(int argc, char** argv) {
   mbid::app::CommonOptions common;
   ImportFlags import_flags;
   app.add_flag("-q,--quiet", common.quiet, "No progress on standard error");
+  app.add_flag("--overwrite", common.overwrite, "Replace output files that exist");
 
   std::string scenario_path;
   CLI::App* modes = app.add_subcommand(
@@ -254,6 +256,8 @@ int Main(int argc, char** argv) {
   std::vector<mbid::NamedFile> outputs{{"-o", output_path}, {"--json", common.json_path}};
   for (const std::string& path : export_paths) outputs.push_back({"--export", path});
   mbid::CheckOutputsAreNew(inputs, outputs);
+  mbid::CheckOutputsReplaceable(outputs, common.overwrite);  // before the work, not after
+  mbid::records::CheckHdf5OutputName(output_path);
   if (run->parsed()) {
     if (scenario_path.empty()) scenario_path = mbid::validation::DefaultScenarioPath();
     return mbid::app::RunValidationCycle(scenario_path, output_dir, common);

@@ -21,7 +21,6 @@ int RunIdentifyCommand(const std::string& data_path,
                        const identification::IdentificationOptions& given,
                        const std::string& output_path, const CommonOptions& common) {
   given.Validate("command line");  // before reading a possibly large file
-  CheckHdf5OutputName(output_path);
   records::ImportReport import;
   const Measurement measurement = records::ImportMeasurement(
       data_path, MergeImportOptions({}, common.import, nullptr), &import);

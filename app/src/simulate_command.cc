@@ -57,7 +57,6 @@ void Export(const Measurement& measured, const std::string& path) {
 
 int RunSimulateCommand(const std::string& scenario_path, const std::string& output_path,
                        const CommonOptions& common, const std::vector<std::string>& export_paths) {
-  CheckHdf5OutputName(output_path);
   for (const std::string& path : export_paths) ExportFormatOf(path);  // before the simulation
   const Scenario scenario = LoadScenario(scenario_path);
   const auto model = scenario.MakeModel();

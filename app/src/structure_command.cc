@@ -71,7 +71,6 @@ StartedSettings StartFromRoute1(const model::MechanicalModel& model,
 int RunStructureCommand(const std::string& scenario_path,
                         const std::vector<std::string>& data_paths, int max_rigid, int threads,
                         const std::string& output_path, const CommonOptions& common) {
-  CheckHdf5OutputName(output_path);
   const Scenario scenario = LoadScenario(scenario_path);
   const auto model = scenario.MakeModel();
   const auto* multibody = dynamic_cast<const model::MultibodyModel*>(model.get());

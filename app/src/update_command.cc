@@ -91,7 +91,6 @@ void PrintSummary(const updating::UpdateResult& result,
 
 int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::string>& data_paths,
                      const std::string& output_path, const CommonOptions& common) {
-  CheckHdf5OutputName(output_path);
   const Scenario scenario = LoadScenario(scenario_path);
   const auto model = scenario.MakeModel();
   updating::UpdatingSettings settings = scenario.updating;

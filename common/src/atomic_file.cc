@@ -181,4 +181,21 @@ void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
   }
 }
 
+void CheckOutputsReplaceable(const std::vector<NamedFile>& outputs, bool overwrite) {
+  for (const NamedFile& output : outputs) {
+    if (output.path.empty() || output.path == "-") continue;
+    std::error_code error;
+    const fs::path folder = fs::absolute(output.path, error).parent_path();
+    if (!fs::is_directory(folder, error)) {
+      throw InputError(output.flag, output.path,
+                       "its folder " + folder.string() + " does not exist",
+                       "an output in an existing folder");
+    }
+    if (!overwrite && fs::exists(output.path, error)) {
+      throw InputError(output.flag, output.path, "exists",
+                       "a new file name, or --overwrite to replace it");
+    }
+  }
+}
+
 }  // namespace mbid

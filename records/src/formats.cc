@@ -71,4 +71,13 @@ RawTable ReadRawTable(const std::string& path) {
 }
 
 }  // namespace internal
+void CheckHdf5OutputName(const std::string& path) {
+  if (path.empty() || path == "-") return;
+  const std::string extension = LowerExtension(path);
+  if (extension == ".h5" || extension == ".hdf5" || !IsSupportedFile(path)) return;
+  throw InputError("-o", path,
+                   "'" + extension + "' names another record format, and -o writes HDF5",
+                   "a .h5 file name (mbid simulate --export writes .csv, .uff, .uffb and .mat)");
+}
+
 }  // namespace mbid::records

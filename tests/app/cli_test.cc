@@ -212,7 +212,8 @@ TEST_F(CliTest, SimulateIsReproducible) {
   const fs::path b = dir_ / "b.h5";
   ASSERT_EQ(Run("simulate " + kReference + " -o " + a.string()).exit_code, 0);
   ASSERT_EQ(Run("simulate " + kReference + " -o " + b.string()).exit_code, 0);
-  EXPECT_EQ(Run("simulate " + kReference + " -o " + b.string() + " -q").err, "");  // quiet
+  EXPECT_EQ(Run("simulate " + kReference + " -o " + b.string() + " -q --overwrite").err,
+            "");  // quiet
   const std::string command = "h5diff " + a.string() + " " + b.string() + " > /dev/null";
   EXPECT_EQ(std::system(command.c_str()), 0);
 }
@@ -220,6 +221,33 @@ TEST_F(CliTest, SimulateIsReproducible) {
 }  // namespace
 
 namespace {
+
+// Nothing of the user's is replaced unasked: an existing output file is refused (exit 2, one
+// line, before any work, the file as it was) unless --overwrite is given; an output in a folder
+// that does not exist is refused before the work too.
+TEST_F(CliTest, AnExistingFileIsReplacedOnlyWithOverwrite) {
+  const fs::path mine = dir_ / "mine.h5";
+  std::ofstream(mine) << "precious";
+  for (const std::string& outputs :
+       {" -o " + mine.string(), " -o " + (dir_ / "new.h5").string() + " --json " + mine.string()}) {
+    const CommandResult refused = Run("simulate " + kReference + outputs);
+    EXPECT_EQ(refused.exit_code, 2) << refused.err;
+    EXPECT_EQ(refused.err,
+              "mbid: error: " +
+                  std::string(outputs.find("--json") == std::string::npos ? "-o" : "--json") + ":" +
+                  mine.string() +
+                  ": exists; expected a new file name, or --overwrite to replace it\n");
+    EXPECT_EQ(ReadText(mine), "precious");
+    EXPECT_FALSE(fs::exists(dir_ / "new.h5"));
+  }
+  ASSERT_EQ(Run("simulate " + kReference + " -o " + mine.string() + " --overwrite -q").exit_code,
+            0);
+  EXPECT_NE(ReadText(mine), "precious");
+  const CommandResult nowhere =
+      Run("modes " + kReference + " --json " + (dir_ / "no" / "modes.json").string());
+  EXPECT_EQ(nowhere.exit_code, 2);
+  EXPECT_NE(nowhere.err.find("does not exist"), std::string::npos) << nowhere.err;
+}
 
 TEST_F(CliTest, RunClosesTheValidationCycle) {
   // A fast variant of the reference scenario: 5 s instead of 8 (every mode has decayed by then

@@ -171,13 +171,13 @@ TEST_F(StructureCliTest, BadInputIsExitTwoWithOneLineAndNoOutput) {
 
 TEST_F(StructureCliTest, AnEarlierReportIsReplaced) {
   // --max-rigid 0: the full model alone (one fit; CI time). A second run into the same -o
-  // replaces the report the first one wrote.
+  // (with --overwrite) replaces the report the first one wrote.
   const fs::path scenario = WriteScenario("crane");
   const fs::path record = Simulate(scenario);
   const std::string command = "-q structure " + scenario.string() + " " + record.string() +
                               " --max-rigid 0 -o " + (dir_ / "ranking.h5").string();
   ASSERT_EQ(Run(command).exit_code, 0);
-  const CommandResult again = Run(command + " --json -");
+  const CommandResult again = Run(command + " --json - --overwrite");
   ASSERT_EQ(again.exit_code, 0) << again.err;
   const nlohmann::json json = nlohmann::json::parse(again.out);
   ASSERT_EQ(json.at("structures").size(), 1u);

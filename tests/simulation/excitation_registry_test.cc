@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <string>
 #include <variant>
 #include <vector>
@@ -117,6 +118,31 @@ TEST(ExcitationRegistryTest, ADeflectionOfMoreThanHalfATurnIsRefused) {
   EXPECT_NE(std::string(error.what()).find("7 deg is 0.122173 rad"), std::string::npos)
       << error.what();
   EXPECT_NO_THROW(Read("{type: initial_deflection, deflection_rad: {theta: -3.14159}}"));
+}
+
+// A load drop needs the machine's payload point: said when the scenario is read, naming the
+// excitation's type, not when the test is first simulated.
+TEST(ExcitationRegistryTest, ALoadDropWithoutAPayloadPointIsRefusedOnReading) {
+  const std::unique_ptr<model::MechanicalModel> arm =
+      model::MakeModel(YamlReader::FromString(R"(
+type: multibody
+bodies:
+  arm: {parent: ground, joint: {type: revolute, coordinates: [q], axis: [0, 1, 0]},
+        mass_kg: 50.0, com_m: [2.0, 0, 0], inertia_kgm2: [1, 1, 1]}
+springs:
+  q: {stiffness_Nm_per_rad: 4.0e4, damping_Nms_per_rad: 10}
+outputs:
+  q: {type: coordinate, coordinate: q}
+)",
+                                              "arm.yaml"));
+  const YamlReader root =
+      YamlReader::FromString("excitation: {type: load_drop, payload_mass_kg: 500}\n", "drop.yaml");
+  const InputError error =
+      testing::CatchInputError([&] { ReadExcitation(root.Child("excitation"), *arm); });
+  EXPECT_EQ(error.field(), "excitation.type");
+  EXPECT_NE(std::string(error.what()).find("drop.yaml"), std::string::npos) << error.what();
+  EXPECT_NE(std::string(error.what()).find("names no payload point"), std::string::npos)
+      << error.what();
 }
 
 TEST(ExcitationRegistryTest, UnknownTypeListsTheRegisteredOnes) {

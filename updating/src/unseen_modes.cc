@@ -109,9 +109,9 @@ std::vector<std::string> MarkUnseenParameters(const model::MechanicalModel& mode
   }
   if (!unseen.empty()) {
     result.warnings.push_back(fmt::format(
-        "{}: the records' channels do not see the modes {} acts on (the linearized model); left "
+        "{}: the records' channels do not see the modes {} on (the linearized model); left "
         "undetermined",
-        fmt::join(unseen, ", "), unseen.size() == 1 ? "it" : "they"));
+        fmt::join(unseen, ", "), unseen.size() == 1 ? "it acts" : "they act"));
   }
   return unseen;
 }

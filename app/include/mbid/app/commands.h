@@ -10,16 +10,13 @@ namespace mbid::app {
 
 // Options every command shares.
 struct CommonOptions {
-  bool quiet = false;      // no progress on standard error
-  std::string json_path;   // "" = none, "-" = standard output
-  bool overwrite = false;  // replace an output folder an earlier run of the command wrote
+  bool quiet = false;     // no progress on standard error
+  std::string json_path;  // "" = none, "-" = standard output
+  // Replace existing output files; `run`: an output folder an earlier run wrote.
+  bool overwrite = false;
   validation::ImportOverrides import;  // --channel, --unit, --fill-gaps for measured files
   bool profile = false;  // --profile: profile-likelihood intervals (updating.profile.enabled)
 };
-
-// InputError (exit 2) when an HDF5 output's name (-o) has the extension of another record
-// format mbid reads (.csv, .txt, .uff, .mat, ...): that file would be misread. Other names pass.
-void CheckHdf5OutputName(const std::string& path);
 
 // `mbid modes SCENARIO [--json FILE]`: the linearized model and its exact modes.
 int RunModesCommand(const std::string& scenario_path, const CommonOptions& common);

@@ -54,4 +54,9 @@ struct NamedFile {
 void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
                         const std::vector<NamedFile>& outputs);
 
+// Throws InputError (naming the output's flag and path) before any work when an output's folder
+// does not exist, or the output exists and `overwrite` is false: nothing of the user's is
+// replaced unasked (--overwrite). Outputs "" and "-" are skipped.
+void CheckOutputsReplaceable(const std::vector<NamedFile>& outputs, bool overwrite);
+
 }  // namespace mbid

@@ -61,6 +61,10 @@ std::vector<std::string> ConvertToSi(Measurement* measurement, const std::string
 // The file name extensions ImportMeasurement reads (".csv", ".h5", ...), and whether `path`
 // has one of them (case ignored).
 std::vector<std::string> SupportedExtensions();
+// The name of an HDF5 output (-o): one that says another record format is refused (InputError
+// naming -o), so that no HDF5 file ends up named .csv or .mat, which mbid would then read as that
+// format. "" and "-" pass.
+void CheckHdf5OutputName(const std::string& path);
 bool IsSupportedFile(const std::string& path);
 // The extension of `path`'s file name in lower case, with its dot (".csv"); "" if none.
 std::string LowerExtension(const std::string& path);
