@@ -380,22 +380,26 @@ std::string TunedParametersMarkdown(const updating::UpdateResult& result,
       "from {}.\n\n",
       result.termination_name(), result.iterations, result.initial_cost, result.final_cost,
       result.jacobian);
-  out << fmt::format("| parameter | tuned | std | start | {} | difference |\n", model_label);
+  // "start": where the best minimum's own fit began (a Route-1 set, the scenario, a design point).
+  out << fmt::format("| parameter | tuned | std | start of its fit | {} | difference |\n",
+                     model_label);
   out << "|---|---|---|---|---|---|\n";
   for (const updating::ParameterEstimate& p : result.parameters) {
     double true_value = std::numeric_limits<double>::quiet_NaN();
     for (const model::Parameter& q : model.parameters()) {
       if (q.name == p.name) true_value = q.value;
     }
-    out << fmt::format(
-        "| {} ({}) | {:.4g}{} | {} | {:.4g} | {} | {} |\n", p.name, p.units, p.value,
-        p.at_bound ? " (at bound)" : "",
-        std::isfinite(p.std) ? fmt::format("{:.2g} ({:.2g}%)", p.std, 100 * p.relative_std)
-                             : "undetermined",
-        p.initial, std::isfinite(true_value) ? fmt::format("{:.4g}", true_value) : "-",
-        std::isfinite(true_value)
-            ? fmt::format("{:+.3g}%", 100 * (p.value - true_value) / true_value)
-            : "");
+    out << fmt::format("| {} ({}) | {:.4g}{} | {} | {:.4g} | {} | {} |\n", p.name, p.units, p.value,
+                       p.at_bound ? " (at bound)" : "",
+                       // An undetermined parameter's std is no result either: said in its cell.
+                       !std::isfinite(p.std) ? "undetermined"
+                       : p.determined ? fmt::format("{:.2g} ({:.2g}%)", p.std, 100 * p.relative_std)
+                                      : fmt::format("undetermined (std {:.2g})", p.std),
+                       p.initial,
+                       std::isfinite(true_value) ? fmt::format("{:.4g}", true_value) : "-",
+                       std::isfinite(true_value)
+                           ? fmt::format("{:+.3g}%", 100 * (p.value - true_value) / true_value)
+                           : "");
   }
   const std::vector<std::string> profiles = updating::DescribeProfiles(result);
   if (!profiles.empty()) {

@@ -87,8 +87,13 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
   test.tuned = test.search.best;
   if (test.release && !test.tuned.tests.empty()) test.release->Place(test.tuned.tests.front());
   test.start_note = start == "route1" ? "Route 1 (eq. 7)" : "the scenario's values";
-  if (!test.search.minima.empty() && test.search.minima.front().starts.front() != start) {
-    test.start_note += "; best minimum from " + test.search.minima.front().starts.front();
+  if (!test.search.minima.empty()) {
+    // Every start that ended in the best minimum: the table's start is one of them.
+    const std::vector<std::string>& from = test.search.minima.front().starts;
+    if (from.size() > 1 || from.front() != start) {
+      test.start_note +=
+          fmt::format(" (primary start); best minimum reached from {}", fmt::join(from, ", "));
+    }
   }
   say(fmt::format("updating: {} after {} iterations, cost {:.3g} -> {:.3g}; {} distinct minima{}",
                   test.tuned.termination_name(), test.tuned.iterations, test.tuned.initial_cost,
