@@ -135,16 +135,20 @@ void MultibodyModel::Impl::CheckMassMatrix() const {
           .all()) {
     return;
   }
-  std::string coordinate = coordinates.front();
-  for (Eigen::Index i = 0; i < diagonal.size(); ++i) {
-    if (!(diagonal[i] > 1e-12 * diagonal.cwiseAbs().maxCoeff())) {
-      coordinate = coordinates[static_cast<size_t>(i)];
-      break;
+  // The motion that moves no mass: M's eigenvector of least eigenvalue (a massless link turning
+  // with its child about one axis is qc and qd together, not a zero on the diagonal).
+  std::string moving;
+  if (m.allFinite()) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(m);
+    const Eigen::VectorXd v = eigen.eigenvectors().col(0);
+    for (Eigen::Index i = 0; i < v.size(); ++i) {
+      if (std::abs(v[i]) < 0.1 * v.cwiseAbs().maxCoeff()) continue;
+      moving += (moving.empty() ? "'" : ", '") + coordinates[static_cast<size_t>(i)] + "'";
     }
   }
   throw InputError("machine description", "bodies",
-                   "the mass matrix is singular at q = 0 (near coordinate '" + coordinate +
-                       "'): some motion of the joints moves no mass",
+                   "the mass matrix is singular at q = 0 (coordinates " + moving +
+                       "): some motion of the joints moves no mass",
                    "every coordinate moving some mass or inertia (a massless frame may not turn "
                    "about or slide along the axis of its only child's joint)");
 }

@@ -544,6 +544,9 @@ outputs:
   EXPECT_EQ(error.source(), "machine.yaml") << error.what();
   EXPECT_EQ(error.field(), "model.bodies") << error.what();
   EXPECT_NE(std::string(error.what()).find("mass matrix is singular"), std::string::npos);
+  // The two coordinates that turn together, not the first of the machine's.
+  EXPECT_NE(std::string(error.what()).find("(coordinates 'q1', 'q2')"), std::string::npos)
+      << error.what();
 }
 
 struct BadCase {
