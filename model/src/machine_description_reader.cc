@@ -122,6 +122,13 @@ JointDescription ReadJoint(const YamlReader& joint, const ExpressionContext& con
     }
   } else {
     result.coordinates = joint.StringList("coordinates");
+    // Counted here, before the springs and outputs name them (a universal joint given one
+    // coordinate was reported through its second coordinate's spring).
+    const size_t dofs = result.type == JointType::kUniversal ? 2 : 1;
+    if (result.coordinates.size() != dofs) {
+      joint.FailAt("coordinates", std::to_string(result.coordinates.size()) + " coordinates",
+                   std::to_string(dofs) + " for this joint type");
+    }
     if (result.type == JointType::kUniversal) {
       if (joint.Has("axis"))
         joint.FailAt("axis", "'axis' on a universal joint", "axes: [[..], [..]]");

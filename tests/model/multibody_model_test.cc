@@ -585,6 +585,9 @@ INSTANTIATE_TEST_SUITE_P(
                 "not defined above"},
         BadCase{"coordinate twice", "coordinates: [c]", "coordinates: [a]",
                 "model.bodies.jib.joint.coordinates", "twice"},
+        // Its second coordinate's spring must not be reported first.
+        BadCase{"universal joint with one coordinate", "coordinates: [a, b]", "coordinates: [a]",
+                "model.bodies.mast.joint.coordinates", "expected 2 for this joint type"},
         BadCase{"spring on unknown coordinate", "  c: {stiffness_Nm_per_rad: 3.0e5",
                 "  d: {stiffness_Nm_per_rad: 3.0e5", "model.springs.d", "unknown coordinate"},
         BadCase{"output unknown body", "body: jib, direction: [1, 0, 0]}\n  pitch",
