@@ -361,6 +361,20 @@ TEST(CredibilityTest, WhiteExcessOverTheNoiseOnlyInflates) {
   EXPECT_TRUE(result.parameters[0].determined);
 }
 
+TEST(CredibilityTest, AResidualFarBelowTheWeightsSaysTheNoiseIsOverstated) {
+  // White noise half the stated level (chi^2/dof 0.25, 5 sampling std below 1 is 0.89 at
+  // 4000): the weights overstate the noise and the standard deviations are twice too large;
+  // said, not changed (on the safe side). At the noise's level nothing is said.
+  const UpdateResult result = AssessResidual(Ar1Noise(4000, 0.0, 0.5, 14));
+  EXPECT_NEAR(result.chi_square_per_dof, 0.25, 0.02);
+  EXPECT_EQ(result.std_inflation, 1.0);
+  EXPECT_TRUE(result.parameters[0].determined);
+  ASSERT_EQ(result.credibility.size(), 1u);
+  EXPECT_NE(result.credibility[0].find("that noise is overstated"), std::string::npos)
+      << result.credibility[0];
+  EXPECT_TRUE(AssessResidual(Ar1Noise(4000, 0.0, 1.0, 11)).credibility.empty());
+}
+
 TEST(CredibilityTest, ColouredExcessOverTheNoiseDeterminesNothing) {
   // A smaller excess, coloured (AR(1), rho = 0.8, 1.08 times the noise: chi^2/dof 1.17, spread
   // 3% over 20000 samples of correlation time 8.9): signal the model does not reproduce, which

@@ -107,6 +107,17 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
         "the noise was estimated from this fit's own residual: a misfit cannot be told from "
         "noise except by the residual's whiteness");
   }
+  // Far below 1 (5 of chi^2/dof's sampling standard deviations sqrt(2 / dof)): the weights
+  // overstate the noise, as an identification's residual does when its modes missed something
+  // (chi^2/dof 0.25 on a boom whose identification left 16 times the noise). The standard
+  // deviations are then too large; said, and left so (on the safe side).
+  if (from_records && result.chi_square_per_dof < 1 - 5 * std::sqrt(2 / dof)) {
+    result.credibility.push_back(fmt::format(
+        "the residual is {:.3g} times the noise the fit was weighted with (chi^2/dof = {:.4g}): "
+        "that noise is overstated, and the standard deviations are about {:.3g} times too large",
+        std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof,
+        1 / std::sqrt(std::max(result.chi_square_per_dof, 1e-12))));
+  }
   // A clipped channel holds its peaks at the rail, a glitch jumps off the motion: the fit takes
   // such samples as measured and leans towards them, whatever the residual says.
   std::string faulty;
