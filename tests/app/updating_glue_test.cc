@@ -2,6 +2,10 @@
 // paper chose its four "main" modes among all it found).
 #include <gtest/gtest.h>
 
+#include <string>
+#include <tuple>
+#include <vector>
+
 #include "../updating/crane_fixture.h"
 #include "mbid/model/linear_model.h"
 #include "mbid/updating/settings.h"
@@ -80,19 +84,32 @@ TEST(UpdatingGlueTest, RouteOneRunsOnTheMainModesAndNamesTheOthers) {
   EXPECT_NE(note.find("3 identified modes for 4 coordinates"), std::string::npos) << note;
 }
 
+// The reference crane's exact (noise-free) free decay and default settings, for tests of records
+// cut at a release mbid found in them (TestRecord::release_detected), weighted by 1e-5 rad.
+struct DetectedReleases {
+  updating::testing::Crane crane =
+      updating::testing::LoadCrane(updating::testing::kReferenceScenario);
+  Measurement exact;
+  updating::UpdatingSettings settings =
+      updating::MakeDefaultUpdatingSettings(*crane.model, crane.simulation.integrator);
+  DetectedReleases(double duration_s, double rate_hz)
+      : exact(updating::testing::SimulateExact(crane, duration_s, rate_hz)) {}
+  updating::TestRecord Test(const std::string& name, const Measurement& record) const {
+    updating::TestRecord test = updating::MakeTestRecord(name, record, crane.excitation, settings);
+    test.noise_std = {{"psi", 1e-5}, {"phi", 1e-5}};
+    test.release_detected = true;
+    return test;
+  }
+};
+
 // Placing a detected release refits the best (release_profile.h): what the global search or
 // Route 1 judged of it must survive. A parameter marked undetermined (here by hand, as the search
 // marks those its alternative minima differ in) stays undetermined with its reason; the exact
 // record's release is placed where it is (noise-free: within a hundredth of a sample).
 TEST(UpdatingGlueTest, APlacedReleaseKeepsWhatTheSearchLeftUndetermined) {
-  const updating::testing::Crane crane =
-      updating::testing::LoadCrane(updating::testing::kReferenceScenario);
-  const Measurement record = updating::testing::SimulateExact(crane, 2.0, 100.0);
-  const updating::UpdatingSettings settings =
-      updating::MakeDefaultUpdatingSettings(*crane.model, crane.simulation.integrator);
-  updating::TestRecord test = updating::MakeTestRecord("rec", record, crane.excitation, settings);
-  test.noise_std = {{"psi", 1e-5}, {"phi", 1e-5}};
-  test.release_detected = true;
+  const DetectedReleases setup(2.0, 100.0);
+  const auto& [crane, record, settings] = std::tie(setup.crane, setup.exact, setup.settings);
+  const updating::TestRecord test = setup.Test("rec", record);
   updating::UpdateResult best = updating::UpdateModel(*crane.model, {test}, settings.options);
   ASSERT_NE(best.termination, updating::UpdateResult::Termination::kFailure);
   for (updating::ParameterEstimate& p : best.parameters) {
@@ -134,18 +151,12 @@ TEST(UpdatingGlueTest, APlacedReleaseKeepsWhatTheSearchLeftUndetermined) {
 // first (correct) one 0.19 samples off, and further sweeps place each with the other placed.
 // Noise-free exact records: both releases back to a fiftieth of a sample.
 TEST(UpdatingGlueTest, TwoDetectedReleasesArePlacedTogether) {
-  const updating::testing::Crane crane =
-      updating::testing::LoadCrane(updating::testing::kReferenceScenario);
-  const Measurement exact = updating::testing::SimulateExact(crane, 2.0, 100.0);
+  const DetectedReleases setup(2.0, 100.0);
+  const auto& [crane, exact, settings] = std::tie(setup.crane, setup.exact, setup.settings);
   const double tau = exact.sample_interval_s;
-  const updating::UpdatingSettings settings =
-      updating::MakeDefaultUpdatingSettings(*crane.model, crane.simulation.integrator);
   std::vector<updating::TestRecord> records;
   for (const Measurement& record : {exact, validation::MoveRelease(exact, 0.4 * tau)}) {
-    records.push_back(updating::MakeTestRecord("rec" + std::to_string(records.size()), record,
-                                               crane.excitation, settings));
-    records.back().noise_std = {{"psi", 1e-5}, {"phi", 1e-5}};
-    records.back().release_detected = true;
+    records.push_back(setup.Test("rec" + std::to_string(records.size()), record));
   }
   updating::UpdateResult best = updating::UpdateModel(*crane.model, records, settings.options);
   ASSERT_NE(best.termination, updating::UpdateResult::Termination::kFailure);
@@ -170,16 +181,11 @@ TEST(UpdatingGlueTest, TwoDetectedReleasesArePlacedTogether) {
 // placement follows the parabola past its 2-sample clamp, round after round, back to the
 // release. Noise-free exact record: within a fiftieth of a sample.
 TEST(UpdatingGlueTest, AReleaseDetectedSixSamplesLateIsPlacedBack) {
-  const updating::testing::Crane crane =
-      updating::testing::LoadCrane(updating::testing::kReferenceScenario);
-  const Measurement exact = updating::testing::SimulateExact(crane, 1.0, 1000.0);
+  const DetectedReleases setup(1.0, 1000.0);
+  const auto& [crane, exact, settings] = std::tie(setup.crane, setup.exact, setup.settings);
   const double tau = exact.sample_interval_s;
-  const updating::UpdatingSettings settings =
-      updating::MakeDefaultUpdatingSettings(*crane.model, crane.simulation.integrator);
-  std::vector<updating::TestRecord> records{updating::MakeTestRecord(
-      "late", validation::MoveRelease(exact, 6 * tau), crane.excitation, settings)};
-  records[0].noise_std = {{"psi", 1e-5}, {"phi", 1e-5}};
-  records[0].release_detected = true;
+  std::vector<updating::TestRecord> records{
+      setup.Test("late", validation::MoveRelease(exact, 6 * tau))};
   updating::UpdateResult best = updating::UpdateModel(*crane.model, records, settings.options);
   ASSERT_NE(best.termination, updating::UpdateResult::Termination::kFailure);
   const std::vector<std::string> lines =
