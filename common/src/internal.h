@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -57,6 +58,11 @@ inline std::string Join(const std::vector<std::string>& items, const std::string
 
 // Whole file as text; a file that cannot be opened or read is an InputError naming it.
 inline std::string ReadTextFile(const std::string& path, const std::string& expected) {
+  // A folder opens and reads as nothing on Linux: said as what it is.
+  std::error_code error_code;
+  if (std::filesystem::is_directory(path, error_code)) {
+    throw InputError(path, "", "is a folder", expected);
+  }
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (file == nullptr) {
     throw InputError(path, "", std::string("cannot open: ") + std::strerror(errno), expected);

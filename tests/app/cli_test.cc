@@ -249,6 +249,15 @@ TEST_F(CliTest, AnExistingFileIsReplacedOnlyWithOverwrite) {
   EXPECT_NE(nowhere.err.find("does not exist"), std::string::npos) << nowhere.err;
 }
 
+// A folder given as the scenario is said to be one (Linux opens it and reads nothing, which
+// was then "not a mapping").
+TEST_F(CliTest, AFolderAsTheScenarioIsSaidToBeOne) {
+  const CommandResult result = Run("modes " + dir_.string());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(result.err,
+            "mbid: error: " + dir_.string() + ": is a folder; expected a scenario YAML file\n");
+}
+
 TEST_F(CliTest, RunClosesTheValidationCycle) {
   // A fast variant of the reference scenario: 5 s instead of 8 (every mode has decayed by then
   // to under 1% of its start except the 1.51 Hz one, which the record still shows clearly).

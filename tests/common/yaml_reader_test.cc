@@ -89,6 +89,14 @@ TEST(YamlReaderTest, ClosestMatchUsesEditDistance) {
 // Numbers inside the YAML snippets are arbitrary unless a comment says why; the checked text
 // repeats them.
 
+// A folder named as a scenario: said as what it is (Linux opens it and reads nothing, which was
+// then "not a mapping").
+TEST(YamlReaderBadInputTest, AFolderIsSaidToBeOne) {
+  TempDir dir;
+  const InputError error = CatchInputError([&] { YamlReader::FromFile(dir.File(".")); });
+  EXPECT_THAT(error.what(), HasSubstr(": is a folder; expected a YAML file"));
+}
+
 TEST(YamlReaderBadInputTest, UnknownKeySuggestsClosest) {
   const YamlReader base = Base("mas_kg: 24000");
   const InputError e = CatchInputError([&] { base.ExpectMap(kBaseKeys); });

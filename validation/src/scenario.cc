@@ -45,6 +45,11 @@ const simulation::Excitation& Scenario::RequireExcitation() const {
 }
 
 Scenario LoadScenario(const std::string& path) {
+  // A folder opens and reads as nothing on Linux: said as what it is.
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    throw InputError(path, "", "is a folder", "a scenario YAML file");
+  }
   std::ifstream in(path);
   if (!in) throw InputError(path, "", "cannot open the scenario file", "a readable YAML file");
   std::stringstream text;
