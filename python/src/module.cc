@@ -40,31 +40,41 @@ py::dict Units(const mbid::Measurement& m) {
   return units;
 }
 
-// identify_arrays: a uniformly sampled record from a time array and named channel arrays.
-mbid::Measurement MakeRecord(
-    const py::object& time_object,
-    const std::map<std::string, py::array_t<double, py::array::c_style | py::array::forcecast>>&
-        channels,
-    const std::map<std::string, std::string>& units) {
-  const py::array given = py::array::ensure(time_object);
-  const char kind = given ? given.dtype().kind() : '?';
+using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// `object` as a one-dimensional float64 array, or an InputError naming `field`: real numbers only
+// (strings once crashed; a complex channel lost its imaginary part with numpy's warning alone).
+// `given` gets the array as given (its dtype before the cast).
+Doubles RealVector(const py::object& object, const std::string& field, const std::string& what,
+                   py::array* given) {
+  *given = py::array::ensure(object);
+  const char kind = *given ? given->dtype().kind() : '?';
   if (kind != 'f' && kind != 'i' && kind != 'u') {
     throw mbid::InputError(
-        "identify_arrays", "time",
-        given ? "an array of " + std::string(py::str(given.dtype())) + " values" : "not an array",
-        "a one-dimensional array of times in s (floats or integers)");
+        "identify_arrays", field,
+        *given ? "an array of " + std::string(py::str(given->dtype())) + " values" : "not an array",
+        "a one-dimensional array of " + what + " (real numbers)");
   }
-  if (given.ndim() != 1) {
-    throw mbid::InputError("identify_arrays", "time",
-                           "an array of dimension " + std::to_string(given.ndim()),
-                           "a one-dimensional array of times in s");
+  if (given->ndim() != 1) {
+    throw mbid::InputError("identify_arrays", field,
+                           "an array of dimension " + std::to_string(given->ndim()),
+                           "a one-dimensional array of " + what);
   }
-  using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
-  const Doubles time = Doubles::ensure(given);
-  if (!time) {
-    throw mbid::InputError("identify_arrays", "time", "not convertible to float64",
-                           "a one-dimensional array of times in s");
+  const Doubles values = Doubles::ensure(*given);
+  if (!values) {
+    throw mbid::InputError("identify_arrays", field, "not convertible to float64",
+                           "a one-dimensional array of " + what);
   }
+  return values;
+}
+
+// identify_arrays: a uniformly sampled record from a time array and named channel arrays.
+mbid::Measurement MakeRecord(const py::object& time_object,
+                             const std::map<std::string, py::object>& channels,
+                             const std::map<std::string, std::string>& units) {
+  py::array given;
+  const Doubles time = RealVector(time_object, "time", "times in s", &given);
+  const char kind = given.dtype().kind();
   const Eigen::Index n = time.shape(0);
   const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(time.data(), n);
   // Floating-point times are rounded to their last bit, as a printed column is to its last
@@ -89,8 +99,10 @@ mbid::Measurement MakeRecord(
   }
   m.values.resize(n, static_cast<Eigen::Index>(channels.size()));
   Eigen::Index column = 0;
-  for (const auto& [name, values] : channels) {
-    if (values.ndim() != 1 || values.shape(0) != n) {
+  for (const auto& [name, object] : channels) {
+    py::array as_given;
+    const Doubles values = RealVector(object, "channels/" + name, "values", &as_given);
+    if (values.shape(0) != n) {
       throw mbid::InputError("identify_arrays", "channels/" + name,
                              "an array of shape different from time's",
                              "a one-dimensional array of " + std::to_string(n) + " samples");
@@ -344,9 +356,7 @@ PYBIND11_MODULE(_mbid, m) {
       "scenario of its test, after an impulse or burst from where the forcing ends.");
   m.def(
       "identify_arrays",
-      [](const py::object& time,
-         const std::map<std::string,
-                        py::array_t<double, py::array::c_style | py::array::forcecast>>& channels,
+      [](const py::object& time, const std::map<std::string, py::object>& channels,
          const std::map<std::string, std::string>& units, const IdentificationOptions& options) {
         const mbid::Measurement record = MakeRecord(time, channels, units);
         py::gil_scoped_release release;

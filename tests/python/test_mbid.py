@@ -259,6 +259,16 @@ class ErrorTest(unittest.TestCase):
             self.assertIn("identify_arrays:time", str(raised.exception).replace(" ", ""))
             self.assertEqual(str(raised.exception).count("\n"), 0)
 
+    def test_channels_of_no_real_numbers_are_refused_in_one_line(self):
+        # A complex channel lost its imaginary part behind numpy's ComplexWarning; strings were
+        # refused by pybind's multi-line TypeError. Each is an InputError naming the channel.
+        t = np.arange(20) * 0.01
+        for bad in [np.ones(20) * (1 + 1j), ["a"] * 20, np.ones((20, 2))]:
+            with self.assertRaises(mbid.InputError, msg=repr(bad)) as raised:
+                mbid.identify_arrays(t, {"x": bad})
+            self.assertIn("identify_arrays:channels/x", str(raised.exception).replace(" ", ""))
+            self.assertEqual(str(raised.exception).count("\n"), 0)
+
     def test_epoch_times_in_float64_are_read_to_their_last_bit(self):
         # Unix times of 2023 (1.7e9 s) at 200 Hz: float64 holds them to 2.4e-7 s, 5e-5 of the
         # step, above the 1e-6 a time column's uniformity is held to; a file's HDF5 time vector
