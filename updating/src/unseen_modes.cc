@@ -79,19 +79,21 @@ std::vector<std::string> MarkUnseenParameters(const model::MechanicalModel& mode
     if (after.size() != modes.size()) continue;
     // Each mode's relative change, matched to the nearest pole after the step.
     double largest = 0, seen = 0;
-    std::vector<std::string> acted_on;
+    std::vector<double> change(modes.size(), 0.0);
     for (size_t k = 0; k < modes.size(); ++k) {
-      double change = std::numeric_limits<double>::infinity();
+      if (!(std::abs(modes[k].lambda) > 0)) continue;  // a free motion's zero pole: no scale
+      double nearest = std::numeric_limits<double>::infinity();
       for (const model::Mode& mode : after) {
-        change = std::min(change, std::abs(mode.lambda - modes[k].lambda));
+        nearest = std::min(nearest, std::abs(mode.lambda - modes[k].lambda));
       }
-      change /= std::abs(modes[k].lambda);
-      largest = std::max(largest, change);
-      if (visibility[k] > kVisible) seen = std::max(seen, change);
+      change[k] = nearest / std::abs(modes[k].lambda);
+      largest = std::max(largest, change[k]);
+      if (visibility[k] > kVisible) seen = std::max(seen, change[k]);
     }
     if (!(largest > 0) || seen > kSeenShare * largest) continue;
+    std::vector<std::string> acted_on;  // the unseen modes it moves
     for (size_t k = 0; k < modes.size(); ++k) {
-      if (visibility[k] <= kVisible) {
+      if (visibility[k] <= kVisible && change[k] > kSeenShare * largest) {
         acted_on.push_back(fmt::format("{:.3g} Hz", modes[k].frequency_hz()));
       }
     }
