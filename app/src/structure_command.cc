@@ -169,9 +169,7 @@ int RunStructureCommand(const std::string& scenario_path,
   options.after_reference = validation::PlaceDetectedReleases;
   const updating::StructureRanking ranking = updating::RankStructures(candidates, records, options);
   const updating::UpdateResult& reference = ranking.reference_search.best;
-  for (size_t i = 0; i < tests.size() && i < reference.tests.size(); ++i) {
-    tests[i].release.Place(reference.tests[i]);
-  }
+  validation::PlaceReleases(reference, &tests);
 
   nlohmann::json summary = StructureRankingToJson(ranking, data_paths);
   summary["max_rigid"] = max_rigid;

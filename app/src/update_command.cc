@@ -111,10 +111,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   const std::string& note = update.note;
   const updating::GlobalSearchResult& search = update.search;
   const updating::UpdateResult& result = search.best;
-  // A detected release is reported where the fit placed it.
-  for (size_t i = 0; i < tests.size() && i < result.tests.size(); ++i) {
-    tests[i].release.Place(result.tests[i]);
-  }
+  validation::PlaceReleases(result, &tests);  // reported where the fit placed them
 
   const bool converged = result.termination == updating::UpdateResult::Termination::kConverged;
   nlohmann::json summary = updating::UpdateResultToJson(result, algebraic.get());

@@ -132,10 +132,10 @@ UpdateResult Update(const Scenario& scenario, const std::vector<Measurement>& re
   const validation::RecordedUpdate update =
       validation::UpdateFromTests(*model, tests, settings, [](const std::string&) {});
   UpdateResult result = Summarise(update.search, update.start);
-  for (size_t i = 0; i < tests.size(); ++i) {
-    if (i < update.search.best.tests.size()) tests[i].release.Place(update.search.best.tests[i]);
-    result.release_time_s.push_back(tests[i].release.release_time_s);
-    result.release.push_back(tests[i].release.how);
+  validation::PlaceReleases(update.search.best, &tests);
+  for (const validation::LoadedTest& test : tests) {
+    result.release_time_s.push_back(test.release.release_time_s);
+    result.release.push_back(test.release.how);
   }
   return result;
 }

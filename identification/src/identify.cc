@@ -66,16 +66,13 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   if (detection.detected && detection.from_rest) {
     // The whole decay knows the release better than its first samples (release.h).
     const double onset_s = result.release_time_s;
-    // Each analysed channel's level at rest: the median before the release.
+    // Each analysed channel's level at rest, as the detection found it.
     std::vector<double> rest_level;
     for (const std::string& channel : result.channels) {
       const auto column =
           std::find(measurement.channels.begin(), measurement.channels.end(), channel) -
           measurement.channels.begin();
-      std::vector<double> before(detection.rest_samples);
-      for (int j = 0; j < detection.rest_samples; ++j) before[j] = measurement.values(j, column);
-      std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
-      rest_level.push_back(before.empty() ? 0.0 : before[before.size() / 2]);
+      rest_level.push_back(detection.rest_level[static_cast<size_t>(column)]);
     }
     result.release_time_s = RefineReleaseFromModes(result, onset_s, rest_level);
     if (result.release_time_s != onset_s) {

@@ -290,10 +290,12 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   // late). Where fewer than kShortRestSamples precede the release, each channel must also stay
   // within 6 noise standard deviations of that median (the noise from the whole record's third
   // differences; a coarsely sampled decay overstates it, which leaves the test lenient).
+  std::vector<double> levels;
   for (Eigen::Index c = 0; c < m; ++c) {
     std::vector<double> before(y.col(c).data(), y.col(c).data() + rest);
     std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
     const double level = before[before.size() / 2];
+    levels.push_back(level);
     double bound = kRestFraction * range(c);
     const double noise = ThirdDifferenceNoise(y.col(c));
     // A long rest in a channel whose noise is a few % of its range holds 4-sigma samples beyond
@@ -302,6 +304,7 @@ ReleaseDetection DetectRelease(const Measurement& record) {
     if ((y.col(c).head(rest).array() - level).abs().maxCoeff() > bound) return detection;
   }
   detection.detected = true;
+  detection.rest_level = levels;
   detection.from_rest = !jumps && !moving_off;
   detection.rest_samples = rest;
   detection.release_time_s = record.start_time_s + t0 * record.sample_interval_s;

@@ -151,16 +151,8 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
 
   result.undetermined.clear();
   for (ParameterEstimate& p : result.parameters) {
+    SetInterval(p, result.std_inflation);
     const double relative = p.relative_std * result.std_inflation;
-    if (std::isfinite(relative)) {
-      if (p.log_scale) {
-        p.interval_lower = p.value * std::exp(-2 * relative);
-        p.interval_upper = p.value * std::exp(2 * relative);
-      } else {
-        p.interval_lower = p.value - 2 * p.std * result.std_inflation;
-        p.interval_upper = p.value + 2 * p.std * result.std_inflation;
-      }
-    }
     if (!faulty.empty() && p.test.empty()) {
       p.determined = false;
       p.why_undetermined = faulty;

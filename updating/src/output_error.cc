@@ -88,6 +88,18 @@ const ParameterEstimate& UpdateResult::Find(const std::string& name) const {
   throw std::out_of_range("UpdateResult::Find: no parameter '" + name + "'");
 }
 
+void SetInterval(ParameterEstimate& p, double std_inflation) {
+  const double relative = p.relative_std * std_inflation;
+  if (!std::isfinite(relative)) return;
+  if (p.log_scale) {
+    p.interval_lower = p.value * std::exp(-2 * relative);
+    p.interval_upper = p.value * std::exp(2 * relative);
+  } else {
+    p.interval_lower = p.value - 2 * p.std * std_inflation;
+    p.interval_upper = p.value + 2 * p.std * std_inflation;
+  }
+}
+
 void ApplyEstimates(const UpdateResult& result, model::MechanicalModel& model) {
   for (const ParameterEstimate& estimate : result.parameters) {
     if (estimate.test.empty()) model.SetParameter(estimate.name, estimate.value);

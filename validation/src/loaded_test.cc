@@ -63,6 +63,12 @@ LoadedTest PrepareTest(Measurement record, const std::string& origin,
   return test;
 }
 
+void PlaceReleases(const updating::UpdateResult& fit, std::vector<LoadedTest>* tests) {
+  for (size_t i = 0; i < tests->size() && i < fit.tests.size(); ++i) {
+    (*tests)[i].release.Place(fit.tests[i]);
+  }
+}
+
 void DescribeLoadedTest(const LoadedTest& test) {
   std::cerr << fmt::format("mbid: {}: {}\n", test.path, DescribeImport(test.import));
   std::cerr << fmt::format("mbid: {}: free decay from {:.6g} s of the record ({}); t = 0 there\n",

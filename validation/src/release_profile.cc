@@ -182,15 +182,7 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
     if (added == added_variance.end() || !std::isfinite(p.std)) continue;
     p.std = std::sqrt(p.std * p.std + added->second);
     if (p.value != 0) p.relative_std = p.std / std::abs(p.value);
-    // The intervals as output_error.h defines them, from the widened std.
-    if (p.log_scale) {
-      const double factor = std::exp(2 * p.relative_std * best->std_inflation);
-      p.interval_lower = p.value / factor;
-      p.interval_upper = p.value * factor;
-    } else {
-      p.interval_lower = p.value - 2 * p.std * best->std_inflation;
-      p.interval_upper = p.value + 2 * p.std * best->std_inflation;
-    }
+    updating::SetInterval(p, best->std_inflation);  // from the widened std
   }
   for (size_t i = 0; i < detected.size(); ++i) {
     const std::string& name = (*records)[detected[i]].name;

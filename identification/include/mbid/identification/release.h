@@ -21,6 +21,9 @@ struct ReleaseDetection {
   // fraction of a sample); false: the record starts in the decay, release_time_s is its start.
   bool detected = false;
   int rest_samples = 0;  // samples at rest before the release
+  // Per channel of the record, its level at rest: the median before the release (glitches
+  // bridged). Empty unless detected.
+  std::vector<double> rest_level;
   // true when the structure set off from rest in every channel (positions, no jump): a load or
   // pull release, whose instant the identified modes then refine (RefineReleaseFromModes).
   bool from_rest = false;

@@ -264,4 +264,8 @@ UpdateResult UpdateModel(const model::MechanicalModel& model, const std::vector<
 // Sets each tuned shared parameter of `model` to its estimate.
 void ApplyEstimates(const UpdateResult& result, model::MechanicalModel& model);
 
+// `p`'s approximate 95% interval (ParameterEstimate::interval_lower) from its std, inflated by
+// `std_inflation`; left as it is when the std is undefined.
+void SetInterval(ParameterEstimate& p, double std_inflation);
+
 }  // namespace mbid::updating

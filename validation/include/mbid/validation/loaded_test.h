@@ -27,6 +27,10 @@ struct LoadedTest {
   AppliedRelease release;
 };
 
+// Each test's detected release where `fit` (of these tests, in order) placed it
+// (AppliedRelease::Place).
+void PlaceReleases(const updating::UpdateResult& fit, std::vector<LoadedTest>* tests);
+
 // Imports `path` (the overrides' channels, units, gaps), checks its channels against `model`,
 // takes the excitation stored with a simulated HDF5 record (else the scenario's), cuts the
 // record at the release and identifies its modes (for Route 1 and the noise weights).
