@@ -197,5 +197,42 @@ TEST(UpdatingGlueTest, AReleaseDetectedSixSamplesLateIsPlacedBack) {
   EXPECT_NEAR(best.tests[0].release_shift_s, -6 * tau, 0.02 * tau);
 }
 
+// The release's uncertainty widens a parameter's std; where the widened spread passes what the
+// records determine, the parameter is no longer reported determined (it was, before).
+TEST(UpdatingGlueTest, AReleaseUncertaintyThatWidensPastTheLimitLeavesTheParameterUndetermined) {
+  updating::UpdateResult best;
+  best.std_inflation = 1;
+  const auto estimate = [](std::string name, double value, double std) {
+    updating::ParameterEstimate p;
+    p.name = std::move(name);
+    p.value = value;
+    p.std = std;
+    p.relative_std = std / value;
+    p.lower = 0.01 * value;
+    p.upper = 100 * value;
+    p.determined = true;
+    p.log_scale = false;  // an interval of +-2 std
+    return p;
+  };
+  best.parameters = {estimate("c_wide", 1000, 200), estimate("c_kept", 1000, 50),
+                     estimate("d_untouched", 10, 2.5)};
+  updating::UpdateOptions options;  // undetermined_relative_std 0.3
+  // c_wide: sqrt(200^2 + 250^2) = 320, relative 0.32 > 0.3; c_kept: sqrt(50^2 + 100^2) = 112.
+  validation::WidenForReleases({{"c_wide", 250.0 * 250.0}, {"c_kept", 100.0 * 100.0}}, options,
+                               &best);
+  const updating::ParameterEstimate& wide = best.Find("c_wide");
+  EXPECT_NEAR(wide.std, 320.156, 1e-3);
+  EXPECT_FALSE(wide.determined);
+  EXPECT_NE(wide.why_undetermined.find("relative std 0.32"), std::string::npos)
+      << wide.why_undetermined;
+  EXPECT_NE(wide.why_undetermined.find("release"), std::string::npos) << wide.why_undetermined;
+  EXPECT_EQ(best.undetermined, std::vector<std::string>{"c_wide"});
+  const updating::ParameterEstimate& kept = best.Find("c_kept");
+  EXPECT_NEAR(kept.std, 111.803, 1e-3);
+  EXPECT_TRUE(kept.determined);
+  EXPECT_NEAR(kept.interval_upper, 1000 + 2 * 111.803, 1e-2);  // the interval from the widened std
+  EXPECT_EQ(best.Find("d_untouched").std, 2.5);
+}
+
 }  // namespace
 }  // namespace mbid::app

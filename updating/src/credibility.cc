@@ -152,7 +152,6 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
   result.undetermined.clear();
   for (ParameterEstimate& p : result.parameters) {
     SetInterval(p, result.std_inflation);
-    const double relative = p.relative_std * result.std_inflation;
     if (!faulty.empty() && p.test.empty()) {
       p.determined = false;
       p.why_undetermined = faulty;
@@ -163,28 +162,37 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
       p.determined = false;
       p.why_undetermined =
           "the fit does not explain the records (a residual above the noise, not white)";
-    } else if (!std::isfinite(relative)) {
-      p.determined = false;
-      p.why_undetermined = "no standard deviation: the records leave it in a flat direction";
-    } else if (relative > options.undetermined_relative_std) {
-      p.determined = false;
-      p.why_undetermined = fmt::format("relative std {:.3g}{} above {}", relative,
-                                       result.std_inflation > 1 ? " (inflated)" : "",
-                                       options.undetermined_relative_std);
-    } else if (p.lower < p.upper && (p.interval_lower <= p.lower || p.interval_upper >= p.upper)) {
-      // The records allow values up to the bound (and maybe beyond): the bound, not the data,
-      // decides where the estimate ends.
-      const bool low = p.interval_lower <= p.lower;
-      p.determined = false;
-      p.why_undetermined = fmt::format(
-          "its interval [{:.4g}, {:.4g}] reaches the {} bound {:.4g}: the records do not bound "
-          "it within the allowed range",
-          p.interval_lower, p.interval_upper, low ? "lower" : "upper", low ? p.lower : p.upper);
-    } else if (!p.determined && p.why_undetermined.empty()) {
+    } else if (!MarkIfSpreadUndetermined(p, result.std_inflation,
+                                         options.undetermined_relative_std) &&
+               !p.determined && p.why_undetermined.empty()) {
       p.why_undetermined = "marked by the caller";
     }
     if (!p.determined) result.undetermined.push_back(p.name);
   }
+}
+
+bool MarkIfSpreadUndetermined(ParameterEstimate& p, double std_inflation,
+                              double undetermined_relative_std) {
+  const double relative = p.relative_std * std_inflation;
+  if (!std::isfinite(relative)) {
+    p.why_undetermined = "no standard deviation: the records leave it in a flat direction";
+  } else if (relative > undetermined_relative_std) {
+    p.why_undetermined =
+        fmt::format("relative std {:.3g}{} above {}", relative,
+                    std_inflation > 1 ? " (inflated)" : "", undetermined_relative_std);
+  } else if (p.lower < p.upper && (p.interval_lower <= p.lower || p.interval_upper >= p.upper)) {
+    // The records allow values up to the bound (and maybe beyond): the bound, not the data,
+    // decides where the estimate ends.
+    const bool low = p.interval_lower <= p.lower;
+    p.why_undetermined = fmt::format(
+        "its interval [{:.4g}, {:.4g}] reaches the {} bound {:.4g}: the records do not bound it "
+        "within the allowed range",
+        p.interval_lower, p.interval_upper, low ? "lower" : "upper", low ? p.lower : p.upper);
+  } else {
+    return false;
+  }
+  p.determined = false;
+  return true;
 }
 
 }  // namespace mbid::updating

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "mbid/identification/release.h"
+#include "mbid/updating/credibility.h"
 
 namespace mbid::validation {
 namespace {
@@ -81,6 +82,23 @@ Measurement MoveRelease(const Measurement& record, double delta_s) {
 
 Measurement AsFitted(const Measurement& cut, const updating::TestFit& fit) {
   return fit.release_shift_s == 0 ? cut : MoveRelease(cut, fit.release_shift_s);
+}
+
+void WidenForReleases(const std::map<std::string, double>& added_variance,
+                      const updating::UpdateOptions& options, updating::UpdateResult* best) {
+  for (updating::ParameterEstimate& p : best->parameters) {
+    const auto added = added_variance.find(p.name);
+    if (added == added_variance.end() || !std::isfinite(p.std)) continue;
+    p.std = std::sqrt(p.std * p.std + added->second);
+    if (p.value != 0) p.relative_std = p.std / std::abs(p.value);
+    updating::SetInterval(p, best->std_inflation);  // from the widened std
+    // A parameter the release's uncertainty moves too far is no longer determined by the records.
+    if (p.determined && updating::MarkIfSpreadUndetermined(p, best->std_inflation,
+                                                           options.undetermined_relative_std)) {
+      p.why_undetermined += " with the release's uncertainty";
+      best->undetermined.push_back(p.name);
+    }
+  }
 }
 
 std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& model,
@@ -176,14 +194,7 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
   for (const auto& part : release_variance) {
     for (const auto& [name, variance] : part) added_variance[name] += variance;
   }
-  // The standard deviations and intervals of the final fit, widened by every release's part.
-  for (updating::ParameterEstimate& p : best->parameters) {
-    const auto added = added_variance.find(p.name);
-    if (added == added_variance.end() || !std::isfinite(p.std)) continue;
-    p.std = std::sqrt(p.std * p.std + added->second);
-    if (p.value != 0) p.relative_std = p.std / std::abs(p.value);
-    updating::SetInterval(p, best->std_inflation);  // from the widened std
-  }
+  WidenForReleases(added_variance, options, best);
   for (size_t i = 0; i < detected.size(); ++i) {
     const std::string& name = (*records)[detected[i]].name;
     if (detected[i] < best->tests.size() && placed[i]) {

@@ -14,6 +14,13 @@ namespace mbid::updating {
 void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& tests,
                        const UpdateOptions& options);
 
+// Marks `p` undetermined, with the reason, where its spread says the records do not determine
+// it: no finite std, a relative std (times `std_inflation`) above `undetermined_relative_std`,
+// or an interval (ParameterEstimate::interval_lower, already set) reaching a bound. Returns
+// whether it did; `p` is left as it is otherwise.
+bool MarkIfSpreadUndetermined(ParameterEstimate& p, double std_inflation,
+                              double undetermined_relative_std);
+
 // Shared parameters the records can tell only through the model's nonlinear coupling: in the
 // tuned model's linearization every mode the parameter moves is invisible in the records'
 // channels (a swing mode of a symmetric arm in its inclinometers). A fit then reads the

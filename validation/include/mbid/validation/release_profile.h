@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,13 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
                                                std::vector<updating::TestRecord>* records,
                                                const updating::UpdateOptions& options,
                                                updating::UpdateResult* best);
+
+// Widens each shared parameter's std (and interval) of `best` by the variance the releases'
+// uncertainty adds to it (by name), and marks a parameter the widened spread no longer
+// determines (UpdateOptions::undetermined_relative_std, an interval reaching a bound)
+// undetermined, the reason saying so. Part of PlaceDetectedReleases.
+void WidenForReleases(const std::map<std::string, double>& added_variance,
+                      const updating::UpdateOptions& options, updating::UpdateResult* best);
 
 // `record` with its release `delta_s` later: every sample's time from the release less by
 // `delta_s`; samples that would come before the release are left out.
