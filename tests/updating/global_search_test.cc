@@ -68,6 +68,10 @@ TEST(GlobalSearchTest, FindsTheTrueMinimumAndReportsTheSwappedOneAsAlternative) 
   const LoadDrop drop(8.0);
   GlobalSearchOptions search;
   search.threads = 2;
+  // 4 design points for CI time: the true minimum and the swapped alternative are reached from
+  // the same starts as with the default 12 (measured: best chi^2/dof 0.998 with either; 3 minima
+  // kept against 4).
+  search.design_starts = 4;
   const GlobalSearchResult result =
       SearchGlobally(*drop.crane.model, {drop.test}, drop.Options(), "design", {}, search);
   ASSERT_FALSE(result.minima.empty());
