@@ -2,9 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "mbid/common/output_folder.h"
 #include "mbid/report/run_folder.h"
@@ -57,6 +60,21 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
     early.Start(test, test_count);
   };
   const validation::CycleResult cycle = validation::RunCycle(scenario, options);
+  // What the reading, the identification and the fits doubt is said even with --quiet, as
+  // `mbid update` says it (the report has it too); a line shared by jointly tuned tests once.
+  std::vector<std::string> warnings;
+  for (const validation::RunTest& test : cycle.tests) {
+    const std::string prefix = cycle.tests.size() > 1 ? "test " + test.name + ": " : "";
+    std::vector<std::string> lines;
+    if (test.import && common.quiet) lines = test.import->warnings;  // else in the progress
+    lines.insert(lines.end(), test.identified.warnings.begin(), test.identified.warnings.end());
+    lines.insert(lines.end(), test.tuned.warnings.begin(), test.tuned.warnings.end());
+    for (const std::string& line : lines) {
+      if (std::find(warnings.begin(), warnings.end(), line) != warnings.end()) continue;
+      warnings.push_back(line);
+      std::cerr << "mbid: warning: " << prefix << line << "\n";
+    }
+  }
   progress.Say(cycle.verdict_line);
   for (const std::string& reason : cycle.reasons) {
     // Said even with --quiet: a run that did not pass says why.

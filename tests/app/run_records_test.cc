@@ -258,8 +258,11 @@ TEST_F(RunRecordsTest, FieldRecordIsCutAtTheReleaseAndItsOffsetsFitted) {
   mbid::WriteMeasurementCsv(field, (dir_ / "field.csv").string());
   std::ofstream(base, std::ios::app) << "record: {name: field, file: field.csv}\n";
   const fs::path out = dir_ / "run";
-  const CommandResult result = Run("run " + base.string() + " -o " + out.string());
+  const CommandResult result = Run("run " + base.string() + " -o " + out.string() + " --quiet");
   ASSERT_EQ(result.exit_code, 0) << result.err;
+  // Where the fit put the release is said on standard error too, under --quiet as by `update`.
+  EXPECT_NE(result.err.find("mbid: warning: field: the fit places the release"), std::string::npos)
+      << result.err;
   const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));
   const nlohmann::json& test = summary["tests"][0];
   EXPECT_EQ(test["release"]["release"], "detected");
