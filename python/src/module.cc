@@ -40,6 +40,61 @@ py::dict Units(const mbid::Measurement& m) {
   return units;
 }
 
+// A path given as str or os.PathLike (pathlib.Path), or nothing.
+std::optional<std::string> AsPath(const py::handle& object) {
+  if (py::isinstance<py::str>(object)) return object.cast<std::string>();
+  if (py::hasattr(object, "__fspath__")) {
+    return py::module_::import("os").attr("fspath")(object).cast<std::string>();
+  }
+  return std::nullopt;
+}
+
+std::string TypeName(const py::handle& object) {
+  return py::str(py::type::of(object).attr("__name__")).cast<std::string>();
+}
+
+// A path argument (str or os.PathLike), else a one-line TypeError.
+std::string PathArgument(const py::object& object, const std::string& function) {
+  if (const auto path = AsPath(object)) return *path;
+  throw py::type_error(function + "(): path is of type " + TypeName(object) +
+                       "; expected a str or os.PathLike");
+}
+
+// A scenario argument: an mbid.Scenario or the path of its file. Anything else is a TypeError of
+// one line naming the function and the argument (pybind11's own lists every overload).
+mbid::Scenario AsScenario(const py::object& object, const std::string& function) {
+  if (py::isinstance<mbid::Scenario>(object)) return object.cast<mbid::Scenario>();
+  if (const auto path = AsPath(object)) return mbid::LoadScenario(*path);
+  throw py::type_error(function + "(): scenario is of type " + TypeName(object) +
+                       "; expected an mbid.Scenario or the path of a scenario file");
+}
+
+// A record argument: an mbid.Record or the path of a record file.
+mbid::Measurement AsRecord(const py::handle& object, const std::string& function,
+                           const std::string& argument) {
+  if (py::isinstance<mbid::Measurement>(object)) return object.cast<mbid::Measurement>();
+  if (const auto path = AsPath(object)) return mbid::ReadRecord(*path);
+  throw py::type_error(function + "(): " + argument + " is of type " + TypeName(object) +
+                       "; expected an mbid.Record or the path of a record file");
+}
+
+// update()'s records: a list (any iterable) of records or paths, or a single one.
+std::vector<mbid::Measurement> AsRecords(const py::object& object) {
+  std::vector<mbid::Measurement> records;
+  if (py::isinstance<mbid::Measurement>(object) || AsPath(object)) {
+    records.push_back(AsRecord(object, "update", "records"));
+  } else if (py::isinstance<py::iterable>(object)) {
+    for (const py::handle item : object) {
+      records.push_back(
+          AsRecord(item, "update", "records[" + std::to_string(records.size()) + "]"));
+    }
+  } else {
+    throw py::type_error("update(): records is of type " + TypeName(object) +
+                         "; expected a list of mbid.Record or of record file paths");
+  }
+  return records;
+}
+
 using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 // `object` as a one-dimensional float64 array, or an InputError naming `field`: real numbers only
@@ -326,10 +381,12 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readonly("identified", &mbid::ValidationResult::identified)
       .def_readonly("updated", &mbid::ValidationResult::updated);
 
-  // Paths as str or os.PathLike (pathlib.Path).
+  // Paths as str or os.PathLike (pathlib.Path); a scenario or record argument may be one.
   m.def(
       "load_scenario",
-      [](const std::filesystem::path& path) { return mbid::LoadScenario(path.string()); },
+      [](const py::object& path) {
+        return mbid::LoadScenario(PathArgument(path, "load_scenario"));
+      },
       py::arg("path"), "Reads a scenario file.");
   m.def("load_scenario_text", &mbid::LoadScenarioFromText, py::arg("yaml"),
         py::arg("source") = "scenario", "A scenario from YAML text.");
@@ -337,23 +394,34 @@ PYBIND11_MODULE(_mbid, m) {
       "default_scenario_path",
       [](const std::string& hint) { return mbid::DefaultScenarioPath(hint); },
       py::arg("data_dir_hint") = "", "The built-in reference scenario's file.");
-  m.def("simulate", &mbid::Simulate, py::arg("scenario"), py::call_guard<py::gil_scoped_release>(),
-        "Simulates the scenario's test: a Record.");
+  m.def(
+      "simulate",
+      [](const py::object& scenario_object) {
+        const mbid::Scenario scenario = AsScenario(scenario_object, "simulate");
+        py::gil_scoped_release release;
+        return mbid::Simulate(scenario);
+      },
+      py::arg("scenario"), "Simulates the scenario's test (a Scenario or its file): a Record.");
   m.def(
       "read_record",
-      [](const std::filesystem::path& path) { return mbid::ReadRecord(path.string()); },
+      [](const py::object& path) { return mbid::ReadRecord(PathArgument(path, "read_record")); },
       py::arg("path"), "Reads a record file (CSV, HDF5, MAT, UFF58, LVM), SI units.");
   m.def(
       "identify",
-      [](const mbid::Measurement& record, const IdentificationOptions& options,
-         const std::optional<mbid::Scenario>& scenario) {
+      [](const py::object& record_object, const IdentificationOptions& options,
+         const py::object& scenario_object) {
+        const mbid::Measurement record = AsRecord(record_object, "identify", "record");
+        std::optional<mbid::Scenario> scenario;
+        if (!scenario_object.is_none()) scenario = AsScenario(scenario_object, "identify");
+        py::gil_scoped_release release;
         return scenario ? mbid::IdentifyTest(record, *scenario, options)
                         : mbid::Identify(record, options);
       },
       py::arg("record"), py::arg("options") = IdentificationOptions(),
-      py::arg("scenario") = py::none(), py::call_guard<py::gil_scoped_release>(),
-      "Identifies the modes of a free-decay record (options: IdentificationOptions); with the "
-      "scenario of its test, after an impulse or burst from where the forcing ends.");
+      py::arg("scenario") = py::none(),
+      "Identifies the modes of a free-decay record (a Record or its file; options: "
+      "IdentificationOptions); with the scenario of its test, after an impulse or burst from "
+      "where the forcing ends.");
   m.def(
       "identify_arrays",
       [](const py::object& time, const std::map<std::string, py::object>& channels,
@@ -368,23 +436,30 @@ PYBIND11_MODULE(_mbid, m) {
       "values}.");
   m.def(
       "update",
-      [](const mbid::Scenario& scenario, const std::vector<mbid::Measurement>& records) {
+      [](const py::object& scenario_object, const py::object& records_object) {
+        const mbid::Scenario scenario = AsScenario(scenario_object, "update");
+        const std::vector<mbid::Measurement> records = AsRecords(records_object);
+        py::gil_scoped_release release;
         return mbid::Update(scenario, records);
       },
-      py::arg("scenario"), py::arg("records"), py::call_guard<py::gil_scoped_release>(),
-      "Tunes the scenario's model to the records: .parameters['c_alpha'].value, .std.");
+      py::arg("scenario"), py::arg("records"),
+      "Tunes the scenario's model (a Scenario or its file) to the records (Records or their "
+      "files): .parameters['c_alpha'].value, .std.");
   m.def(
       "run",
-      [](const mbid::Scenario& scenario, const std::optional<std::filesystem::path>& output_folder,
-         bool overwrite, bool quiet) {
+      [](const py::object& scenario_object,
+         const std::optional<std::filesystem::path>& output_folder, bool overwrite, bool quiet) {
+        const mbid::Scenario scenario = AsScenario(scenario_object, "run");
         mbid::ValidationOptions options;
         // None: in memory (a default path would come back from Python as ".").
         if (output_folder) options.output_folder = output_folder->string();
         options.overwrite = overwrite;
         options.quiet = quiet;
+        py::gil_scoped_release release;
         return mbid::RunValidationCycle(scenario, options);
       },
       py::arg("scenario"), py::arg("output_folder") = py::none(), py::arg("overwrite") = false,
-      py::arg("quiet") = true, py::call_guard<py::gil_scoped_release>(),
-      "The validation cycle in memory: .verdict is 'passed', 'failed' or 'inconclusive'.");
+      py::arg("quiet") = true,
+      "The validation cycle of a Scenario (or its file) in memory: .verdict is 'passed', "
+      "'failed' or 'inconclusive'.");
 }

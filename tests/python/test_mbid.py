@@ -290,6 +290,44 @@ class ErrorTest(unittest.TestCase):
             mbid.read_record(pathlib.Path("/nonexistent/record.csv"))
         self.assertIn("/nonexistent/record.csv", str(raised.exception))
 
+    def test_scenarios_and_records_may_be_given_as_their_files(self):
+        # A path where a Scenario or Record is expected is read as load_scenario / read_record
+        # would: the same bits as the objects give.
+        with tempfile.TemporaryDirectory() as folder:
+            h5 = pathlib.Path(folder) / "test.h5"
+            subprocess.run([MBID_BINARY, "simulate", REFERENCE, "-o", str(h5), "--quiet"],
+                           check=True)
+            by_path = mbid.update(REFERENCE, [h5])
+            by_object = mbid.update(mbid.load_scenario(REFERENCE), [mbid.read_record(h5)])
+            single = mbid.update(REFERENCE, str(h5))  # one record, not in a list
+            identified = mbid.identify(str(h5))
+            self.assertEqual(identified.modes[0].frequency_hz,
+                             mbid.identify(mbid.read_record(h5)).modes[0].frequency_hz)
+        for name in ["c_alpha", "d_theta"]:
+            self.assertEqual(by_path.parameters[name].value, by_object.parameters[name].value)
+            self.assertEqual(single.parameters[name].value, by_object.parameters[name].value)
+        simulated = mbid.simulate(pathlib.Path(REFERENCE))
+        np.testing.assert_array_equal(simulated.time,
+                                      mbid.simulate(mbid.load_scenario(REFERENCE)).time)
+        self.assertEqual(mbid.run(REFERENCE).verdict, "passed")
+
+    def test_arguments_of_the_wrong_type_are_refused_in_one_line(self):
+        # pybind11's own TypeError lists every signature over several lines; these name the
+        # function, the argument and what it takes.
+        cases = [(lambda: mbid.load_scenario(3), "load_scenario(): path is of type int"),
+                 (lambda: mbid.read_record(None), "read_record(): path is of type NoneType"),
+                 (lambda: mbid.simulate(3.5), "simulate(): scenario is of type float"),
+                 (lambda: mbid.identify({}), "identify(): record is of type dict"),
+                 (lambda: mbid.update(REFERENCE, 7), "update(): records is of type int"),
+                 (lambda: mbid.update(REFERENCE, [7]), "update(): records[0] is of type int"),
+                 (lambda: mbid.run([]), "run(): scenario is of type list")]
+        for call, start in cases:
+            with self.assertRaises(TypeError) as raised:
+                call()
+            message = str(raised.exception)
+            self.assertTrue(message.startswith(start), message)
+            self.assertEqual(message.count("\n"), 0, message)
+
     def test_units_are_converted_to_si_or_refused(self):
         # A unit decay stated in deg comes back with amplitude pi / 180 rad, as a file's would;
         # a unit udunits2 does not know, and the ambiguous 'g', are refused with the channel.
