@@ -169,6 +169,13 @@ TEST(UpdatingGlueTest, TwoDetectedReleasesArePlacedTogether) {
   };
   EXPECT_NEAR(first_time(records[0].record), 0.0, 0.02 * tau);
   EXPECT_NEAR(first_time(records[1].record), 0.0, 0.02 * tau);
+  // Noise-free: each within its own std (0.0024 samples); three sweeps alone left the first 4
+  // of its std off, and c_theta 2.3 of its.
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_NEAR(best.tests[k].release_shift_s, k == 0 ? 0.0 : -0.4 * tau,
+                best.tests[k].release_shift_std_s)
+        << k;
+  }
   for (const char* name : {"c_alpha", "c_gamma", "c_eta", "c_theta", "d_alpha", "d_theta"}) {
     const double truth = crane.model->GetParameter(name);
     // Within 2 of the standard deviations 1e-5 rad of noise would give (widened by the
@@ -195,6 +202,30 @@ TEST(UpdatingGlueTest, AReleaseDetectedSixSamplesLateIsPlacedBack) {
   // The cut left out samples 0-5; sample 6 is at 6 tau from the true release.
   EXPECT_NEAR(records[0].record.start_time_s, 6 * tau, 0.02 * tau);
   EXPECT_NEAR(best.tests[0].release_shift_s, -6 * tau, 0.02 * tau);
+  EXPECT_NEAR(best.tests[0].release_shift_s, -6 * tau, best.tests[0].release_shift_std_s);
+}
+
+// A release known sharply: the noise-free crane at 100 Hz, weighted as 1e-5 rad of noise, pins
+// it to 0.0024 samples, and a record cut 0.3 samples late must be placed back to that, not to
+// what a parabola through half a sample either way says (0.01 samples, 4 of its std, off before).
+TEST(UpdatingGlueTest, AReleaseIsPlacedToItsOwnStdWhereTheRecordPinsIt) {
+  const DetectedReleases setup(2.0, 100.0);
+  const auto& [crane, exact, settings] = std::tie(setup.crane, setup.exact, setup.settings);
+  const double tau = exact.sample_interval_s;
+  std::vector<updating::TestRecord> records{
+      setup.Test("late", validation::MoveRelease(exact, 0.3 * tau))};
+  updating::UpdateResult best = updating::UpdateModel(*crane.model, records, settings.options);
+  ASSERT_NE(best.termination, updating::UpdateResult::Termination::kFailure);
+  const double detected_cost = best.final_cost;
+  validation::PlaceDetectedReleases(*crane.model, &records, settings.options, &best);
+  const double std_s = best.tests[0].release_shift_std_s;
+  EXPECT_LT(std_s, 0.01 * tau);
+  EXPECT_NEAR(best.tests[0].release_shift_s, -0.3 * tau, std_s);
+  EXPECT_LT(best.final_cost, detected_cost);
+  for (const char* name : {"c_alpha", "c_gamma", "c_eta", "c_theta", "d_alpha", "d_theta"}) {
+    const double truth = crane.model->GetParameter(name);
+    EXPECT_NEAR(best.Find(name).value, truth, best.Find(name).std) << name;  // noise-free
+  }
 }
 
 // The release's uncertainty widens a parameter's std; where the widened spread passes what the

@@ -13,13 +13,15 @@ namespace mbid::validation {
 // to a fraction of a sample, and the fit of a long finely sampled record is far more precise
 // than that: half a sample at 2 kHz moved the crane's c_theta by 24 of its standard deviations.
 // So the fit places the release too. For each such test the cost is profiled over the instant:
-// local fits from `best` with the test's samples moved half a sample either way (the other
-// tests as they are); the parabola's least point (at most two samples on per round; two rounds, up
-// to eight while the step is clamped) is where the test's record is moved, and `best` is refitted
-// there. Its curvature gives the instant's standard deviation, and each shared parameter's std
-// gains what that uncertainty moves it by (the two fits' slope times it). `records` are moved in
-// place; each placed test's shift and its std go to best->tests[t] (TestFit::release_shift_s);
-// returns one line per test.
+// local fits from `best` with the test's samples moved either way (the other tests as they
+// are), half a sample first, then twice the instant's std; Newton steps on the parabola (at most
+// two samples each, taken only where they lower the cost) until a step at that scale is a tenth
+// of the std, and `best` is refitted there. Several tests are placed in sweeps (Aitken's limit
+// after two) until no release moves by a tenth of its std. The curvature gives the instant's
+// standard deviation, and each shared parameter's std gains what that uncertainty moves it by
+// (the slope of the two fits beside it times it); a parameter it widens past what the records
+// determine is marked undetermined. `records` are moved in place; each placed test's shift and
+// its std go to best->tests[t] (TestFit::release_shift_s); returns one line per test.
 std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& model,
                                                std::vector<updating::TestRecord>* records,
                                                const updating::UpdateOptions& options,
