@@ -140,6 +140,32 @@ TEST(ReleaseTest, AnAccelerometerBesideANoisyAngleIsWithinHalfASample) {
   RecordProperty("a_sample_early", early);
 }
 
+// A sensor the test does not excite (the out-of-plane accelerometer of a planar load drop)
+// records noise alone: its whole range is a few noise std, which any fraction of it crossed at
+// once, and the release beside it was not found (the record analysed from its start). The
+// onset is looked for in the channels with a signal; the noise channel's level at rest is
+// reported all the same.
+TEST(ReleaseTest, AChannelOfNoiseAloneDoesNotHideTheRelease) {
+  const Release test;
+  for (unsigned seed = 1; seed < 5; ++seed) {
+    const Measurement angle = test.Record("rad", seed);
+    Measurement both = angle;
+    both.channels = {"theta", "quiet"};
+    both.units = {"rad", "m/s^2"};
+    both.values.resize(angle.samples(), 2);
+    both.values.col(0) = angle.values.col(0);
+    std::mt19937_64 rng(seed + 50);
+    std::normal_distribution<double> normal(0.02, 0.005);  // an offset and its noise
+    for (int j = 0; j < angle.samples(); ++j) both.values(j, 1) = normal(rng);
+    const ReleaseDetection found = DetectRelease(both);
+    ASSERT_TRUE(found.detected) << seed;
+    EXPECT_NEAR(found.release_time_s, test.release_s, 0.3 * test.interval_s) << seed;
+    ASSERT_EQ(found.rest_level.size(), 2u);
+    EXPECT_NEAR(found.rest_level[0], test.deflected, 1e-5);
+    EXPECT_NEAR(found.rest_level[1], 0.02, 0.002);  // the median of 124 draws of std 0.005
+  }
+}
+
 // A record that starts at the release (as mbid simulates them) or in the middle of the decay
 // has nothing at rest before it: the release is its start.
 TEST(ReleaseTest, RecordStartingInTheDecayHasNoRestSegment) {
