@@ -227,6 +227,37 @@ TEST_F(MachineCliTest, UpdateTakesTheCoordinateChannelsSimulateWrites) {
   EXPECT_LT(std::abs(c_theta["value"].get<double>() - 9.4e6), 4 * c_theta["std"].get<double>());
 }
 
+// A slide released from a deflection of 10 mm, its deflection fitted as a nuisance parameter:
+// a length, reported in m (it was labelled rad), and recovered within 4 of its std.
+TEST_F(MachineCliTest, AFittedSlideDeflectionIsALength) {
+  const fs::path scenario = dir_ / "slide.yaml";
+  std::ofstream(scenario) << R"(name: slide
+model:
+  type: multibody
+  bodies:
+    cart: {parent: ground, joint: {type: prismatic, coordinates: [x], axis: [1, 0, 0]}, mass_kg: 1000.0, inertia_kgm2: [100, 100, 100]}
+  springs:
+    x: {stiffness_N_per_m: 1.0e6, damping_Ns_per_m: 2000.0}
+  outputs: {x_cart: {type: coordinate, coordinate: x}}
+excitation: {type: initial_deflection, deflection_m: {x: 0.01}}
+simulation: {duration_s: 2}
+sensors: {sample_rate_hz: 200, channels: [x_cart], noise_std_m: 1.0e-5, seed: 3}
+updating: {fit_initial_deflection: true, global_search: {enabled: false}}
+)";
+  const fs::path record = dir_ / "slide.h5";
+  ASSERT_EQ(Run("simulate " + scenario.string() + " -o " + record.string()).exit_code, 0);
+  const fs::path json = dir_ / "update.json";
+  const CommandResult result =
+      Run("update " + scenario.string() + " " + record.string() + " --json " + json.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json parameters = nlohmann::json::parse(ReadText(json))["parameters"];
+  const std::string name = record.string() + ":deflection_x";
+  ASSERT_TRUE(parameters.contains(name)) << parameters.dump();
+  EXPECT_EQ(parameters[name]["units"], "m");
+  EXPECT_NEAR(parameters[name]["value"].get<double>(), 0.01,
+              4 * parameters[name]["std"].get<double>());
+}
+
 struct BadMachine {
   const char* name;
   const char* from;

@@ -75,7 +75,9 @@ std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,
         Unknown unknown;
         unknown.kind = Unknown::Kind::kDeflection;
         unknown.name = test.name + ":deflection_" + coordinate;
-        unknown.units = "rad";
+        // A prismatic coordinate's deflection is a length (excitation.deflection_m).
+        const std::string unit = model.coordinate_unit(coordinate);
+        unknown.units = unit.empty() ? "rad" : unit;
         unknown.test = static_cast<int>(t);
         unknown.coordinate = coordinate;
         unknown.log_scale = false;
