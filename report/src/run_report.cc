@@ -427,16 +427,20 @@ std::vector<std::pair<std::string, double>> CalcRelativeSpread(
   if (results.empty()) return spread;
   for (const updating::ParameterEstimate& p : results.front()->parameters) {
     if (!p.test.empty()) continue;  // a nuisance parameter of one test
-    double lowest = p.value, highest = p.value;
+    // Determined values only: an undetermined one is where its fit happened to stop (a test
+    // that does not excite the joint keeps its start), and its spread says nothing of the joint.
+    double lowest = INFINITY, highest = -INFINITY;
+    int count = 0;
     for (const updating::UpdateResult* result : results) {
       for (const updating::ParameterEstimate& q : result->parameters) {
-        if (q.name == p.name && q.test.empty()) {
+        if (q.name == p.name && q.test.empty() && q.determined) {
           lowest = std::min(lowest, q.value);
           highest = std::max(highest, q.value);
+          ++count;
         }
       }
     }
-    spread.emplace_back(p.name, (highest - lowest) / highest);
+    spread.emplace_back(p.name, count >= 2 ? (highest - lowest) / highest : NAN);
   }
   return spread;
 }
@@ -462,8 +466,11 @@ std::string TestsTableMarkdown(const std::vector<std::string>& test_names,
     out << "\n";
   }
   out << "| relative spread, % |";
-  for (const auto& [name, value] : spread) out << fmt::format(" {:.0f} |", 100 * value);
-  out << "\n";
+  for (const auto& [name, value] : spread) {
+    out << (std::isfinite(value) ? fmt::format(" {:.0f} |", 100 * value) : std::string(" - |"));
+  }
+  out << "\n\nThe spread is over the determined values (\"-\": fewer than two tests determine the "
+         "parameter).\n";
   return out.str();
 }
 

@@ -86,8 +86,9 @@ std::string TunedParametersMarkdown(const updating::UpdateResult& result,
 std::string TestsTableMarkdown(const std::vector<std::string>& test_names,
                                const std::vector<const updating::UpdateResult*>& results);
 
-// The relative spread (max - min) / max of each shared parameter over the results (names in the
-// first result's order; nuisance parameters of single tests left out).
+// The relative spread (max - min) / max of each shared parameter over the results where it is
+// determined (NaN where fewer than two determine it; names in the first result's order; nuisance
+// parameters of single tests left out).
 std::vector<std::pair<std::string, double>> CalcRelativeSpread(
     const std::vector<const updating::UpdateResult*>& results);
 // Route 1's solution sets (eq. 7), admissible or not, with their initial-state mismatch.
