@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -211,7 +212,7 @@ int WriteRunFolder(const validation::CycleResult& cycle, const validation::Scena
     for (const RunTest& test : tests) results.push_back(&test.tuned);
     nlohmann::json spread = nlohmann::json::object();
     for (const auto& [name, value] : CalcRelativeSpread(results)) {
-      spread[name] = value;
+      spread[name] = std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
       run.WriteScalar("/validation/spread", name, value, "1");
     }
     summary["spread"] = spread;
