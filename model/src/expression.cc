@@ -45,7 +45,9 @@ double ExpressionContext::Evaluate(const std::string& text) const {
         std::isalpha(static_cast<unsigned char>(token[0]))) {
       throw std::invalid_argument("unknown parameter '" + token + "' in '" + text + "'");
     }
-    throw std::invalid_argument("'" + text + "' does not parse: " + error.GetMsg());
+    std::string why = error.GetMsg();  // muparser's sentence ends with a full stop
+    while (!why.empty() && (why.back() == '.' || why.back() == ' ')) why.pop_back();
+    throw std::invalid_argument("'" + text + "' does not parse: " + why);
   }
   if (!std::isfinite(value)) {
     throw std::invalid_argument("'" + text + "' is not finite (" + std::to_string(value) + ")");

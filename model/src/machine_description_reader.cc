@@ -1,5 +1,6 @@
 // Reads `model: {type: multibody}` (docs/machine-description.md) into a MachineDescription.
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -15,6 +16,13 @@ double Number(const YamlReader& node, const ExpressionContext& context) {
   const YAML::Node& yaml = node.node();
   if (!yaml.IsScalar()) node.Fail("is not a number", "a number or an expression of parameters");
   const std::string& text = yaml.Scalar();
+  // YAML's own infinities and NaN are numbers to YAML, not to an expression parser.
+  std::string lower = text;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (lower == ".nan" || lower == ".inf" || lower == "+.inf" || lower == "-.inf") {
+    node.Fail("'" + text + "' is not finite", "a finite number or an expression of parameters");
+  }
   char* end = nullptr;
   std::strtod(text.c_str(), &end);
   const bool plain_number = !text.empty() && end == text.c_str() + text.size() && yaml.Tag() != "!";
@@ -238,6 +246,15 @@ MachineDescription ReadMachineDescription(const YamlReader& model) {
     BodyDescription result;
     result.name = name;
     result.parent = body.String("parent");
+    // Said here, before the springs and outputs: a missing parent body leaves its coordinates
+    // unknown to them, and their error named the symptom (MachineDescription::Validate checks it
+    // too, for descriptions made in code).
+    if (result.parent != "ground" &&
+        std::none_of(machine.bodies.begin(), machine.bodies.end(),
+                     [&](const BodyDescription& b) { return b.name == result.parent; })) {
+      body.FailAt("parent", "parent '" + result.parent + "' is not defined above",
+                  "ground or a body listed before '" + name + "'");
+    }
     result.joint = ReadJoint(body.Child("joint"), context);
     result.mass_kg = Number(body, "mass_kg", context);
     result.com_m = Vector3(body, "com_m", context, Eigen::Vector3d::Zero());

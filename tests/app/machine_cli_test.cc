@@ -288,6 +288,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadMachine{"ParentBelow", "parent: boom, joint: {type: revolute, coordinates: [stick]",
                    "parent: bucket, joint: {type: revolute, coordinates: [stick]",
                    "model.bodies.stick.parent"},
+        // The boom's body gone (here renamed with its coordinate): the stick's parent is
+        // named, not the boom spring that lost its coordinate.
+        BadMachine{"ParentMissing",
+                   "boom:  {parent: upper, joint: {type: revolute, coordinates: [boom]",
+                   "lift:  {parent: upper, joint: {type: revolute, coordinates: [lift]",
+                   "model.bodies.stick.parent"},
+        // YAML's NaN is a number to YAML: said so, not as a parser's complaint about ".nan ".
+        BadMachine{"NanMass", "mass_kg: 1800.0", "mass_kg: .nan",
+                   "model.bodies.boom.mass_kg: '.nan' is not finite"},
         BadMachine{"ZeroAxis", "coordinates: [swing], axis: [0, 0, 1]",
                    "coordinates: [swing], axis: [0, 0, 0]", "model.bodies.upper.joint.axis"},
         BadMachine{"TriangleInequality", "[40.0, 700.0, 700.0]", "[40.0, 700.0, 1700.0]",
