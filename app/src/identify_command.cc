@@ -58,8 +58,8 @@ int RunIdentifyCommand(const std::string& data_path,
     for (const std::string& w : import.warnings)
       std::cerr << "mbid: warning: " + data_path + ": " + w + "\n";
   }
-  const identification::ModalResult result =
-      identification::Identify(measurement, options, data_path);
+  identification::ModalResult result = identification::Identify(measurement, options, data_path);
+  validation::AddImportDoubts(import, &result);
 
   std::unique_ptr<H5Writer> file;
   if (!output_path.empty()) {

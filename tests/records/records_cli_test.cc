@@ -123,7 +123,7 @@ TEST_F(RecordsCliTest, IdentifyFillsGapsAndReportsTheImport) {
 // it (x rate / 100 Hz; x 1000 when the logger's ms are read as us).
 // A unitless `time` column in ms (read in s by the contract) is doubted even under --quiet, as
 // every warning is (interfaces.md: --quiet drops progress lines, not warnings); the doubt is in
-// the JSON's import item too.
+// the JSON's import item too, and makes the result unreliable.
 TEST_F(RecordsCliTest, AMillisecondClockReadAsSecondsIsDoubtedEvenWhenQuiet) {
   std::string text = "time,x [m]\n";
   for (int j = 0; j < 801; ++j) text += fmt::format("{},{:.9g}\n", 10 * j, Decay(j * 0.01));
@@ -137,6 +137,12 @@ TEST_F(RecordsCliTest, AMillisecondClockReadAsSecondsIsDoubtedEvenWhenQuiet) {
       << quiet.err;
   const nlohmann::json summary = nlohmann::json::parse(quiet.out);
   ASSERT_EQ(summary["import"]["warnings"].size(), 1u) << summary["import"].dump();
+  // Every frequency may be 1000 times off: the result is not to be relied on, and says why.
+  EXPECT_FALSE(summary["reliable"].get<bool>());
+  ASSERT_FALSE(summary["reasons"].empty());
+  EXPECT_EQ(
+      summary["reasons"][0].get<std::string>().rfind("reading the record: the time column", 0), 0u)
+      << summary["reasons"].dump();
 }
 
 TEST_F(RecordsCliTest, TimeBaseFlagsSetTheSampleRateAndTheTimeUnit) {

@@ -105,4 +105,11 @@ nlohmann::json ImportReportToJson(const records::ImportReport& report) {
   return json;
 }
 
+void AddImportDoubts(const records::ImportReport& report, identification::ModalResult* identified) {
+  for (const std::string& warning : report.warnings) {
+    identified->reasons.push_back("reading the record: " + warning);
+    identified->reliable = false;
+  }
+}
+
 }  // namespace mbid::validation

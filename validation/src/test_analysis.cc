@@ -63,6 +63,7 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
       test.identified.reliable = false;
     }
   }
+  if (test.import) AddImportDoubts(*test.import, &test.identified);
   say(fmt::format("identified {} modes ({}), K = {:.3f}", test.identified.modes.size(),
                   test.identified.method, test.identified.correlation.minCoeff()));
   if (identified) identified(test);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "mbid/common/yaml_reader.h"
+#include "mbid/identification/modal_result.h"
 #include "mbid/model/mechanical_model.h"
 #include "mbid/records/records.h"
 
@@ -54,5 +55,10 @@ records::ImportOptions MergeImportOptions(const records::ImportOptions& base,
 // psi: deg -> rad (x 0.0174533), 2 gap samples filled".
 std::string DescribeImport(const records::ImportReport& report);
 nlohmann::json ImportReportToJson(const records::ImportReport& report);
+
+// The reading's doubts (ImportReport::warnings: a time column without a unit whose step looks
+// like ms) are doubts about the modes too: each becomes a reason of `identified`, which is then
+// unreliable. A record whose every frequency may be 1000 times off is no result to size on.
+void AddImportDoubts(const records::ImportReport& report, identification::ModalResult* identified);
 
 }  // namespace mbid::validation
