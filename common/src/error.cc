@@ -10,12 +10,30 @@
 namespace mbid {
 namespace {
 
+// `text` cut to its first and last characters where it is longer than `limit` bytes: a message
+// quotes file contents, and a 5 MB cell made a 5 MB error line. Cuts fall between UTF-8
+// characters.
+std::string Shorten(const std::string& text, size_t limit) {
+  if (text.size() <= limit) return text;
+  const auto boundary = [&text](size_t at) {
+    while (at > 0 && at < text.size() && (static_cast<unsigned char>(text[at]) & 0xC0) == 0x80) {
+      --at;
+    }
+    return at;
+  };
+  const size_t head = boundary(limit * 3 / 4);
+  const size_t tail = boundary(text.size() - limit / 4);
+  return text.substr(0, head) + fmt::format(" [... {} bytes ...] ", tail - head) +
+         text.substr(tail);
+}
+
 std::string FormatInputError(const std::string& source, const std::string& field,
                              const std::string& problem, const std::string& expected) {
-  std::string message = source;
-  if (!field.empty()) message += ":" + field;
-  message += ": " + problem;
-  if (!expected.empty()) message += "; expected " + expected;
+  constexpr size_t kLimit = 400;  // per part: a path, a key path, a problem, what was expected
+  std::string message = Shorten(source, kLimit);
+  if (!field.empty()) message += ":" + Shorten(field, kLimit);
+  message += ": " + Shorten(problem, kLimit);
+  if (!expected.empty()) message += "; expected " + Shorten(expected, kLimit);
   return OneLine(message);
 }
 

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -279,7 +280,16 @@ RawTable ReadCsv(const std::string& path) {
   std::vector<FirstText> text_in(columns.size());
   std::vector<bool> has_value(columns.size(), false);
   const auto not_a_number = [&path](const std::string& cell, const std::string& where) {
-    return InputError(path, where, "'" + cell + "' is not a number",
+    // A number a double cannot hold ('1e400', a 5 MB row of digits) is one, out of range.
+    errno = 0;
+    char* end = nullptr;
+    std::strtod(cell.c_str(), &end);
+    const bool out_of_range =
+        !cell.empty() && end == cell.c_str() + cell.size() && errno == ERANGE;
+    return InputError(path, where,
+                      "'" + cell + "' is " +
+                          (out_of_range ? "a number beyond a double's range (1e-308 to 1.8e308)"
+                                        : "not a number"),
                       "a decimal number, or an empty cell or NaN for a gap");
   };
   Metadata metadata;

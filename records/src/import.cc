@@ -345,7 +345,7 @@ std::vector<std::vector<double>> TakeValues(const RawTable& table, const std::st
   if (first_sample < 0) return values;
   const std::string field = SampleField(table, Describe(*first_column->column), first_sample);
   if (options.fill_gaps == GapFill::kRefuse) {
-    throw InputError(path, field, "empty cell (a gap in the record)",
+    throw InputError(path, field, "empty or NaN cell (a gap in the record)",
                      "a value in every cell, or gaps filled by `--fill-gaps linear` (record key "
                      "`fill_gaps: linear`)");
   }

@@ -36,6 +36,11 @@ const BadFile kBadFiles[] = {
     {"AngleAsTime", "Zeit [deg];x [mm]\n0;1\n1;2\n", "column 1 (Zeit)", "cannot be converted", "s"},
     {"FieldCount", "t [s];x [mm]\n0;1\n1;2\n2;3;4\n3;4\n", "line 4", "3 fields", "2 fields"},
     {"NotANumber", "t [s];x [mm]\n0;1\n1;zwei\n", "line 3, column 2 (x)", "'zwei'", "number"},
+    // A number, but none a double holds: said so, not "not a number".
+    {"BeyondADouble", "t [s];x [mm]\n0;1\n1;1e400\n", "line 3, column 2 (x)",
+     "'1e400' is a number beyond a double's range", "number"},
+    {"NanCell", "t [s];x [mm]\n0;1\n1;NaN\n2;3\n", "line 3, column 2 (x)", "empty or NaN cell",
+     "--fill-gaps linear"},
     {"NonUniformTime", "t [s];x [mm]\n0;1\n1;2\n2;3\n3.5;4\n4;5\n", "line 5", "non-uniform",
      "uniform"},
     {"DecreasingTime", "t [s];x [mm]\n0;1\n2;2\n1;3\n", "line 4", "decreases", "increasing"},
@@ -69,6 +74,20 @@ INSTANTIATE_TEST_SUITE_P(Records, BadFileTest, ::testing::ValuesIn(kBadFiles),
                          [](const ::testing::TestParamInfo<BadFile>& param_info) {
                            return std::string(param_info.param.name);
                          });
+
+// A cell of 100,000 digits (a logger's runaway line): the message quotes its start and end and
+// stays one line of a few hundred characters (it was the whole cell).
+TEST(BadFileMessageTest, AHugeCellIsQuotedShort) {
+  TempDir dir;
+  const std::string path = dir.File("huge.csv");
+  WriteText(path, "t [s];x [mm]\n0;1\n1;2x" + std::string(100000, '7') + "\n");
+  const InputError e = CatchInputError([&] { ImportMeasurement(path); });
+  const std::string message = e.what();
+  EXPECT_LT(message.size(), 1200u) << message.substr(0, 2000);
+  EXPECT_THAT(message, HasSubstr("line 3, column 2 (x): '2x777"));
+  EXPECT_THAT(message, HasSubstr(" bytes ...] 777"));
+  EXPECT_EQ(message.find('\n'), std::string::npos);
+}
 
 TEST(BadOptionsTest, UnknownMappedColumnListsTheColumns) {
   TempDir dir;
