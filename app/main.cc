@@ -146,7 +146,8 @@ int Main(int argc, char** argv) {
   std::string identify_offset = "fit";
   CLI::App* identify = app.add_subcommand(
       "identify", "Identify the modes of a free-decay record (HDF5, CSV or logger export)");
-  identify->add_option("DATA", data_path, "Measurement file (.h5, .csv, .txt)")->required();
+  identify->add_option("DATA", data_path, "Measurement file (.h5, .csv, .txt, .mat, .uff, .lvm)")
+      ->required();
   AddImportFlags(identify, &import_flags);
   identify->add_option("-o,--output", output_path, "Write /measurement and /identification (.h5)");
   identify->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
@@ -197,7 +198,9 @@ int Main(int argc, char** argv) {
   CLI::App* update = app.add_subcommand(
       "update", "Tune the joints' stiffness and damping to measurements (Route 1, then Ceres)");
   update->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
-  update->add_option("DATA", update_data, "Measurement files (.h5, .csv, .txt), one per test")
+  update
+      ->add_option("DATA", update_data,
+                   "Measurement files (.h5, .csv, .txt, .mat, .uff, .lvm), one per test")
       ->required();
   AddImportFlags(update, &import_flags);
   update->add_option("-o,--output", output_path, "Write /measurement, /scenario, /updating (.h5)");
@@ -211,7 +214,7 @@ int Main(int argc, char** argv) {
       "plan", "Rank candidate next tests by the information they add (D-optimal design)");
   plan->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
   plan->add_option("DATA", plan_data,
-                   "Recorded tests (.h5, .csv, .txt), one per test; none: "
+                   "Recorded tests (.h5, .csv, .txt, .mat, .uff, .lvm), one per test; none: "
                    "plan from the scenario's values");
   plan->add_option("--candidates", plan_candidates, "Candidate tests (YAML, docs/planning.md)")
       ->required();
@@ -224,7 +227,9 @@ int Main(int argc, char** argv) {
   CLI::App* structure = app.add_subcommand(
       "structure", "Rank structures (which joints really move) by BIC of their Route 2 fits");
   structure->add_option("SCENARIO", scenario_path, "Scenario YAML file")->required();
-  structure->add_option("DATA", structure_data, "Measurement files (.h5, .csv, .txt), one per test")
+  structure
+      ->add_option("DATA", structure_data,
+                   "Measurement files (.h5, .csv, .txt, .mat, .uff, .lvm), one per test")
       ->required();
   AddImportFlags(structure, &import_flags);
   structure

@@ -150,7 +150,35 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
       break;
     }
   }
-  return found;
+  if (found) return true;
+  // One column (a single channel logged without a time column: its sample rate comes from
+  // --sample-rate-hz): a name, maybe a units row, then numbers, one per line. The separator is
+  // one the lines do not hold, so that a decimal comma stays in its number.
+  for (const char separator : {'\t', ';', ','}) {
+    const bool absent = std::none_of(content.begin(), content.end(), [&](int i) {
+      return lines[static_cast<size_t>(i)].text.find(separator) != std::string::npos;
+    });
+    if (!absent) continue;
+    for (size_t k = 0; k + 1 < content.size(); ++k) {
+      const auto header = SplitFields(lines[content[k]].text, separator);
+      if (header.size() != 1 || header[0].empty() || IsDataRow(header, separator)) continue;
+      const auto next = SplitFields(lines[content[k + 1]].text, separator);
+      int units_row = -1;
+      if (!IsDataRow(next, separator)) {
+        if (k + 2 >= content.size() || !IsUnitsRow(next)) continue;
+        if (!IsDataRow(SplitFields(lines[content[k + 2]].text, separator), separator)) continue;
+        units_row = content[k + 1];
+      }
+      dialect->separator = separator;
+      dialect->header = content[k];
+      dialect->units_row = units_row;
+      dialect->field_count = 1;
+      dialect->preamble_lines = static_cast<int>(k);
+      return true;
+    }
+    break;
+  }
+  return false;
 }
 
 std::string CsvDialect::Describe(bool decimal_comma, bool thousands) const {

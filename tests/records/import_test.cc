@@ -258,6 +258,27 @@ TEST(ImportTest, NoTimeColumnWithSampleRate) {
   EXPECT_EQ(m.values(2, 1), 6.0);
 }
 
+// One channel logged without a time column: no separator anywhere, which the dialect search
+// needed (refused as "no header line followed by rows of numbers"). A decimal comma stays in its
+// number; a units row is read as with several columns.
+TEST(ImportTest, OneChannelWithoutATimeColumn) {
+  TempDir dir;
+  ImportOptions options;
+  options.sample_rate_hz = 100;
+  const std::string plain = dir.File("one.csv");
+  WriteText(plain, "# logger 7\npsi [mrad]\n1.5\n-2\n0.25\n");
+  const Measurement m = ImportMeasurement(plain, options);
+  ASSERT_EQ(m.channels, std::vector<std::string>{"psi"});
+  ASSERT_EQ(m.samples(), 3);
+  EXPECT_EQ(m.sample_interval_s, 0.01);
+  EXPECT_DOUBLE_EQ(m.values(1, 0), -2e-3);
+  const std::string comma = dir.File("komma.csv");
+  WriteText(comma, "Neigung\ndeg\n0,5\n1,25\n");
+  const Measurement c = ImportMeasurement(comma, options);
+  ASSERT_EQ(c.samples(), 2);
+  EXPECT_DOUBLE_EQ(c.values(1, 0), 1.25 * M_PI / 180);
+}
+
 TEST(ImportTest, MbidCsvAndHdf5RoundTripsStayBitExact) {
   TempDir dir;
   const Measurement written = mbid::testing::MakeMeasurement(300);

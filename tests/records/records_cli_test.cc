@@ -58,7 +58,7 @@ TEST_F(RecordsCliTest, IdentifyRefusesAGapNamingLineAndColumnAndWritesNothing) {
   const fs::path out = dir_ / "out.h5";
   const CommandResult result = Run("identify " + data.string() + " -o " + out.string() +
                                    " --json " + (dir_ / "s.json").string());
-  ExpectOneErrorLine(result, data.string() + ":line 104, column 2 (Boom angle): empty cell");
+  ExpectOneErrorLine(result, data.string() + ":line 104, column 2 (Boom angle): empty or NaN cell");
   EXPECT_NE(result.err.find("--fill-gaps linear"), std::string::npos) << result.err;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_FALSE(fs::exists(dir_ / "s.json"));
