@@ -192,6 +192,26 @@ void StatedRateGrid(const Eigen::VectorXd& time, const std::string& path, const 
     }
   }
   const bool beyond = high - low > resolution + tolerance;
+  if (beyond && time.size() > 2) {
+    // Another rate, not a dropped sample: the times lie on a grid of their own (a straight
+    // offset within the resolution), whose step is not the stated one. Named at the first
+    // sample off the stated grid, with the rate the column shows (it was named at the last
+    // sample, as "a dropped or repeated sample").
+    const Eigen::Index n = time.size();
+    const double step = (time[n - 1] - time[0]) / static_cast<double>(n - 1);
+    const Eigen::ArrayXd own =
+        time.array() - time[0] - step * Eigen::ArrayXd::LinSpaced(n, 0, static_cast<double>(n - 1));
+    if (own.maxCoeff() - own.minCoeff() <= resolution + tolerance) {
+      Eigen::Index j = 1;
+      while (j < n && std::abs(offset[j] - offset[0]) <= resolution + tolerance) ++j;
+      throw InputError(path, SampleField(table, "", std::min(j, n - 1)),
+                       fmt::format("the time column steps {:.6g} s ({:.6g} Hz), not the stated "
+                                   "{} Hz",
+                                   step, 1 / step, rate_hz),
+                       "the rate the time column shows, or no stated rate (the time column "
+                       "gives it)");
+    }
+  }
   const bool ties = high - low >= resolution - tolerance;
   const bool apart = last_low < first_high || last_high < first_low;
   if (beyond || (ties && apart)) {

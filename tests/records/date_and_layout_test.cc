@@ -16,6 +16,7 @@
 namespace mbid::records {
 namespace {
 
+using mbid::testing::CatchInputError;
 using mbid::testing::Decay;
 using mbid::testing::MakeExport;
 using mbid::testing::Print;
@@ -260,6 +261,17 @@ TEST(DateAndLayoutTest, AStatedRateSettlesACoarselyPrintedTimeColumn) {
   // A stated rate that is not the column's is refused too.
   options.sample_rate_hz = 81;
   EXPECT_THROW(ImportMeasurement(path, options), InputError);
+  // Where the column is printed finely enough to show its own grid (100 Hz to 1 ms), at the first
+  // sample off the stated grid and with the column's rate (it was named at the last sample, as
+  // a dropped or repeated one).
+  const std::string fine = dir.File("fine.csv");
+  WriteText(fine, MakeExport("t [s],psi [deg]\n", 800, [&](int j) {
+              return fmt::format("{:.3f},{}", j / 100.0, Print(psi(j / 100.0)));
+            }));
+  options.sample_rate_hz = 200;
+  const InputError other = CatchInputError([&] { ImportMeasurement(fine, options); });
+  EXPECT_THAT(other.what(),
+              HasSubstr(":line 3: the time column steps 0.01 s (100 Hz), not the stated 200 Hz"));
   // 200 Hz printed to 0.01 s: every other time repeats the one before (0.00, 0.01, 0.01, ...),
   // which the stated rate reads as its grid (it was refused as a repeated time).
   const std::string repeats = dir.File("repeats.csv");
