@@ -28,6 +28,10 @@ const std::map<std::string, std::string>& Aliases() {
   static const std::map<std::string, std::string> aliases = {
       {"deg", "degree"},
       {"degs", "degree"},
+      {"mdeg", "millidegree"},  // a prefix on an alias: udunits2 knows "millidegree" only
+      {"udeg", "microdegree"},
+      {"\u00b5deg", "microdegree"},  // micro sign
+      {"\u03bcdeg", "microdegree"},  // Greek mu
       {"gn", "standard_free_fall"},
       {"g0", "standard_free_fall"},
       {"g_n", "standard_free_fall"},

@@ -48,6 +48,10 @@ TEST(UnitsTest, ConversionFactors) {
   // udunits' factors against the definitions; 1e-15 relative: the last bits of its products.
   EXPECT_NEAR(FindConversion("deg", "rad", "f", "c").scale, M_PI / 180, 1e-15 * M_PI / 180);
   EXPECT_NEAR(FindConversion("°", "rad", "f", "c").scale, M_PI / 180, 1e-15 * M_PI / 180);
+  // Prefixed degrees as loggers print them (refused before: udunits2 has no "mdeg").
+  EXPECT_NEAR(FindConversion("mdeg", "rad", "f", "c").scale, M_PI / 180e3, 1e-15 * M_PI / 180e3);
+  EXPECT_NEAR(FindConversion("µdeg/s", "rad/s", "f", "c").scale, M_PI / 180e6,
+              1e-15 * M_PI / 180e6);
   EXPECT_DOUBLE_EQ(FindConversion("mm/s^2", "m/s^2", "f", "c").scale, 1e-3);
   EXPECT_DOUBLE_EQ(FindConversion("gn", "m/s^2", "f", "c").scale, 9.80665);  // CGPM 1901
   EXPECT_DOUBLE_EQ(FindConversion("g0", "m/s^2", "f", "c").scale, 9.80665);
