@@ -284,8 +284,7 @@ RawTable ReadCsv(const std::string& path) {
     errno = 0;
     char* end = nullptr;
     std::strtod(cell.c_str(), &end);
-    const bool out_of_range =
-        !cell.empty() && end == cell.c_str() + cell.size() && errno == ERANGE;
+    const bool out_of_range = !cell.empty() && end == cell.c_str() + cell.size() && errno == ERANGE;
     return InputError(path, where,
                       "'" + cell + "' is " +
                           (out_of_range ? "a number beyond a double's range (1e-308 to 1.8e308)"
@@ -409,6 +408,10 @@ RawTable ReadCsv(const std::string& path) {
   table.format = table.si_by_contract ? "mbid-csv" : "csv";
   table.dialect = dialect.Describe(decimal.mark == DecimalMark::kComma, thousands);
   if (date_column >= 0) table.dialect += fmt::format(", dates in column {}", date_column + 1);
+  if (timestamps) {
+    table.dialect += fmt::format(", timestamps read as s from the first ({}){}", first_text,
+                                 day_offset > 0 ? ", past midnight into the next day" : "");
+  }
   for (size_t c = 0; c < text_in.size(); ++c) {
     if (!text_in[c].cell.empty()) {
       table.dialect += fmt::format(", text in column {}{}, no channel", c + 1,

@@ -118,10 +118,14 @@ TEST(ImportTest, IsoTimestampsBecomeSecondsFromTheFirstSample) {
               return fmt::format("2026-03-01T12:00:{:02d}.{:03d}Z,{}", ms / 1000, ms % 1000,
                                  Print(angle(j * 0.01)));
             }));
-  const Measurement m = ImportMeasurement(path);
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, {}, &report);
   EXPECT_EQ(m.start_time_s, 0.0);                 // seconds from the first sample
   EXPECT_NEAR(m.sample_interval_s, 0.01, 1e-15);  // integer seconds subtracted first: exact
   ExpectChannel(m, 0, angle, kDeg);
+  // The import line says so, with the origin (the record's time 0 is that instant).
+  EXPECT_THAT(report.dialect,
+              HasSubstr("timestamps read as s from the first (2026-03-01T12:00:00.125Z)"));
 }
 
 TEST(ImportTest, TimePrintedWithFewDigitsIsFittedByLeastSquares) {
