@@ -100,6 +100,17 @@ struct DetectedReleases {
     test.release_detected = true;
     return test;
   }
+  // The exact record cut `samples` late, and the fit there (at the detected instant).
+  struct Late {
+    std::vector<updating::TestRecord> records;
+    updating::UpdateResult best;
+  };
+  Late CutLate(double samples) const {
+    Late late{{Test("late", validation::MoveRelease(exact, samples * exact.sample_interval_s))},
+              {}};
+    late.best = updating::UpdateModel(*crane.model, late.records, settings.options);
+    return late;
+  }
 };
 
 // Placing a detected release refits the best (release_profile.h): what the global search or
@@ -191,9 +202,7 @@ TEST(UpdatingGlueTest, AReleaseDetectedSixSamplesLateIsPlacedBack) {
   const DetectedReleases setup(1.0, 1000.0);
   const auto& [crane, exact, settings] = std::tie(setup.crane, setup.exact, setup.settings);
   const double tau = exact.sample_interval_s;
-  std::vector<updating::TestRecord> records{
-      setup.Test("late", validation::MoveRelease(exact, 6 * tau))};
-  updating::UpdateResult best = updating::UpdateModel(*crane.model, records, settings.options);
+  auto [records, best] = setup.CutLate(6);
   ASSERT_NE(best.termination, updating::UpdateResult::Termination::kFailure);
   const std::vector<std::string> lines =
       validation::PlaceDetectedReleases(*crane.model, &records, settings.options, &best);
@@ -212,9 +221,7 @@ TEST(UpdatingGlueTest, AReleaseIsPlacedToItsOwnStdWhereTheRecordPinsIt) {
   const DetectedReleases setup(2.0, 100.0);
   const auto& [crane, exact, settings] = std::tie(setup.crane, setup.exact, setup.settings);
   const double tau = exact.sample_interval_s;
-  std::vector<updating::TestRecord> records{
-      setup.Test("late", validation::MoveRelease(exact, 0.3 * tau))};
-  updating::UpdateResult best = updating::UpdateModel(*crane.model, records, settings.options);
+  auto [records, best] = setup.CutLate(0.3);
   ASSERT_NE(best.termination, updating::UpdateResult::Termination::kFailure);
   const double detected_cost = best.final_cost;
   validation::PlaceDetectedReleases(*crane.model, &records, settings.options, &best);
