@@ -57,6 +57,28 @@ bool ParseCommittedName(const std::string& name, std::string* id, uint32_t* crc)
   return !id->empty();
 }
 
+// A temporary of this program: AtomicFile's "<file>.tmp-<pid>-<n>" (or a folder's
+// "<name>.tmp-<pid>"). Only such names, the case files' own and unsealed ones are ever removed:
+// a file of the user's in the folder (or in cases/) stays, whatever its name.
+bool IsTemporaryName(const std::string& name) {
+  const size_t at = name.rfind(".tmp-");
+  if (at == std::string::npos || at == 0) return false;
+  const std::string rest = name.substr(at + 5);  // "<pid>-<n>" or "<pid>"
+  const size_t dash = rest.find('-');
+  const std::string pid = rest.substr(0, dash);
+  const std::string n = dash == std::string::npos ? "1" : rest.substr(dash + 1);
+  const auto digits = [](const std::string& text) {
+    return !text.empty() && text.size() <= 10 &&
+           text.find_first_not_of("0123456789") == std::string::npos;
+  };
+  return digits(pid) && digits(n);
+}
+
+bool IsUnsealedName(const std::string& name) {
+  const size_t length = sizeof(kUnsealed) - 1;
+  return name.size() > length && name.compare(name.size() - length, length, kUnsealed) == 0;
+}
+
 // What a kill between creating the folder and committing the manifest leaves: nothing, an
 // empty cases/ or a temporary of the manifest. Such a folder starts afresh.
 bool IsHalfCreated(const fs::path& dir) {
@@ -130,18 +152,22 @@ ResultsFolder::Scan ResultsFolder::ScanCommitted(const Campaign& campaign) const
   scan.committed.assign(campaign.cases.size(), false);
   std::error_code error;
   // Temporaries of a process that was killed (AtomicFile names them "<file>.tmp-<pid>-<n>"),
-  // unsealed case files that lost their process before the checksummed rename, and files of
-  // cases this campaign does not have go; committed cases are checked against their CRC-32.
+  // unsealed case files that lost their process before the checksummed rename, and case files
+  // of cases this campaign does not have go; committed cases are checked against their CRC-32.
+  // Any other file is the user's and stays (a note put in cases/ was deleted on --resume).
   for (const auto& entry : fs::directory_iterator(fs::path(dir_) / "cases", error)) {
     const std::string path = entry.path().string();
     const std::string name = entry.path().filename().string();
     std::string id;
     uint32_t expected = 0;
-    const auto it = ParseCommittedName(name, &id, &expected) ? index.find(id) : index.end();
-    if (name.find(".tmp-") != std::string::npos || it == index.end()) {
-      fs::remove(entry.path(), error);
+    const bool committed_name = ParseCommittedName(name, &id, &expected);
+    const auto it = committed_name ? index.find(id) : index.end();
+    if (IsTemporaryName(name) || IsUnsealedName(name) || (committed_name && it == index.end())) {
+      std::error_code ignored;
+      if (entry.is_regular_file(ignored)) fs::remove(entry.path(), ignored);
       continue;
     }
+    if (!committed_name) continue;  // not a file of this program's
     std::string why;
     try {
       const uint32_t actual = FileCrc32(path);
@@ -159,9 +185,7 @@ ResultsFolder::Scan ResultsFolder::ScanCommitted(const Campaign& campaign) const
     scan.damaged.push_back(id + ": " + why);
   }
   for (const auto& entry : fs::directory_iterator(dir_, error)) {
-    if (entry.path().filename().string().find(".tmp-") != std::string::npos) {
-      fs::remove_all(entry.path(), error);
-    }
+    if (IsTemporaryName(entry.path().filename().string())) fs::remove_all(entry.path(), error);
   }
   return scan;
 }
@@ -194,8 +218,20 @@ std::map<std::string, std::string> ResultsFolder::FindCommittedCases() const {
 }
 
 void ResultsFolder::RemoveCases() const {
+  // The case files and their temporaries; cases/ itself only when nothing else is in it.
+  const fs::path cases = fs::path(dir_) / "cases";
   std::error_code error;
-  fs::remove_all(fs::path(dir_) / "cases", error);
+  for (const auto& entry : fs::directory_iterator(cases, error)) {
+    const std::string name = entry.path().filename().string();
+    std::string id;
+    uint32_t crc = 0;
+    std::error_code ignored;
+    if ((ParseCommittedName(name, &id, &crc) || IsUnsealedName(name) || IsTemporaryName(name)) &&
+        entry.is_regular_file(ignored)) {
+      fs::remove(entry.path(), ignored);
+    }
+  }
+  fs::remove(cases, error);  // fails, and keeps it, where the user's files are
 }
 
 }  // namespace mbid::campaign::internal

@@ -49,7 +49,8 @@ class ResultsFolder {
   // The committed file of each case found in cases/, by case id.
   std::map<std::string, std::string> FindCommittedCases() const;
   std::string Path(const std::string& name) const;  // DIR/<name>
-  // Removes cases/ once campaign.h5 holds them.
+  // Removes the case files once campaign.h5 holds them, and cases/ when nothing else is in it
+  // (a file of the user's there stays).
   void RemoveCases() const;
 
  private:

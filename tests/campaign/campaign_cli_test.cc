@@ -228,6 +228,38 @@ TEST_F(CampaignCliTest, ResumeRedoesTemporariesAndDamagedCaseFiles) {
   EXPECT_TRUE(ReadText(out / "campaign.h5") == ReadText(dir_ / "whole" / "campaign.h5"));
 }
 
+// Files of the user's in a campaign folder are never removed: a note in cases/ (which the resume
+// deleted with everything else of no case's name), one named like a temporary but not one of
+// this program's, and one beside the results. The campaign's own leftovers go, and cases/ stays
+// only because the note is in it.
+TEST_F(CampaignCliTest, ResumeAndTheFinalCleanUpLeaveTheUsersFiles) {
+  const fs::path campaign = Write("small.yaml", SmallCampaign());
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(
+      Run("campaign " + campaign.string() + " -o " + (dir_ / "whole").string() + " -q").exit_code,
+      0);
+  fs::create_directories(out / "cases");
+  fs::copy_file(dir_ / "whole" / "campaign.json", out / "campaign.json");
+  Write("out/cases/notes.txt", "mine");
+  Write("out/cases/plan.tmp-draft", "mine too");
+  Write("out/readme.md", "and mine");
+  Write("out/cases/case_0002.unsealed.h5", "a case killed before its rename");
+  Write("out/cases/case_0002.unsealed.h5.tmp-12345-0", "half a case");
+  const CommandResult result =
+      Run("campaign " + campaign.string() + " -o " + out.string() + " --resume -q");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(ReadText(out / "campaign.h5") == ReadText(dir_ / "whole" / "campaign.h5"));
+  EXPECT_EQ(ReadText(out / "cases" / "notes.txt"), "mine");
+  EXPECT_EQ(ReadText(out / "cases" / "plan.tmp-draft"), "mine too");
+  EXPECT_EQ(ReadText(out / "readme.md"), "and mine");
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(out / "cases")) {
+    left.push_back(entry.path().filename().string());
+  }
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"notes.txt", "plan.tmp-draft"}));
+}
+
 TEST_F(CampaignCliTest, AFolderKilledBeforeItsManifestStartsAfresh) {
   // Killed after creating the folder and before committing the manifest: an empty cases/ and
   // a temporary of the manifest. Neither a fresh start nor --resume may refuse it.
