@@ -1,6 +1,7 @@
 #include "mbid/campaign/campaign.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -101,9 +102,37 @@ void ReadBase(const YamlReader& root, Campaign& campaign) {
   campaign.base = YAML::Load(campaign.base_text);
 }
 
+// `model.parameters` is a free map (any name may be declared, used or not), so the scenario
+// reader cannot tell a misspelt swept parameter: it became a new parameter nothing used, and
+// every case was the base (a sweep of `boom_angel_deg` gave identical cases, reported as swept).
+// A set or swept `model.parameters.<name>` must name one the base scenario declares.
+void CheckDeclaredParameter(const Campaign& campaign, const Assignment& input) {
+  const std::string prefix = "model.parameters.";
+  if (input.key.rfind(prefix, 0) != 0) return;
+  const std::string name =
+      input.key.substr(prefix.size(), input.key.find_first_of(".[", prefix.size()) - prefix.size());
+  const YAML::Node declared = campaign.base["model"]["parameters"];
+  std::vector<std::string> names;
+  if (declared && declared.IsMap()) {
+    for (const auto& entry : declared) names.push_back(entry.first.as<std::string>());
+  }
+  if (std::find(names.begin(), names.end(), name) != names.end()) return;
+  std::string expected = names.empty() ? "a parameter the base scenario declares in "
+                                         "model.parameters (it declares none)"
+                                       : "one of " + fmt::format("{}", fmt::join(names, ", "));
+  if (!names.empty()) expected += "; did you mean '" + ClosestMatch(name, names) + "'?";
+  throw InputError(campaign.path, input.field,
+                   "'" + name +
+                       "' is not a parameter of the base scenario's model (a value "
+                       "nothing uses: every case would be the same)",
+                   expected);
+}
+
 // Checks once what all cases share: fixed values must give a valid scenario, swept keys must be
 // keys the scenario knows (their values are checked per case).
 void ProbeKeys(const Campaign& campaign, const std::vector<Assignment>& first_inputs) {
+  for (const Assignment& input : campaign.fixed) CheckDeclaredParameter(campaign, input);
+  for (const Assignment& input : first_inputs) CheckDeclaredParameter(campaign, input);
   CampaignCase probe;
   probe.id = "probe";
   try {

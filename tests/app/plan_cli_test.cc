@@ -149,6 +149,20 @@ TEST_F(PlanCliTest, BadCandidatesFilesAreInputErrorsNamingFileAndKey) {
   expect_error("--candidates " + model.string(), "model.yaml:candidates[0].model.configuration");
   const fs::path top = Write("top.yaml", "candidate: []\n");
   expect_error("--candidates " + top.string(), "top.yaml:candidate");
+  // A machine description's parameters are a free map: a misspelt one was a new parameter that
+  // nothing used, and the candidate scored as the recorded test.
+  const fs::path parameter = Write("parameter.yaml", R"(candidates:
+  - name: longer
+    excitation: {type: initial_deflection, deflection_rad: {theta: -0.006}}
+    model: {parameters: {boom_lenght_m: 12.0}}
+)");
+  const CommandResult typo = Run("-q plan " + kScenarios + "reference-crane-description.yaml" +
+                                 " --candidates " + parameter.string());
+  EXPECT_EQ(typo.exit_code, 2) << typo.err;
+  EXPECT_NE(typo.err.find("parameter.yaml:candidates[0].model.parameters.boom_lenght_m: "
+                          "'boom_lenght_m' is not a parameter of the scenario's model"),
+            std::string::npos)
+      << typo.err;
 }
 
 }  // namespace

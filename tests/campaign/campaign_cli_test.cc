@@ -260,6 +260,48 @@ TEST_F(CampaignCliTest, ResumeAndTheFinalCleanUpLeaveTheUsersFiles) {
   EXPECT_EQ(left, (std::vector<std::string>{"notes.txt", "plan.tmp-draft"}));
 }
 
+// model.parameters is a free map: a misspelt swept parameter became one more that nothing
+// used, and the "sweep" gave identical cases. Refused with the declared names (exit 2, no
+// folder); spelt right, the cases differ.
+TEST_F(CampaignCliTest, ASweptParameterMustBeOneTheBaseDeclares) {
+  const auto sweep = [&](const std::string& name, const std::string& out) {
+    const fs::path campaign =
+        Write(name + ".yaml", "name: lengths\nbase: " + kScenarios +
+                                  "/reference-crane-description.yaml\nsteps: [modes]\nsweep:\n"
+                                  "  - grid:\n      model.parameters." +
+                                  name + ": [9.0, 11.0]\n");
+    return Run("campaign " + campaign.string() + " -o " + (dir_ / out).string() + " -q");
+  };
+  const CommandResult typo = sweep("boom_lenght_m", "typo");
+  EXPECT_EQ(typo.exit_code, 2) << typo.err;
+  EXPECT_NE(typo.err.find("boom_lenght_m.yaml:sweep[0].grid.model.parameters.boom_lenght_m: "
+                          "'boom_lenght_m' is not a parameter of the base scenario's model"),
+            std::string::npos)
+      << typo.err;
+  EXPECT_NE(typo.err.find("did you mean 'boom_length_m'?"), std::string::npos) << typo.err;
+  EXPECT_FALSE(fs::exists(dir_ / "typo"));
+  const CommandResult right = sweep("boom_length_m", "right");
+  ASSERT_EQ(right.exit_code, 0) << right.err;
+  // The first mode's frequency (column exact.mode1.frequency_hz) of the two cases: a 10 m boom
+  // 9 or 11 m long, the crane's first mode 0.64 and 0.52 Hz (measured).
+  std::istringstream lines(ReadText(dir_ / "right" / "summary.csv"));
+  std::string header, row;
+  std::getline(lines, header);
+  std::vector<std::string> columns;
+  for (std::stringstream cells(header); std::getline(cells, row, ',');) columns.push_back(row);
+  const auto column = std::find(columns.begin(), columns.end(), "exact.mode1.frequency_hz");
+  ASSERT_NE(column, columns.end()) << header;
+  std::vector<double> first_mode;
+  while (std::getline(lines, row)) {
+    std::stringstream cells(row);
+    std::string cell;
+    for (auto k = columns.begin(); k <= column; ++k) std::getline(cells, cell, ',');
+    first_mode.push_back(std::stod(cell));
+  }
+  ASSERT_EQ(first_mode.size(), 2u);
+  EXPECT_GT(first_mode[0] - first_mode[1], 0.05);  // a longer boom swings slower
+}
+
 TEST_F(CampaignCliTest, AFolderKilledBeforeItsManifestStartsAfresh) {
   // Killed after creating the folder and before committing the manifest: an empty cases/ and
   // a temporary of the manifest. Neither a fresh start nor --resume may refuse it.

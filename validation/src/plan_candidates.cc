@@ -1,7 +1,9 @@
 #include "mbid/validation/plan_candidates.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -76,6 +78,27 @@ CandidateFile ReadCandidateFile(const std::string& path, const Scenario& scenari
     }
     const model::MechanicalModel* own = &model;
     if (entry.Has("model")) {
+      // model.parameters is a free map: a misspelt name would be one more parameter nothing
+      // uses, and the candidate the recorded test again (scored as such, without a word).
+      const YamlReader overrides = entry.Child("model");
+      if (overrides.IsMap() && overrides.Has("parameters") &&
+          overrides.Child("parameters").IsMap()) {
+        std::vector<std::string> declared;
+        if (scenario.root.Has("model") && scenario.root.Child("model").Has("parameters") &&
+            scenario.root.Child("model").Child("parameters").IsMap()) {
+          declared = scenario.root.Child("model").Child("parameters").Keys();
+        }
+        const YamlReader parameters = overrides.Child("parameters");
+        for (const std::string& name : parameters.Keys()) {
+          if (std::find(declared.begin(), declared.end(), name) != declared.end()) continue;
+          parameters.FailAt(name, "'" + name + "' is not a parameter of the scenario's model",
+                            declared.empty()
+                                ? "a parameter the scenario declares in model.parameters (it "
+                                  "declares none)"
+                                : "one of " + fmt::format("{}", fmt::join(declared, ", ")) +
+                                      "; did you mean '" + ClosestMatch(name, declared) + "'?");
+        }
+      }
       const YamlReader merged(MergedSection(scenario, entry, "model", false), path,
                               entry.field() + ".model");
       candidate.model = model::MakeModel(merged);
