@@ -52,7 +52,7 @@ class Evaluator {
   Evaluator(const Campaign& campaign, const DamperSizingSpec& spec, const std::string& joint)
       : campaign_(campaign) {
     campaign_.cases.clear();
-    key_ = DamperSizingSpec::DampingKey(joint);
+    key_ = spec.DampingKey(joint);
     // The damping ratio alone needs no simulation.
     if (!spec.has_settling_target()) campaign_.steps = {false, false, false};
   }
@@ -87,9 +87,10 @@ using internal::ToVector;
 
 // A joint's curves from the cases' summary rows (the cases that swept its damper, in campaign
 // order); `damping` and `points` receive the sweep for the bisection.
-JointSizing ReadCurves(const std::string& joint, const std::vector<nlohmann::ordered_json>& rows,
+JointSizing ReadCurves(const DamperSizingSpec& spec, const std::string& joint,
+                       const std::vector<nlohmann::ordered_json>& rows,
                        std::vector<double>* damping_out, std::vector<Point>* points_out) {
-  const std::string key = DamperSizingSpec::DampingKey(joint);
+  const std::string key = spec.DampingKey(joint);
   JointSizing sizing;
   sizing.joint = joint;
   std::vector<double>& damping = *damping_out;
@@ -166,10 +167,6 @@ std::pair<double, std::string> FindSmallest(const DamperSizingSpec& spec, const 
 
 }  // namespace
 
-std::string DamperSizingSpec::DampingKey(const std::string& joint) {
-  return "model.joints." + joint + ".damping_Nms_per_rad";
-}
-
 DamperSizingSpec ReadDamperSizing(const YamlReader& section, const YAML::Node& base) {
   section.ExpectMap(
       {"joints", "range_Nms_per_rad", "points", "spacing", "targets", "relative_tolerance"});
@@ -177,17 +174,34 @@ DamperSizingSpec ReadDamperSizing(const YamlReader& section, const YAML::Node& b
   spec.joints = section.StringList("joints");
   if (spec.joints.empty())
     section.FailAt("joints", "empty list", "the joints whose dampers to size");
-  const YAML::Node joints = base["model"]["joints"];
+  // The truck crane names its joints in model.joints; a machine description its compliant
+  // coordinates in model.springs (a revolute one's damper is in N*m*s/rad, as the range).
+  const YAML::Node model = base["model"];
+  const bool described = model && model.IsMap() && model["type"] && model["type"].IsScalar() &&
+                         model["type"].Scalar() == "multibody";
+  const YAML::Node joints =
+      model && model.IsMap() ? model[described ? "springs" : "joints"] : YAML::Node();
   std::vector<std::string> known;
-  if (joints.IsMap()) {
+  if (joints && joints.IsMap()) {
     for (const auto& item : joints) known.push_back(item.first.Scalar());
   }
+  const std::string where = described ? "model.springs" : "model.joints";
   for (const std::string& joint : spec.joints) {
     if (std::find(known.begin(), known.end(), joint) == known.end()) {
       section.FailAt("joints", "unknown joint '" + joint + "'",
-                     fmt::format("joints of the base scenario's model: {}; did you mean '{}'?",
-                                 fmt::join(known, ", "), ClosestMatch(joint, known)));
+                     known.empty()
+                         ? "a joint of the base scenario's " + where + " (it has none)"
+                         : fmt::format("joints of the base scenario's {}: {}; did you "
+                                       "mean '{}'?",
+                                       where, fmt::join(known, ", "), ClosestMatch(joint, known)));
     }
+    if (described && joints[joint].IsMap() && !joints[joint]["stiffness_Nm_per_rad"] &&
+        !joints[joint]["damping_Nms_per_rad"]) {
+      section.FailAt("joints",
+                     "'" + joint + "' is a prismatic coordinate (its spring in N/m and N*s/m)",
+                     "revolute coordinates: the study sizes dampers in N*m*s/rad");
+    }
+    spec.damping_keys[joint] = where + "." + joint + ".damping_Nms_per_rad";
   }
   const YamlReader range = section.Child("range_Nms_per_rad");
   if (range.node().IsMap()) {
@@ -256,8 +270,7 @@ std::vector<std::vector<Assignment>> DamperSizingCases(const DamperSizingSpec& s
       const double value = k == spec.points - 1 ? high
                            : spec.log_spacing   ? low * std::pow(high / low, u)
                                                 : low + u * (high - low);
-      cases.push_back(
-          {{DamperSizingSpec::DampingKey(joint), NumberNode(value), field + ".range_Nms_per_rad"}});
+      cases.push_back({{spec.DampingKey(joint), NumberNode(value), field + ".range_Nms_per_rad"}});
     }
   }
   return cases;
@@ -296,7 +309,7 @@ DamperSizingResult SizeDampers(const Campaign& campaign, const DamperSizingSpec&
   for (const std::string& joint : spec.joints) {
     std::vector<double> damping;
     std::vector<Point> points;
-    JointSizing sizing = ReadCurves(joint, rows, &damping, &points);
+    JointSizing sizing = ReadCurves(spec, joint, rows, &damping, &points);
     const Evaluator evaluate(campaign, spec, joint);
     for (const std::string& target : targets) {
       sizing.targets.push_back(target);

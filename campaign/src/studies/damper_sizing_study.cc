@@ -30,7 +30,7 @@ class DamperSizingStudy : public CampaignStudy {
     if (!root.Has("steps")) campaign->steps.simulate = spec_.has_settling_target();
     if (spec_.has_settling_target()) campaign->steps.simulate = true;
     for (const std::string& joint : spec_.joints) {
-      campaign->swept_keys.push_back(DamperSizingSpec::DampingKey(joint));
+      campaign->swept_keys.push_back(spec_.DampingKey(joint));
     }
     return inputs;
   }

@@ -37,11 +37,14 @@ struct DamperSizingSpec {
   double relative_tolerance = 1e-6;  // bisection stops at this relative bracket width
 
   bool has_settling_target() const { return max_settling_time_s > 0; }
-  // The scenario key of joint k's damping.
-  static std::string DampingKey(const std::string& joint);
+  // The scenario key of each joint's damping: model.joints.<joint>.damping_Nms_per_rad (the
+  // truck crane) or model.springs.<coordinate>.damping_Nms_per_rad (a machine description).
+  std::map<std::string, std::string> damping_keys;
+  const std::string& DampingKey(const std::string& joint) const { return damping_keys.at(joint); }
 };
 
-// Reads the `damper_sizing:` section; joints must exist in the base scenario's model.joints.
+// Reads the `damper_sizing:` section; joints must exist in the base scenario's model.joints (the
+// truck crane) or be revolute coordinates with a spring in model.springs (a description).
 DamperSizingSpec ReadDamperSizing(const YamlReader& section, const YAML::Node& base);
 
 // The cases of the sweep: for each joint, `points` values of its damping (log or linear).
