@@ -216,8 +216,7 @@ Campaign LoadCampaign(const std::string& path) {
     root.FailAt("name", "'" + campaign.name + "'", "a non-empty name without '/'");
   }
   campaign.description = root.String("description", "");
-  const int seed = root.Int("seed", 1);
-  if (seed < 0) root.FailAt("seed", std::to_string(seed), "an integer >= 0");
+  const int seed = root.Seed("seed", 1);
   campaign.seed = static_cast<std::uint64_t>(seed);
   ReadBase(root, campaign);
 

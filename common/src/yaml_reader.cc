@@ -244,8 +244,21 @@ double YamlReader::PositiveDouble(const std::string& key, double fallback) const
 }
 
 int YamlReader::Int(const std::string& key) const {
+  return RequiredIntInRange(key, std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+}
+
+int YamlReader::Int(const std::string& key, int fallback) const {
+  return Has(key) ? Int(key) : fallback;
+}
+
+int YamlReader::IntInRange(const std::string& key, int fallback, int min, int max) const {
+  return Has(key) ? RequiredIntInRange(key, min, max) : fallback;
+}
+
+int YamlReader::RequiredIntInRange(const std::string& key, int min, int max) const {
   const YamlReader child = Child(key);
   const std::string text = child.AsString();
+  const std::string expected = fmt::format("an integer between {} and {}", min, max);
   if (IsQuoted(child.node_)) {
     child.Fail("is the quoted string '" + text + "'", "a plain integer (without quotes)");
   }
@@ -254,24 +267,26 @@ int YamlReader::Int(const std::string& key) const {
   long long value = 0;
   const char* end = digits.data() + digits.size();
   const auto [ptr, ec] = std::from_chars(digits.data(), end, value);
-  if (ptr == end && ec == std::errc() && value >= std::numeric_limits<int>::min() &&
-      value <= std::numeric_limits<int>::max()) {
-    return static_cast<int>(value);
+  bool integral = ptr == end && ec == std::errc();
+  bool in_range = integral && value >= min && value <= max;
+  if (!integral) {
+    // Also integral numbers written with an exponent ("1e6").
+    double d = 0;
+    integral = internal::ParseDouble(text, &d) == internal::ParseStatus::kOk && std::isfinite(d) &&
+               d == std::floor(d);
+    in_range = integral && d >= min && d <= max;
+    if (in_range) value = static_cast<long long>(d);
   }
-  // Also accept integral numbers written with an exponent ("1e6").
-  double d = 0;
-  if (internal::ParseDouble(text, &d) == internal::ParseStatus::kOk && std::isfinite(d) &&
-      d == std::floor(d) && d >= std::numeric_limits<int>::min() &&
-      d <= std::numeric_limits<int>::max()) {
-    return static_cast<int>(d);
-  }
-  child.Fail("'" + text + "' is not an integer",
-             fmt::format("an integer between {} and {}", std::numeric_limits<int>::min(),
-                         std::numeric_limits<int>::max()));
+  if (in_range) return static_cast<int>(value);
+  // An integer beyond the range is one, out of range (it was "not an integer" above int's).
+  const bool digits_only =
+      !digits.empty() && digits.find_first_not_of("-0123456789") == std::string_view::npos;
+  child.Fail("'" + text + "' is " + (integral || digits_only ? "out of range" : "not an integer"),
+             expected);
 }
 
-int YamlReader::Int(const std::string& key, int fallback) const {
-  return Has(key) ? Int(key) : fallback;
+int YamlReader::Seed(const std::string& key, int fallback) const {
+  return IntInRange(key, fallback, 0, std::numeric_limits<int>::max());
 }
 
 bool YamlReader::Bool(const std::string& key, bool fallback) const {

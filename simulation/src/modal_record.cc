@@ -74,8 +74,7 @@ ModalRecordSpec ReadModalRecordSpec(const YamlReader& node) {
                   "a correlation in (0, 1] per channel");
     }
   }
-  const int seed = node.Int("seed", 1);
-  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
+  const int seed = node.Seed("seed", 1);
   spec.seed = static_cast<std::uint64_t>(seed);
   const YamlReader modes = node.Child("modes");
   if (!modes.node().IsSequence() || modes.node().size() == 0) {

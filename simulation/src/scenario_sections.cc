@@ -165,8 +165,7 @@ SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalM
   options.bias = ReadPerUnitChannelValues(node, "bias", options.channels, model, false);
   options.quantization_step =
       ReadPerUnitChannelValues(node, "quantization_step", options.channels, model, true);
-  const int seed = node.Int("seed", 1);
-  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
+  const int seed = node.Seed("seed", 1);
   options.seed = static_cast<std::uint64_t>(seed);
   return options;
 }

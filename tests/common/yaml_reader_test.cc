@@ -295,6 +295,23 @@ TEST(YamlReaderBadInputTest, FractionWhereIntegerExpected) {
   EXPECT_EQ(e.problem(), "'1.5' is not an integer");
 }
 
+// A seed beyond either end of its range: one message, the same range (a negative one said
+// ">= 0" while one beyond 2^31 said "between -2147483648 and 2147483647").
+TEST(YamlReaderBadInputTest, ASeedOutOfRangeSaysItsRange) {
+  for (const char* text : {"-4", "3000000000", "1e10"}) {
+    const YamlReader sensors =
+        YamlReader::FromString(std::string("sensors: {seed: ") + text + "}\n", kSource)
+            .Child("sensors");
+    const InputError e = CatchInputError([&] { sensors.Seed("seed", 1); });
+    EXPECT_EQ(e.field(), "sensors.seed");
+    EXPECT_EQ(e.problem(), std::string("'") + text + "' is out of range");
+    EXPECT_EQ(e.expected(), "an integer between 0 and 2147483647");
+  }
+  const YamlReader absent = YamlReader::FromString("sensors: {}\n", kSource).Child("sensors");
+  EXPECT_EQ(absent.Seed("seed", 7), 7);
+  EXPECT_THROW(absent.Int("seed"), InputError);  // a required integer stays required
+}
+
 TEST(YamlReaderBadInputTest, ScalarWhereMapExpected) {
   const YamlReader root = YamlReader::FromString("model: crane\n", kSource);
   const InputError e = CatchInputError([&] { root.Child("model").ExpectMap(kBaseKeys); });

@@ -81,8 +81,7 @@ simulation::SensitivityOptions ReadSensitivity(const YamlReader& node,
 }
 
 std::uint64_t ReadSeed(const YamlReader& node, std::uint64_t fallback) {
-  const int seed = node.Int("seed", static_cast<int>(fallback));
-  if (seed < 0) node.FailAt("seed", "negative seed", "an integer >= 0");
+  const int seed = node.Seed("seed", static_cast<int>(fallback));
   return static_cast<std::uint64_t>(seed);
 }
 

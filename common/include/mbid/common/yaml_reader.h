@@ -44,6 +44,10 @@ class YamlReader {
   double PositiveDouble(const std::string& key, double fallback) const;
   int Int(const std::string& key) const;
   int Int(const std::string& key, int fallback) const;
+  // An integer in [min, max]; one message for a value out of range on either side.
+  int IntInRange(const std::string& key, int fallback, int min, int max) const;
+  // A random seed: an integer in [0, 2147483647].
+  int Seed(const std::string& key, int fallback) const;
   bool Bool(const std::string& key, bool fallback) const;
   std::string String(const std::string& key) const;
   std::string String(const std::string& key, const std::string& fallback) const;
@@ -64,6 +68,7 @@ class YamlReader {
 
  private:
   std::string ChildField(const std::string& key) const;
+  int RequiredIntInRange(const std::string& key, int min, int max) const;
 
   YAML::Node node_;
   std::string source_;
