@@ -136,8 +136,10 @@ int Main(int argc, char** argv) {
       "campaign", "Run a campaign of virtual tests or a design study (threads; MPI under mpirun)");
   campaign->add_option("CAMPAIGN", campaign_path, "Campaign YAML file")->required();
   campaign->add_option("-o,--output", output_dir, "Results folder")->required();
-  campaign->add_option("--workers", campaign_workers, "Worker threads (default: one per core)")
-      ->check(CLI::PositiveNumber);
+  campaign
+      ->add_option("--workers,--threads", campaign_workers,
+                   "Worker threads (default: one per core)")
+      ->check(CLI::Range(1, 1 << 20));
   campaign->add_flag("--resume", campaign_resume, "Finish a campaign this folder holds");
 
   std::string data_path;

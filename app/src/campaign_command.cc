@@ -39,6 +39,10 @@ int RunCampaignCommand(const std::string& campaign_path, const std::string& outp
   Campaign campaign;
   try {
     CheckWorkerCount(workers);
+    if (common.overwrite) {  // accepted by every command; a campaign is resumed, never replaced
+      throw InputError("--overwrite", "", "a campaign folder is never replaced",
+                       "--resume to finish the campaign a folder holds, or a new output folder");
+    }
     campaign = LoadCampaign(campaign_path);
   } catch (const std::exception& error) {
     // Every rank finds the same mistake; rank 0 alone reports it.

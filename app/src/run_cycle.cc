@@ -2,12 +2,9 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
-#include <string>
-#include <vector>
 
 #include "mbid/common/output_folder.h"
 #include "mbid/report/run_folder.h"
@@ -60,20 +57,9 @@ int RunValidationCycle(const std::string& scenario_path, const std::string& outp
     early.Start(test, test_count);
   };
   const validation::CycleResult cycle = validation::RunCycle(scenario, options);
-  // What the reading, the identification and the fits doubt is said even with --quiet, as
-  // `mbid update` says it (the report has it too); a line shared by jointly tuned tests once.
-  std::vector<std::string> warnings;
-  for (const validation::RunTest& test : cycle.tests) {
-    const std::string prefix = cycle.tests.size() > 1 ? "test " + test.name + ": " : "";
-    std::vector<std::string> lines;
-    if (test.import && common.quiet) lines = test.import->warnings;  // else in the progress
-    lines.insert(lines.end(), test.identified.warnings.begin(), test.identified.warnings.end());
-    lines.insert(lines.end(), test.tuned.warnings.begin(), test.tuned.warnings.end());
-    for (const std::string& line : lines) {
-      if (std::find(warnings.begin(), warnings.end(), line) != warnings.end()) continue;
-      warnings.push_back(line);
-      std::cerr << "mbid: warning: " << prefix << line << "\n";
-    }
+  // Said even with --quiet, as `mbid update` says them (the reading's are in the progress).
+  for (const std::string& line : validation::CollectWarnings(cycle, common.quiet)) {
+    std::cerr << "mbid: warning: " << line << "\n";
   }
   progress.Say(cycle.verdict_line);
   for (const std::string& reason : cycle.reasons) {

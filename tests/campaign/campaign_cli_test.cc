@@ -475,6 +475,23 @@ TEST_F(CampaignCliTest, BadFlagsAndFoldersAreInvalidInput) {
   const CommandResult missing =
       Run("campaign " + (dir_ / "nope.yaml").string() + " -o " + (dir_ / "o").string());
   EXPECT_EQ(missing.exit_code, 2) << missing.err;
+  // --overwrite, which every command accepts, was ignored here: a campaign is resumed, never
+  // replaced, and the message says so (exit 2, nothing written).
+  const CommandResult overwrite =
+      Run("campaign " + campaign.string() + " -o " + (dir_ / "ow").string() + " --overwrite");
+  EXPECT_EQ(overwrite.exit_code, 2) << overwrite.err;
+  EXPECT_NE(overwrite.err.find("--overwrite: a campaign folder is never replaced; expected "
+                               "--resume"),
+            std::string::npos)
+      << overwrite.err;
+  EXPECT_FALSE(fs::exists(dir_ / "ow"));
+  // --threads, as structure's, is --workers (it was "not expected: 0 --threads"), and its range
+  // is said in the numbers it has (not "0 to 1.8e308" written out).
+  const CommandResult threads =
+      Run("campaign " + campaign.string() + " -o " + (dir_ / "t").string() + " --threads 0");
+  EXPECT_EQ(threads.exit_code, 2);
+  EXPECT_NE(threads.err.find("--workers: Value 0 not in range 1 to 1048576"), std::string::npos)
+      << threads.err;
 }
 
 }  // namespace

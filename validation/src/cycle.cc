@@ -155,4 +155,21 @@ CycleResult RunCycle(const Scenario& scenario, const CycleOptions& options) {
   return result;
 }
 
+std::vector<std::string> CollectWarnings(const CycleResult& cycle, bool with_import) {
+  std::vector<std::string> seen, warnings;
+  for (const RunTest& test : cycle.tests) {
+    const std::string prefix = cycle.tests.size() > 1 ? "test " + test.name + ": " : "";
+    std::vector<std::string> lines;
+    if (test.import && with_import) lines = test.import->warnings;
+    lines.insert(lines.end(), test.identified.warnings.begin(), test.identified.warnings.end());
+    lines.insert(lines.end(), test.tuned.warnings.begin(), test.tuned.warnings.end());
+    for (const std::string& line : lines) {
+      if (std::find(seen.begin(), seen.end(), line) != seen.end()) continue;
+      seen.push_back(line);
+      warnings.push_back(prefix + line);
+    }
+  }
+  return warnings;
+}
+
 }  // namespace mbid::validation
