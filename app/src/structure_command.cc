@@ -161,6 +161,7 @@ int RunStructureCommand(const std::string& scenario_path,
   options.threads = threads;
   // The reference is fitted as `mbid update` fits it: the same starts, the same search.
   options.search = full.settings.global_search;
+  options.search.threads = threads;  // the reference's search too (it took every core)
   options.reference_starts = full.starts;
   options.reference_start = full.start;
   options.quiet = common.quiet;
