@@ -120,6 +120,17 @@ std::string StructureTable(const updating::StructureRanking& ranking) {
           fit.name, fit.fit.termination_name(), fit.fit.iterations);
     }
   }
+  if (!ranking.structures.empty() && ranking.structures.front().skipped.empty() &&
+      !ranking.structures.front().fit.undetermined.empty()) {
+    // The records barely move those joints: the winner is the structure with fewest parameters
+    // they leave free, which says nothing of whether the joints are rigid or compliant.
+    const updating::StructureFit& best = ranking.structures.front();
+    table += fmt::format(
+        "\n- {} (ranked first): its fit leaves {} undetermined: the records hardly move those "
+        "joints, so the ranking does not show whether they are compliant or rigid; a test that "
+        "moves them decides it (mbid plan)\n",
+        best.name, fmt::join(best.fit.undetermined, ", "));
+  }
   return table;
 }
 

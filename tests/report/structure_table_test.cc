@@ -43,5 +43,24 @@ TEST(StructureTableTest, AFitThatStoppedEarlyIsMarkedAsAnUpperBound) {
   EXPECT_EQ(table.find("- rigid x3: its fit stopped"), std::string::npos) << table;
 }
 
+// A record that moves one joint alone (a slew deflection of a platform) leaves the winner's
+// other parameters undetermined: its rank then says nothing of those joints, and the table says
+// so beside the ranking (a true full model ranked third by 13.6 in BIC read as "very strong").
+TEST(StructureTableTest, AWinnerWithUndeterminedParametersIsSaidNotToDecideThoseJoints) {
+  using Termination = updating::UpdateResult::Termination;
+  updating::StructureRanking ranking;
+  ranking.structures = {Candidate("rigid level", 1, 601.6, Termination::kConverged, 8),
+                        Candidate("full", 2, 600.9, Termination::kConverged, 12)};
+  ranking.structures[0].fit.undetermined = {"c_luff", "d_luff"};
+  ranking.structures[1].fit.undetermined = {"c_luff", "d_luff", "c_level"};
+  const std::string table = StructureTable(ranking);
+  EXPECT_NE(table.find("- rigid level (ranked first): its fit leaves c_luff, d_luff undetermined: "
+                       "the records hardly move those joints"),
+            std::string::npos)
+      << table;
+  ranking.structures[0].fit.undetermined.clear();
+  EXPECT_EQ(StructureTable(ranking).find("ranked first"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace mbid::report
