@@ -45,28 +45,39 @@ std::string Cell(double relative_std) {
   return std::isfinite(relative_std) ? fmt::format("{:.3g}", relative_std) : std::string("inf");
 }
 
+// Parameter k's column: its name's width, at least 8.
+size_t Width(const updating::TestPlan& plan, Eigen::Index k) {
+  return std::max<size_t>(8, plan.parameters[static_cast<size_t>(k)].size());
+}
+
 void PrintPlan(const updating::TestPlan& plan, const std::string& estimate_source) {
   std::cout << fmt::format(
       "plan: {} candidate(s) against {} recorded test(s), at the {} values; score = log det of "
       "the Fisher information of all tests (log coordinates), best first\n",
       plan.candidates.size(), plan.recorded_tests, estimate_source);
-  std::string header = fmt::format("{:<20} {:>10} {:>9}", "candidate", "score", "gain");
-  for (const std::string& name : plan.parameters) header += fmt::format(" {:>8}", name);
+  size_t w = 20;  // the longest name sets the first column, so that the others line up
+  for (const updating::CandidateScore& candidate : plan.candidates) {
+    w = std::max(w, candidate.name.size());
+  }
+  std::string header = fmt::format("{:<{}} {:>10} {:>9}", "candidate", w, "score", "gain");
+  for (const std::string& name : plan.parameters) {
+    header += fmt::format(" {:>{}}", name, std::max<size_t>(8, name.size()));
+  }
   std::cout << header << "\n";
   if (plan.recorded_tests > 0) {
     std::string row =
-        fmt::format("{:<20} {:>10.4g} {:>9}", "(recorded only)", plan.recorded_score, "");
+        fmt::format("{:<{}} {:>10.4g} {:>9}", "(recorded only)", w, plan.recorded_score, "");
     for (Eigen::Index k = 0; k < plan.current_relative_std.size(); ++k) {
-      row += fmt::format(" {:>8}", Cell(plan.current_relative_std[k]));
+      row += fmt::format(" {:>{}}", Cell(plan.current_relative_std[k]), Width(plan, k));
     }
     std::cout << row << "\n";
   }
   for (const updating::CandidateScore& candidate : plan.candidates) {
     std::string row =
-        fmt::format("{:<20} {:>10.4g} {:>9}", candidate.name, candidate.score,
+        fmt::format("{:<{}} {:>10.4g} {:>9}", candidate.name, w, candidate.score,
                     std::isfinite(candidate.gain) ? fmt::format("{:.4g}", candidate.gain) : "-");
     for (Eigen::Index k = 0; k < candidate.relative_std.size(); ++k) {
-      row += fmt::format(" {:>8}", Cell(candidate.relative_std[k]));
+      row += fmt::format(" {:>{}}", Cell(candidate.relative_std[k]), Width(plan, k));
     }
     std::cout << row << "\n";
   }

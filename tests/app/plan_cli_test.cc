@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "command_test.h"
@@ -114,6 +115,27 @@ TEST_F(PlanCliTest, WithoutRecordsPlansAtTheScenariosValues) {
   EXPECT_EQ(plan.at("estimate_source"), "scenario");
   EXPECT_EQ(plan.at("estimate").at("c_alpha"), 4.9e7);
   EXPECT_TRUE(plan.at("recorded_score").is_null());
+  // The table: a candidate name longer than the first column (22 characters) shifted its row;
+  // now every line of the table is as long as the header (the columns line up).
+  const fs::path long_name = Write("long.yaml", R"(candidates:
+  - name: impulse-basket-lateral
+    excitation: {type: initial_deflection, deflection_rad: {eta: -0.004}}
+  - name: short
+    excitation: {type: initial_deflection, deflection_rad: {theta: -0.006}}
+)");
+  const CommandResult table =
+      Run("-q plan " + kScenarios + "reference-crane.yaml --candidates " + long_name.string());
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  std::istringstream lines(table.out);
+  std::string line, header;
+  std::getline(lines, line);  // the plan's sentence
+  std::getline(lines, header);
+  int rows = 0;
+  while (std::getline(lines, line) && line.rfind("(columns", 0) != 0) {
+    EXPECT_EQ(line.size(), header.size()) << "\n" << header << "\n" << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2);
 }
 
 TEST_F(PlanCliTest, BadCandidatesFilesAreInputErrorsNamingFileAndKey) {
