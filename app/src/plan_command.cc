@@ -33,14 +33,6 @@ using validation::UpdateFromTests;
 
 namespace {
 
-nlohmann::json PerParameter(const std::vector<std::string>& names, const Eigen::VectorXd& values) {
-  nlohmann::json out = nlohmann::json::object();
-  for (size_t k = 0; k < names.size(); ++k) {
-    out[names[k]] = NumberOrNull(values[static_cast<Eigen::Index>(k)]);
-  }
-  return out;
-}
-
 std::string Cell(double relative_std) {
   return std::isfinite(relative_std) ? fmt::format("{:.3g}", relative_std) : std::string("inf");
 }
@@ -191,44 +183,10 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
   }
 
   nlohmann::json summary;
-  summary["candidates"] = nlohmann::json::array();
-  for (const updating::CandidateScore& candidate : plan.candidates) {
-    nlohmann::json item;
-    item["name"] = candidate.name;
-    item["score"] = NumberOrNull(candidate.score);
-    item["gain"] = NumberOrNull(candidate.gain);
-    item["expected_relative_std"] = PerParameter(plan.parameters, candidate.relative_std);
-    nlohmann::json determined = nlohmann::json::object();
-    for (size_t k = 0; k < plan.parameters.size(); ++k) {
-      determined[plan.parameters[k]] = static_cast<bool>(candidate.determined[k]);
-    }
-    item["determined"] = determined;
-    item["rank"] = candidate.rank;
-    item["ridge"] = NumberOrNull(candidate.ridge);
-    for (size_t i = 0; i < file.candidates.size(); ++i) {
-      if (file.candidates[i].name != candidate.name) continue;
-      nlohmann::json noise = nlohmann::json::object();
-      for (const auto& [channel, value] : file.candidates[i].test.sensors.noise_std) {
-        noise[channel] = value;
-      }
-      item["noise_std"] = noise;
-    }
-    for (const updating::CandidateAtAlternatives& entry : at_alternatives.candidates) {
-      if (entry.name != candidate.name) continue;
-      item["worst_score"] = NumberOrNull(entry.worst_score);
-      nlohmann::json list = nlohmann::json::array();
-      for (size_t a = 0; a < alternatives.size(); ++a) {
-        list.push_back({{"alternative", alternatives[a].label},
-                        {"score", NumberOrNull(entry.scores[a])},
-                        {"separation_chi_square", NumberOrNull(entry.separation[a])},
-                        {"cannot_separate", static_cast<bool>(entry.cannot_separate[a])}});
-      }
-      item["at_alternatives"] = list;
-    }
-    summary["candidates"].push_back(item);
-  }
+  summary["candidates"] =
+      validation::CandidateScoresToJson(plan, file, at_alternatives, alternatives);
   summary["parameters"] = plan.parameters;
-  summary["estimate"] = PerParameter(plan.parameters, plan.values);
+  summary["estimate"] = validation::PerParameterJson(plan.parameters, plan.values);
   summary["estimate_source"] = estimate_source;
   summary["recorded_tests"] = data_paths;
   summary["recorded_score"] = NumberOrNull(plan.recorded_score);
@@ -246,7 +204,8 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
     }
     summary["alternatives"] = list;
   }
-  summary["current_relative_std"] = PerParameter(plan.parameters, plan.current_relative_std);
+  summary["current_relative_std"] =
+      validation::PerParameterJson(plan.parameters, plan.current_relative_std);
   summary["undetermined_relative_std"] = options.undetermined_relative_std;
   summary["score"] =
       "log det(F_recorded + F_candidate + ridge I), F the Fisher information in log coordinates";

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "mbid/common/error.h"
+#include "mbid/common/json_io.h"
 #include "mbid/common/yaml_reader.h"
 #include "mbid/model/model_factory.h"
 #include "mbid/simulation/scenario_sections.h"
@@ -161,6 +162,58 @@ void FillCandidateNoise(CandidateFile& file, const std::map<std::string, double>
       }
     }
   }
+}
+
+nlohmann::json PerParameterJson(const std::vector<std::string>& names,
+                                const Eigen::VectorXd& values) {
+  nlohmann::json out = nlohmann::json::object();
+  for (size_t k = 0; k < names.size(); ++k) {
+    out[names[k]] = NumberOrNull(values[static_cast<Eigen::Index>(k)]);
+  }
+  return out;
+}
+
+nlohmann::json CandidateScoresToJson(
+    const updating::TestPlan& plan, const CandidateFile& file,
+    const updating::AlternativesPlan& at_alternatives,
+    const std::vector<updating::AlternativeMinimumValues>& alternatives) {
+  nlohmann::json candidates = nlohmann::json::array();
+  for (const updating::CandidateScore& candidate : plan.candidates) {
+    nlohmann::json item;
+    item["name"] = candidate.name;
+    item["score"] = NumberOrNull(candidate.score);
+    item["gain"] = NumberOrNull(candidate.gain);
+    item["expected_relative_std"] = PerParameterJson(plan.parameters, candidate.relative_std);
+    nlohmann::json determined = nlohmann::json::object();
+    for (size_t k = 0; k < plan.parameters.size(); ++k) {
+      determined[plan.parameters[k]] = static_cast<bool>(candidate.determined[k]);
+    }
+    item["determined"] = determined;
+    item["rank"] = candidate.rank;
+    item["ridge"] = NumberOrNull(candidate.ridge);
+    for (size_t i = 0; i < file.candidates.size(); ++i) {
+      if (file.candidates[i].name != candidate.name) continue;
+      nlohmann::json noise = nlohmann::json::object();
+      for (const auto& [channel, value] : file.candidates[i].test.sensors.noise_std) {
+        noise[channel] = value;
+      }
+      item["noise_std"] = noise;
+    }
+    for (const updating::CandidateAtAlternatives& entry : at_alternatives.candidates) {
+      if (entry.name != candidate.name) continue;
+      item["worst_score"] = NumberOrNull(entry.worst_score);
+      nlohmann::json list = nlohmann::json::array();
+      for (size_t a = 0; a < alternatives.size(); ++a) {
+        list.push_back({{"alternative", alternatives[a].label},
+                        {"score", NumberOrNull(entry.scores[a])},
+                        {"separation_chi_square", NumberOrNull(entry.separation[a])},
+                        {"cannot_separate", static_cast<bool>(entry.cannot_separate[a])}});
+      }
+      item["at_alternatives"] = list;
+    }
+    candidates.push_back(item);
+  }
+  return candidates;
 }
 
 }  // namespace mbid::validation

@@ -13,11 +13,13 @@
 // ("plan.yaml:candidates[1].excitation.type: ...").
 
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "mbid/model/mechanical_model.h"
 #include "mbid/updating/plan.h"
+#include "mbid/updating/plan_alternatives.h"
 #include "mbid/validation/scenario.h"
 
 namespace mbid::validation {
@@ -43,6 +45,18 @@ CandidateFile ReadCandidateFile(const std::string& path, const Scenario& scenari
 // InputError naming the candidate's sensors.
 void FillCandidateNoise(CandidateFile& file, const std::map<std::string, double>& recorded,
                         const std::map<std::string, double>& scenario_noise);
+
+// {name: value} of `values` in the order of `names`; NaN as null.
+nlohmann::json PerParameterJson(const std::vector<std::string>& names,
+                                const Eigen::VectorXd& values);
+
+// The JSON summary's `candidates` (docs/planning.md): each candidate's score, gain, expected
+// relative std and determined parameters, its noise levels, and its scores at the alternative
+// minima (`at_alternatives`, empty without alternatives).
+nlohmann::json CandidateScoresToJson(
+    const updating::TestPlan& plan, const CandidateFile& file,
+    const updating::AlternativesPlan& at_alternatives,
+    const std::vector<updating::AlternativeMinimumValues>& alternatives);
 
 // `override` merged over `base`: maps key by key (recursively), anything else replaced.
 YAML::Node MergeYaml(const YAML::Node& base, const YAML::Node& override);
