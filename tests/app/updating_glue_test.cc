@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "../updating/crane_fixture.h"
+#include "mbid/identification/release.h"
 #include "mbid/model/linear_model.h"
 #include "mbid/updating/settings.h"
 #include "mbid/validation/release_profile.h"
@@ -138,9 +139,18 @@ TEST(UpdatingGlueTest, APlacedReleaseKeepsWhatTheSearchLeftUndetermined) {
     }
   }
   best.undetermined = {"c_gamma", "d_eta"};
+  // The misplaced fit's own judgment of d_eta goes with it; the search's warning stays.
+  best.warnings = {"the records leave undetermined: d_eta (rank 7 of 8)",
+                   "non-unique: 1 other minimum(s) fit the records as well as the best"};
   std::vector<updating::TestRecord> records{test};
   const std::vector<std::string> lines =
       validation::PlaceDetectedReleases(*crane.model, &records, settings.options, &best);
+  EXPECT_EQ(std::count(best.warnings.begin(), best.warnings.end(), best.warnings.front()), 1);
+  EXPECT_EQ(best.warnings.front(),
+            "non-unique: 1 other minimum(s) fit the records as well as the best");
+  for (const std::string& warning : best.warnings) {
+    EXPECT_EQ(warning.find("d_eta (rank 7"), std::string::npos) << warning;
+  }
   ASSERT_EQ(lines.size(), 1u);
   EXPECT_NE(lines[0].find("the fit places the release"), std::string::npos) << lines[0];
   EXPECT_NEAR(records[0].record.start_time_s, record.start_time_s, 0.01 * record.sample_interval_s);
@@ -233,6 +243,34 @@ TEST(UpdatingGlueTest, AReleaseIsPlacedToItsOwnStdWhereTheRecordPinsIt) {
     const double truth = crane.model->GetParameter(name);
     EXPECT_NEAR(best.Find(name).value, truth, best.Find(name).std) << name;  // noise-free
   }
+}
+
+// A release detected early, with rest samples inside the decay (a load drop's release placed by
+// two of its four modes came 5.5 samples early): the parabola around it bends the wrong way, and
+// the release was kept where detected (no parameter determined). The cost 1, 2, 4 and 8 samples
+// either way finds the way back; noise-free, to within the release's std.
+TEST(UpdatingGlueTest, AReleaseDetectedEarlyAmongRestSamplesIsPlacedBack) {
+  const DetectedReleases setup(1.0, 100.0);
+  const auto& [crane, exact, settings] = std::tie(setup.crane, setup.exact, setup.settings);
+  const double tau = exact.sample_interval_s;
+  constexpr int kRest = 50;  // 0.5 s at rest at the deflection, then the decay
+  Measurement logged = exact;
+  logged.values.resize(kRest + exact.samples(), exact.channel_count());
+  logged.values.bottomRows(exact.samples()) = exact.values;
+  for (int j = 0; j < kRest; ++j) logged.values.row(j) = exact.values.row(0);
+  logged.start_time_s = 0;
+  const double detected = (kRest - 5.5) * tau;  // the truth is kRest * tau
+  std::vector<updating::TestRecord> records{
+      setup.Test("early", identification::CutAtRelease(logged, detected, "early"))};
+  updating::UpdateResult best = updating::UpdateModel(*crane.model, records, settings.options);
+  ASSERT_NE(best.termination, updating::UpdateResult::Termination::kFailure);
+  const std::vector<std::string> lines =
+      validation::PlaceDetectedReleases(*crane.model, &records, settings.options, &best);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("the fit places the release"), std::string::npos) << lines[0];
+  EXPECT_NEAR(best.tests[0].release_shift_s, 5.5 * tau,
+              std::max(best.tests[0].release_shift_std_s, 1e-3 * tau));
+  EXPECT_TRUE(best.Find("c_theta").determined);
 }
 
 // The release's uncertainty widens a parameter's std; where the widened spread passes what the
