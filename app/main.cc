@@ -1,5 +1,7 @@
 // The mbid command: parses flags, calls the libraries, maps failures to the exit codes of
 // docs/interfaces.md (2 invalid input, 3 numerical failure, 1 anything else).
+#include <glog/logging.h>
+
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <iostream>
@@ -310,6 +312,10 @@ int Main(int argc, char** argv) {
 int main(int argc, char** argv) {
   // First, before any thread exists: SIGINT/SIGTERM then remove unfinished outputs.
   mbid::InstallInterruptCleanup();
+  // Ceres logs a fit stopped by a failed simulation (an "E..." line, after glog's own warning
+  // about its set-up); mbid reports what failed itself, in its own words.
+  FLAGS_minloglevel = google::GLOG_FATAL;
+  google::InitGoogleLogging("mbid");
   try {
     return Main(argc, argv);
   } catch (const mbid::InputError& error) {

@@ -80,8 +80,10 @@ void PrintSummary(const updating::UpdateResult& result,
   }
   for (const updating::TestFit& fit : result.tests) {
     for (size_t c = 0; c < fit.channels.size(); ++c) {
-      std::cout << fmt::format("correlation K({}, {}) = {:.4f}\n", fit.name, fit.channels[c],
-                               fit.correlation[static_cast<Eigen::Index>(c)]);
+      const double k = fit.correlation[static_cast<Eigen::Index>(c)];
+      std::cout << fmt::format(
+          "correlation K({}, {}) = {}\n", fit.name, fit.channels[c],
+          std::isfinite(k) ? fmt::format("{:.4f}", k) : "- (no re-simulation)");
     }
     for (const std::string& line : updating::DescribeBaseline(fit)) std::cout << line << "\n";
   }

@@ -65,8 +65,10 @@ void WriteTestGroups(H5Writer& run, const RunTest& test, const std::string& root
   for (size_t c = 0; c < fit.channels.size(); ++c) {
     const auto column = static_cast<Eigen::Index>(c);
     run.WriteScalar(validation + "/correlation", fit.channels[c], fit.correlation[column], "1");
-    run.WriteVector(validation + "/resimulation", fit.channels[c], fit.simulated.values.col(column),
-                    fit.simulated.units[c]);
+    if (column < fit.simulated.values.cols()) {  // none where the re-simulation failed
+      run.WriteVector(validation + "/resimulation", fit.channels[c],
+                      fit.simulated.values.col(column), fit.simulated.units[c]);
+    }
   }
   if (!root.empty()) {
     run.WriteStringAttribute(root, "origin", test.origin);

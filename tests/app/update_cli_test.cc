@@ -199,6 +199,24 @@ TEST_F(UpdateCliTest, NoConvergenceIsNumericalFailureAndLeavesNoFile) {
   EXPECT_FALSE(fs::exists(output));
 }
 
+// A fit whose simulations fail (the integrator allowed 10 steps between samples): exit 3 with
+// CVODES' reason in mbid's words, and nothing of Ceres' own log (glog's "Logging before
+// InitGoogleLogging()" and an "E..." line "Terminating: Residual and Jacobian evaluation
+// failed" came before).
+TEST_F(UpdateCliTest, AFailingSimulationIsSaidInMbidsWordsOnly) {
+  const fs::path scenario =
+      WriteScenario("reference-crane.yaml", "reference", "duration_s: 8", "duration_s: 2");
+  const fs::path record = Simulate(scenario);
+  const fs::path starved = WriteVariant(scenario, "starved.yaml", "integrator: {method: auto,",
+                                        "integrator: {max_steps: 10, method: auto,");
+  std::ofstream(starved, std::ios::app) << "updating: {global_search: {enabled: false}}\n";
+  const CommandResult result = Run("-q update " + starved.string() + " " + record.string());
+  EXPECT_EQ(result.exit_code, 3) << result.err;
+  EXPECT_NE(result.err.find("CV_TOO_MUCH_WORK"), std::string::npos) << result.err;
+  EXPECT_EQ(result.err.find("InitGoogleLogging"), std::string::npos) << result.err;
+  EXPECT_EQ(result.err.find("Terminating:"), std::string::npos) << result.err;
+}
+
 TEST_F(UpdateCliTest, MissingDataFileIsInvalidInputAndLeavesNothing) {
   const fs::path scenario = WriteScenario("reference-crane.yaml", "reference");
   const CommandResult result =

@@ -320,6 +320,10 @@ void AddTestFits(FitProblem& fit, const std::vector<Eigen::MatrixXd>& regression
     test_fit.channels = record.channels;
     test_fit.noise_std = test.sigma;
     for (bool given : test.sigma_given) test_fit.noise_estimated.push_back(!given);
+    // NaN until the re-simulation gives them: every reader finds one entry per channel (a failed
+    // re-simulation left them empty, and `mbid update` read past their end: SIGSEGV).
+    test_fit.residual_rms = Eigen::VectorXd::Constant(record.channel_count(), NAN);
+    test_fit.correlation = Eigen::VectorXd::Constant(record.channel_count(), NAN);
     try {
       test_fit.simulated = fit.evaluators[t]->Simulate(fit.x);
       if (test.baseline->terms() > 0) {
