@@ -1,5 +1,6 @@
 // The Python module `mbid` (its compiled part, mbid._mbid): the facade of <mbid/mbid.h> with
 // records as numpy arrays and mbid's errors as Python exceptions with the same one-line text.
+#include <glog/logging.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -184,6 +185,12 @@ mbid::Measurement MakeRecord(const py::object& time_object,
 
 PYBIND11_MODULE(_mbid, m) {
   m.doc() = "mbid: multibody identification (simulate, identify, update, validate)";
+  // Ceres logs a fit stopped by a failed simulation through glog on stderr; the results say
+  // what failed (converged, credible, the message), as the command line does.
+  if (!google::IsGoogleLoggingInitialized()) {
+    FLAGS_minloglevel = google::GLOG_FATAL;
+    google::InitGoogleLogging("mbid");
+  }
 
   // The same one-line messages as the command line; InputError is a ValueError (bad input),
   // NumericalError a RuntimeError (a fit or integration that failed).

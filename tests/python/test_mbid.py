@@ -311,6 +311,29 @@ class ErrorTest(unittest.TestCase):
                                       mbid.simulate(mbid.load_scenario(REFERENCE)).time)
         self.assertEqual(mbid.run(REFERENCE).verdict, "passed")
 
+    def test_a_fit_whose_simulations_fail_is_neither_converged_nor_credible(self):
+        # The integrator allowed 10 steps: every simulation of the fit fails. The result said
+        # converged False but credible True (the default of a fit never judged), and Ceres' glog
+        # lines reached stderr; now neither.
+        with tempfile.TemporaryDirectory() as folder:
+            h5 = os.path.join(folder, "test.h5")
+            subprocess.run([MBID_BINARY, "simulate", REFERENCE, "-o", h5, "--quiet"], check=True)
+            with open(REFERENCE) as f:
+                text = f.read().replace("integrator: {method: auto,",
+                                        "integrator: {max_steps: 10, method: auto,")
+            self.assertIn("max_steps: 10", text)
+            starved = os.path.join(folder, "starved.yaml")
+            with open(starved, "w") as f:
+                f.write(text + "updating: {global_search: {enabled: false}}\n")
+            script = ("import mbid; r = mbid.update(%r, [%r]); print(r.converged, r.credible)"
+                      % (starved, h5))
+            run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                                 env=dict(os.environ))
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertEqual(run.stdout.split(), ["False", "False"])
+        self.assertNotIn("InitGoogleLogging", run.stderr)
+        self.assertNotIn("Terminating:", run.stderr)
+
     def test_arguments_of_the_wrong_type_are_refused_in_one_line(self):
         # pybind11's own TypeError lists every signature over several lines; these name the
         # function, the argument and what it takes.

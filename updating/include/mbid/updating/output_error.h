@@ -235,7 +235,7 @@ struct UpdateResult {
   double chi_square_per_dof = std::numeric_limits<double>::quiet_NaN();
   bool weights_from_records = false;
   double std_inflation = 1;
-  bool credible = true;
+  bool credible = false;  // until AssessCredibility judges it: a failed fit is never credible
   // Weights from the records' noise and a residual that is that noise: neither above
   // max_chi_square_per_dof, nor noticeably above 1 and not white (signal left unexplained).
   bool explains_records = false;
