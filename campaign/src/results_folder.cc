@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mbid/campaign/campaign_case.h"
+#include "mbid/common/atomic_file.h"
 #include "mbid/common/crash_point.h"
 #include "mbid/common/error.h"
 #include "mbid/common/json_io.h"
@@ -57,21 +58,10 @@ bool ParseCommittedName(const std::string& name, std::string* id, uint32_t* crc)
   return !id->empty();
 }
 
-// A temporary of this program: AtomicFile's "<file>.tmp-<pid>-<n>" (or a folder's
-// "<name>.tmp-<pid>"). Only such names, the case files' own and unsealed ones are ever removed:
-// a file of the user's in the folder (or in cases/) stays, whatever its name.
+// Only names this program writes are ever removed (AtomicFile's temporaries, the case files'
+// own and unsealed ones): a file of the user's in the folder (or in cases/) stays.
 bool IsTemporaryName(const std::string& name) {
-  const size_t at = name.rfind(".tmp-");
-  if (at == std::string::npos || at == 0) return false;
-  const std::string rest = name.substr(at + 5);  // "<pid>-<n>" or "<pid>"
-  const size_t dash = rest.find('-');
-  const std::string pid = rest.substr(0, dash);
-  const std::string n = dash == std::string::npos ? "1" : rest.substr(dash + 1);
-  const auto digits = [](const std::string& text) {
-    return !text.empty() && text.size() <= 10 &&
-           text.find_first_not_of("0123456789") == std::string::npos;
-  };
-  return digits(pid) && digits(n);
+  return ParseAtomicTemporaryName(name, nullptr, nullptr);
 }
 
 bool IsUnsealedName(const std::string& name) {

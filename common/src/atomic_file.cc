@@ -29,20 +29,15 @@ std::string MakeTempPath(const std::string& path) {
 // (kill -9, a crash, a power cut): nobody else names files so, and nobody will commit them.
 void RemoveStaleTemporaries(const std::string& path) {
   const fs::path target(path);
-  const std::string prefix = target.filename().string() + ".tmp-";
   const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(folder, error)) {
-    const std::string name = entry.path().filename().string();
-    if (name.compare(0, prefix.size(), prefix) != 0) continue;
-    const std::string rest = name.substr(prefix.size());  // "<pid>-<n>"
-    const size_t dash = rest.find('-');
-    if (dash == 0 || dash == std::string::npos || dash > 9 ||
-        rest.find_first_not_of("0123456789-") != std::string::npos ||
-        rest.find('-', dash + 1) != std::string::npos || dash + 1 == rest.size()) {
+    std::string of;
+    int pid = 0;
+    if (!ParseAtomicTemporaryName(entry.path().filename().string(), &of, &pid) ||
+        of != target.filename().string()) {
       continue;
     }
-    const int pid = std::stoi(rest.substr(0, dash));
     std::error_code ignored;
     if (internal::ProcessIsGone(pid) && entry.is_regular_file(ignored)) {
       fs::remove(entry.path(), ignored);
@@ -179,6 +174,21 @@ void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
       }
     }
   }
+}
+
+bool ParseAtomicTemporaryName(const std::string& name, std::string* target, int* pid) {
+  const size_t at = name.rfind(".tmp-");
+  if (at == std::string::npos || at == 0) return false;
+  const std::string rest = name.substr(at + 5);  // "<pid>-<n>"
+  const size_t dash = rest.find('-');
+  if (dash == 0 || dash == std::string::npos || dash > 9 ||
+      rest.find_first_not_of("0123456789-") != std::string::npos ||
+      rest.find('-', dash + 1) != std::string::npos || dash + 1 == rest.size()) {
+    return false;
+  }
+  if (target != nullptr) *target = name.substr(0, at);
+  if (pid != nullptr) *pid = std::stoi(rest.substr(0, dash));
+  return true;
 }
 
 void CheckOutputsReplaceable(const std::vector<NamedFile>& outputs, bool overwrite) {

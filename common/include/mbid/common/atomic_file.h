@@ -54,6 +54,10 @@ struct NamedFile {
 void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
                         const std::vector<NamedFile>& outputs);
 
+// Whether the file name `name` is an AtomicFile temporary, "<target>.tmp-<pid>-<n>"; if so,
+// `target` and `pid` (either may be null) receive its target's file name and its writer's pid.
+bool ParseAtomicTemporaryName(const std::string& name, std::string* target, int* pid);
+
 // Throws InputError (naming the output's flag and path) before any work when an output's folder
 // does not exist, or the output exists and `overwrite` is false: nothing of the user's is
 // replaced unasked (--overwrite). Outputs "" and "-" are skipped.
