@@ -197,6 +197,17 @@ double ThirdDifferenceNoise(const Eigen::VectorXd& y) {
   return third[third.size() / 2] / 0.6745 / std::sqrt(20.0);
 }
 
+// Each column's level at rest: the median of its first `rest` samples.
+std::vector<double> RestLevels(const Eigen::MatrixXd& y, int rest) {
+  std::vector<double> levels;
+  for (Eigen::Index c = 0; c < y.cols(); ++c) {
+    std::vector<double> before(y.col(c).data(), y.col(c).data() + rest);
+    std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
+    levels.push_back(before[before.size() / 2]);
+  }
+  return levels;
+}
+
 }  // namespace
 
 // DetectRelease in all of `record`'s channels.
@@ -291,12 +302,9 @@ ReleaseDetection DetectReleaseInChannels(const Measurement& record) {
   // late). Where fewer than kShortRestSamples precede the release, each channel must also stay
   // within 6 noise standard deviations of that median (the noise from the whole record's third
   // differences; a coarsely sampled decay overstates it, which leaves the test lenient).
-  std::vector<double> levels;
+  const std::vector<double> levels = RestLevels(y, rest);
   for (Eigen::Index c = 0; c < m; ++c) {
-    std::vector<double> before(y.col(c).data(), y.col(c).data() + rest);
-    std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
-    const double level = before[before.size() / 2];
-    levels.push_back(level);
+    const double level = levels[static_cast<size_t>(c)];
     double bound = kRestFraction * range(c);
     const double noise = ThirdDifferenceNoise(y.col(c));
     // A long rest in a channel whose noise is a few % of its range holds 4-sigma samples beyond
@@ -340,14 +348,8 @@ ReleaseDetection DetectRelease(const Measurement& record) {
     if (c < record.units.size()) part.units.push_back(record.units[c]);
   }
   ReleaseDetection detection = DetectReleaseInChannels(part);
-  if (detection.detected) {
-    detection.rest_level.clear();
-    for (Eigen::Index c = 0; c < record.values.cols(); ++c) {
-      std::vector<double> before(record.values.col(c).data(),
-                                 record.values.col(c).data() + detection.rest_samples);
-      std::nth_element(before.begin(), before.begin() + before.size() / 2, before.end());
-      detection.rest_level.push_back(before[before.size() / 2]);
-    }
+  if (detection.detected) {  // every channel's, glitches bridged as for the detection's own
+    detection.rest_level = RestLevels(BridgeGlitches(record.values), detection.rest_samples);
   }
   return detection;
 }
