@@ -1,7 +1,6 @@
 #include "mbid/campaign/campaign.h"
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -111,16 +110,9 @@ void CheckDeclaredParameter(const Campaign& campaign, const Assignment& input) {
   if (input.key.rfind(prefix, 0) != 0) return;
   const std::string name =
       input.key.substr(prefix.size(), input.key.find_first_of(".[", prefix.size()) - prefix.size());
-  const YAML::Node declared = campaign.base["model"]["parameters"];
-  std::vector<std::string> names;
-  if (declared && declared.IsMap()) {
-    for (const auto& entry : declared) names.push_back(entry.first.as<std::string>());
-  }
-  if (std::find(names.begin(), names.end(), name) != names.end()) return;
-  std::string expected = names.empty() ? "a parameter the base scenario declares in "
-                                         "model.parameters (it declares none)"
-                                       : "one of " + fmt::format("{}", fmt::join(names, ", "));
-  if (!names.empty()) expected += "; did you mean '" + ClosestMatch(name, names) + "'?";
+  const std::string expected =
+      validation::ExpectDeclaredParameter(campaign.base, name, "base scenario");
+  if (expected.empty()) return;
   throw InputError(campaign.path, input.field,
                    "'" + name +
                        "' is not a parameter of the base scenario's model (a value "

@@ -1,9 +1,7 @@
 #include "mbid/validation/plan_candidates.h"
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
-#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -84,20 +82,14 @@ CandidateFile ReadCandidateFile(const std::string& path, const Scenario& scenari
       const YamlReader overrides = entry.Child("model");
       if (overrides.IsMap() && overrides.Has("parameters") &&
           overrides.Child("parameters").IsMap()) {
-        std::vector<std::string> declared;
-        if (scenario.root.Has("model") && scenario.root.Child("model").Has("parameters") &&
-            scenario.root.Child("model").Child("parameters").IsMap()) {
-          declared = scenario.root.Child("model").Child("parameters").Keys();
-        }
         const YamlReader parameters = overrides.Child("parameters");
         for (const std::string& name : parameters.Keys()) {
-          if (std::find(declared.begin(), declared.end(), name) != declared.end()) continue;
-          parameters.FailAt(name, "'" + name + "' is not a parameter of the scenario's model",
-                            declared.empty()
-                                ? "a parameter the scenario declares in model.parameters (it "
-                                  "declares none)"
-                                : "one of " + fmt::format("{}", fmt::join(declared, ", ")) +
-                                      "; did you mean '" + ClosestMatch(name, declared) + "'?");
+          const std::string expected =
+              ExpectDeclaredParameter(scenario.root.node(), name, "scenario");
+          if (!expected.empty()) {
+            parameters.FailAt(name, "'" + name + "' is not a parameter of the scenario's model",
+                              expected);
+          }
         }
       }
       const YamlReader merged(MergedSection(scenario, entry, "model", false), path,

@@ -1,7 +1,9 @@
 #include "mbid/validation/scenario.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -138,6 +140,23 @@ std::string DefaultScenarioPath(const std::string& data_dir_hint) {
   }
   // None found: the source tree's path, which the error of reading it will name.
   return (fs::path(MBID_SOURCE_DIR) / relative).string();
+}
+
+std::string ExpectDeclaredParameter(const YAML::Node& root, const std::string& name,
+                                    const std::string& whose) {
+  std::vector<std::string> declared;
+  // A missing key is an invalid node, which only its bool test may touch.
+  const YAML::Node model = root.IsMap() ? root["model"] : YAML::Node();
+  const YAML::Node parameters = model && model.IsMap() ? model["parameters"] : YAML::Node();
+  if (parameters && parameters.IsMap()) {
+    for (const auto& entry : parameters) declared.push_back(entry.first.as<std::string>());
+  }
+  if (std::find(declared.begin(), declared.end(), name) != declared.end()) return "";
+  if (declared.empty()) {
+    return "a parameter the " + whose + " declares in model.parameters (it declares none)";
+  }
+  return fmt::format("one of {}; did you mean '{}'?", fmt::join(declared, ", "),
+                     ClosestMatch(name, declared));
 }
 
 }  // namespace mbid::validation

@@ -65,4 +65,11 @@ Scenario LoadScenarioFromText(const std::string& text, const std::string& source
 // configured installation's share/mbid.
 std::string DefaultScenarioPath(const std::string& data_dir_hint = "");
 
+// What a reference to parameter `name` of a scenario's `model.parameters` (`root`: the
+// scenario's YAML) expects instead, or "" when the scenario declares it. model.parameters is a
+// free map: a misspelt name elsewhere (a campaign's sweep, a plan candidate) would be one more
+// parameter that nothing uses. `whose` names the scenario in the text ("base scenario").
+std::string ExpectDeclaredParameter(const YAML::Node& root, const std::string& name,
+                                    const std::string& whose);
+
 }  // namespace mbid::validation
