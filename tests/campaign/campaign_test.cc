@@ -235,12 +235,10 @@ TEST_F(CampaignTest, LawRecoversAnExactQuadraticInTwoVariables) {
   EXPECT_NE(flat.status, "ok");
 }
 
-TEST_F(CampaignTest, DamperSizingFindsTheAnalyticSmallestDamper) {
-  Write("oscillator.yaml", kOscillator);
-  // The sweep 0.5..20 (log, 11 points) brackets d = 4 between 3.16 and 4.57; bisection to a
-  // relative 1e-9 must land within 1e-8 of it (4 * 1e-9 plus the eigenvalue round-off).
-  const Campaign campaign = LoadCampaign(Write("sizing.yaml", R"(name: sizing
-base: oscillator.yaml
+// Sizing the damper of joint `angle` of `base` for a damping ratio of 0.1: 11 log-spaced points
+// over 0.5..20 N*m*s/rad, then bisection to a relative 1e-9.
+std::string SizingCampaign(const std::string& base) {
+  return "name: sizing\nbase: " + base + R"(
 study: damper_sizing
 damper_sizing:
   joints: [angle]
@@ -249,7 +247,14 @@ damper_sizing:
   relative_tolerance: 1.0e-9
   targets:
     min_damping_ratio: 0.1
-)"));
+)";
+}
+
+TEST_F(CampaignTest, DamperSizingFindsTheAnalyticSmallestDamper) {
+  Write("oscillator.yaml", kOscillator);
+  // The sweep 0.5..20 (log, 11 points) brackets d = 4 between 3.16 and 4.57; bisection to a
+  // relative 1e-9 must land within 1e-8 of it (4 * 1e-9 plus the eigenvalue round-off).
+  const Campaign campaign = LoadCampaign(Write("sizing.yaml", SizingCampaign("oscillator.yaml")));
   EXPECT_FALSE(campaign.steps.simulate);  // the damping ratio needs the modes alone
   ASSERT_EQ(campaign.cases.size(), 11u);
   CampaignRunOptions options;
@@ -293,17 +298,7 @@ excitation: {type: initial_deflection, deflection_rad: {angle: 0.01}}
 simulation: {duration_s: 2}
 sensors: {sample_rate_hz: 50, channels: [angle], noise_std_rad: 1.0e-5, seed: 1}
 )");
-  const std::string sizing = R"(name: sizing
-base: turntable.yaml
-study: damper_sizing
-damper_sizing:
-  joints: [angle]
-  range_Nms_per_rad: [0.5, 20]
-  points: 11
-  relative_tolerance: 1.0e-9
-  targets:
-    min_damping_ratio: 0.1
-)";
+  const std::string sizing = SizingCampaign("turntable.yaml");
   const Campaign campaign = LoadCampaign(Write("sizing.yaml", sizing));
   CampaignRunOptions options;
   options.quiet = true;
