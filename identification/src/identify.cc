@@ -107,21 +107,36 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
   }
   if (options.decimation == 0 && record.decimation > 1) {
     // What the band chosen from the spectrum left out: a decaying mode above it is a burst at
-    // the start of what the modes' full-rate fit leaves (out_of_band.h). Analysed again with a
-    // band that holds it.
+    // the start of what the modes' full-rate fit leaves (out_of_band.h), a mode at its top is
+    // half in the filter's edge (a Hann window hides a short record's fast decay). Analysed
+    // again with a band that holds it.
     const Eigen::MatrixXd residual = record.values - result.reconstruction;
-    const double top_hz =
+    const double burst_hz =
         FindDecayingContentTop(record.centered, residual, record.sample_interval_s);
-    if (top_hz > record.flat_frequency_hz) {
-      IdentificationOptions wider = options;
-      wider.decimation =
-          DecimationForBand(1.25 * top_hz, record.sample_interval_s, record.values.rows());
+    double edge_hz = 0;
+    if (options.max_frequency_hz <= 0) {
+      for (const IdentifiedMode& mode : result.modes) {
+        if (mode.frequency_hz > 0.95 * record.flat_frequency_hz) {
+          edge_hz = std::max(edge_hz, mode.frequency_hz);
+        }
+      }
+    }
+    const double top_hz = std::max(burst_hz > record.flat_frequency_hz ? burst_hz : 0, edge_hz);
+    IdentificationOptions wider = options;
+    wider.decimation =
+        DecimationForBand(1.25 * top_hz, record.sample_interval_s, record.values.rows());
+    if (top_hz > 0 && wider.decimation < record.decimation) {
       ModalResult again = Identify(measurement, wider, origin);
+      const std::string what =
+          top_hz == edge_hz
+              ? fmt::format("a mode at {:.4g} Hz is at the top of", edge_hz)
+              : fmt::format("the record's start holds a decaying component up to {:.4g} Hz, above",
+                            burst_hz);
       again.warnings.insert(
           again.warnings.begin(),
-          fmt::format("the record's start holds a decaying component up to {:.4g} Hz, above the "
-                      "{:.4g} Hz its spectrum showed (decimation {}): analysed with decimation {}",
-                      top_hz, record.flat_frequency_hz, record.decimation, wider.decimation));
+          fmt::format("{} the {:.4g} Hz its spectrum showed (decimation {}): analysed with "
+                      "decimation {}",
+                      what, record.flat_frequency_hz, record.decimation, wider.decimation));
       return again;
     }
   }

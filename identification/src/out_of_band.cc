@@ -1,12 +1,16 @@
 #include "out_of_band.h"
 
+#include <algorithm>
+
 #include "mbid/identification/spectrum.h"
 
 namespace mbid::identification {
 namespace {
 
-constexpr Eigen::Index kSegment = 2048;
+constexpr Eigen::Index kLongestSegment = 2048;
 constexpr Eigen::Index kBandBins = 32;
+// Two bands at least, so that a band above the analysed one exists.
+constexpr Eigen::Index kShortestSegment = 2 * kBandBins;
 constexpr double kPowerRatio = 10;
 constexpr double kRoundOff = 1e-12;
 
@@ -29,15 +33,17 @@ Eigen::MatrixXd MirroredPower(const Eigen::MatrixXd& segment, double sample_inte
 
 double FindDecayingContentTop(const Eigen::MatrixXd& values, const Eigen::MatrixXd& residual,
                               double sample_interval_s) {
-  const Eigen::Index samples = residual.rows();
-  if (samples < 2 * kSegment) return 0;
+  // A short record's halves: a burst at the start is as plain there, and the two halves' noise
+  // as alike (the bands keep their 32 bins whatever the segment's length).
+  const Eigen::Index segment = std::min(kLongestSegment, residual.rows() / 2);
+  if (segment < kShortestSegment) return 0;
   Eigen::VectorXd frequency_hz;
   const Eigen::MatrixXd start =
-      MirroredPower(residual.topRows(kSegment), sample_interval_s, &frequency_hz);
+      MirroredPower(residual.topRows(segment), sample_interval_s, &frequency_hz);
   const Eigen::MatrixXd end =
-      MirroredPower(residual.bottomRows(kSegment), sample_interval_s, &frequency_hz);
+      MirroredPower(residual.bottomRows(segment), sample_interval_s, &frequency_hz);
   const Eigen::VectorXd total =
-      MirroredPower(values.topRows(kSegment), sample_interval_s, &frequency_hz).colwise().sum();
+      MirroredPower(values.topRows(segment), sample_interval_s, &frequency_hz).colwise().sum();
   double top_hz = 0;
   for (Eigen::Index c = 0; c < residual.cols(); ++c) {
     for (Eigen::Index b = 1; b + kBandBins <= start.rows(); b += kBandBins) {

@@ -12,9 +12,10 @@ namespace mbid::identification {
 
 // The highest frequency (Hz) at which the start of `residual` (samples x channels at the full
 // sample rate: the record `values` less its fitted modes) holds 10 times the power its end
-// holds, in bands of 32 bins of the spectra of its first and last 2048 samples (each mirrored,
-// so that its ends leak nothing), and over 1e-12 of the power of the values' start (round-off
-// of a noiseless record is no mode); 0 if there is none or the record is under 4096 samples.
+// holds, in bands of 32 bins of the spectra of its first and last 2048 samples, or halves if it
+// is shorter (each mirrored, so that its ends leak nothing), and over 1e-12 of the power of the
+// values' start (round-off of a noiseless record is no mode); 0 if there is none or the record
+// is under 128 samples.
 // Stationary noise, coloured or not, has the same power at both ends: the F ratio of 64 degrees
 // of freedom exceeds 10 with probability below 1e-12.
 double FindDecayingContentTop(const Eigen::MatrixXd& values, const Eigen::MatrixXd& residual,
