@@ -32,11 +32,11 @@ namespace {
 // over the channels c. The score is the terms' least-squares reduction of the residual, over
 // each channel's residual variance, less that of the drift in the mode's shape: chi-square with
 // 4 (channels - 1) degrees of freedom when the one mode is all there is. One channel cannot
-// tell a pair from a drift: no score (0).
+// tell a pair from a drift: its score is the whole reduction (4 degrees of freedom), and a pair
+// it splits into is judged "drifting or two" (AssessReliability's 3 % rule).
 double CloseModeScore(const AnalysisRecord& record, const Estimate& estimate,
                       const Eigen::HouseholderQR<Eigen::MatrixXd>& model_qr,
                       const Eigen::MatrixXd& residual, const Eigen::VectorXd& variance, size_t k) {
-  if (residual.cols() < 2) return 0;
   const Eigen::Index samples = residual.rows();
   Eigen::MatrixXd terms(samples, 4);
   ForEachModeSample(estimate.lambda[k], record.decimated_interval_s, 0, static_cast<int>(samples),
@@ -67,6 +67,7 @@ double CloseModeScore(const AnalysisRecord& record, const Estimate& estimate,
     normal += shape.transpose() * outside * shape / variance(c);
     right += shape.transpose() * outside * (inverse * projections.col(c)) / variance(c);
   }
+  if (residual.cols() < 2) return score;
   return score - right.dot(normal.completeOrthogonalDecomposition().pseudoInverse() * right);
 }
 
@@ -88,9 +89,8 @@ void SplitCloseModes(const AnalysisRecord& record, const IdentificationOptions& 
                      Estimate* estimate) {
   const Eigen::MatrixXd& values = record.decimated;
   const Eigen::Index samples = values.rows();
-  if (values.cols() < 2) return;  // no score (CloseModeScore)
-  const double threshold = CalcChiSquareThreshold(2 * static_cast<int>(values.cols()) - 2,
-                                                  options.significance_false_alarm);
+  const double threshold = CalcChiSquareThreshold(
+      std::max(2, 2 * static_cast<int>(values.cols()) - 2), options.significance_false_alarm);
   // The modes' basis, its QR and the residual: once, and again after a kept split.
   std::optional<Eigen::HouseholderQR<Eigen::MatrixXd>> model_qr;
   Eigen::MatrixXd residual;
