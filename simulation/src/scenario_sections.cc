@@ -137,6 +137,10 @@ SimulationOptions ReadSimulationOptions(const YamlReader& node) {
   return options;
 }
 
+std::vector<std::string> DefaultChannels(const model::MechanicalModel& model) {
+  return model.output_names().empty() ? model.coordinate_names() : model.output_names();
+}
+
 SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalModel& model) {
   SensorOptions options;
   std::vector<std::string> keys{"sample_rate_hz", "channels", "seed"};
@@ -145,8 +149,7 @@ SensorOptions ReadSensorOptions(const YamlReader& node, const model::MechanicalM
   }
   node.ExpectMap(keys);
   options.sample_rate_hz = node.PositiveDouble("sample_rate_hz", options.sample_rate_hz);
-  // Without a list, every output of the model (the crane's psi and phi).
-  options.channels = node.Has("channels") ? node.StringList("channels") : model.output_names();
+  options.channels = node.Has("channels") ? node.StringList("channels") : DefaultChannels(model);
   if (options.channels.empty()) node.FailAt("channels", "no channel", "at least one channel");
   std::vector<std::string> known = model.output_names();
   known.insert(known.end(), model.coordinate_names().begin(), model.coordinate_names().end());

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "command_test.h"
+#include "mbid/common/hdf5_io.h"
 
 namespace mbid::testing {
 namespace {
@@ -256,6 +257,31 @@ updating: {fit_initial_deflection: true, global_search: {enabled: false}}
   EXPECT_EQ(parameters[name]["units"], "m");
   EXPECT_NEAR(parameters[name]["value"].get<double>(), 0.01,
               4 * parameters[name]["std"].get<double>());
+}
+
+// A trial's description without `sensors:` was refused for "unknown channel 'psi'", the crane's
+// channels, in a line naming no file. Its channels are now its outputs, as with a `sensors:`
+// that lists none; and its initial deflection, a length, is labelled m (it was rad).
+TEST_F(MachineCliTest, ADescriptionWithoutSensorsRecordsItsOutputs) {
+  const fs::path scenario = dir_ / "bare.yaml";
+  std::ofstream(scenario) << R"(name: bare
+model:
+  type: multibody
+  bodies:
+    cart: {parent: ground, joint: {type: prismatic, coordinates: [x], axis: [1, 0, 0]}, mass_kg: 1000.0, inertia_kgm2: [100, 100, 100]}
+  springs:
+    x: {stiffness_N_per_m: 1.0e6, damping_Ns_per_m: 2000.0}
+  outputs: {x_cart: {type: coordinate, coordinate: x}}
+excitation: {type: initial_deflection, deflection_m: {x: 0.01}}
+simulation: {duration_s: 1}
+)";
+  const fs::path record = dir_ / "bare.h5";
+  const CommandResult result = Run("simulate " + scenario.string() + " -o " + record.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const H5Reader reader(record.string());
+  EXPECT_EQ(reader.ReadMeasurement().channels, std::vector<std::string>{"x_cart"});
+  EXPECT_EQ(reader.ReadUnits("/truth", "initial_q"), "m");
+  EXPECT_DOUBLE_EQ(reader.ReadVector("/truth", "initial_q")(0), 0.01);
 }
 
 struct BadMachine {

@@ -31,7 +31,14 @@ ModelTruth CalcModelTruth(const model::MechanicalModel& model) {
 void WriteTruth(H5Writer& file, const ModelTruth& truth,
                 const simulation::SimulationResult& result) {
   WriteModelTruth(file, truth);
-  file.WriteVector("/truth", "initial_q", result.initial_q, "rad");
+  // One unit where the coordinates share it (a slide's m), else /truth/linear_model's per
+  // coordinate.
+  const std::vector<std::string>& units = truth.coordinate_units;
+  const bool one_unit =
+      !units.empty() && std::all_of(units.begin(), units.end(),
+                                    [&](const std::string& unit) { return unit == units[0]; });
+  file.WriteVector("/truth", "initial_q", result.initial_q,
+                   one_unit ? units[0] : "SI, per coordinate_units");
   file.WriteStrings("/truth", "coordinates", truth.coordinate_names);
   for (int c = 0; c < result.exact.channel_count(); ++c) {
     file.WriteVector("/truth/exact", result.exact.channels[c], result.exact.values.col(c),

@@ -88,6 +88,8 @@ Scenario LoadScenarioFromText(const std::string& text, const std::string& source
   }
   if (scenario.root.Has("sensors")) {
     scenario.sensors = simulation::ReadSensorOptions(scenario.root.Child("sensors"), *model);
+  } else {
+    scenario.sensors.channels = simulation::DefaultChannels(*model);
   }
   internal::CheckSampleCount(scenario.root.source(),
                              "simulation.duration_s, sensors.sample_rate_hz",

@@ -34,5 +34,8 @@ SimulationOptions ReadSimulationOptions(const YamlReader& simulation);
 // An `integrator:` block; keys it leaves out keep their values in `defaults`.
 IntegratorOptions ReadIntegratorOptions(const YamlReader& integrator, IntegratorOptions defaults);
 SensorOptions ReadSensorOptions(const YamlReader& sensors, const model::MechanicalModel& model);
+// The channels of a scenario that lists none (or has no `sensors:`): the model's outputs, or its
+// coordinates when it has no outputs.
+std::vector<std::string> DefaultChannels(const model::MechanicalModel& model);
 
 }  // namespace mbid::simulation
