@@ -229,5 +229,27 @@ TEST(ProfileTest, AGlitchInTheRecordDeterminesNothing) {
   }
 }
 
+// A trial's case: a sensor bias of 20 times the noise, and the fit told no offsets. The
+// misfit was said to be "a local minimum, or a model that lacks something"; the residual, a
+// constant, names the offset (2e-3 rad, as the record carries it) and the key that fits it.
+TEST(ProfileTest, AnUnfittedSensorOffsetIsNamedInTheMisfit) {
+  Release release(1e-4);
+  release.test.record.values.array() += 2e-3;
+  const UpdateResult result = UpdateModel(*release.truth, {release.test}, release.Options());
+  EXPECT_FALSE(result.credible);
+  ASSERT_FALSE(result.credibility.empty());
+  EXPECT_NE(result.credibility.front().find(
+                "the residual of angle is mostly a constant (0.002 rad, 20 times the noise): an "
+                "offset of the sensor, which updating.fit_offsets: true fits"),
+            std::string::npos)
+      << result.credibility.front();
+  // A record without the offset says nothing of the kind.
+  const Release plain(1e-4);
+  for (const std::string& line :
+       UpdateModel(*plain.truth, {plain.test}, plain.Options()).credibility) {
+    EXPECT_EQ(line.find("mostly a constant"), std::string::npos) << line;
+  }
+}
+
 }  // namespace
 }  // namespace mbid::updating

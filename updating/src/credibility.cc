@@ -33,6 +33,7 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
   bool from_records = true;
   double worst_time = 1;
   std::string worst_channel;
+  std::string offset_hint;
   for (size_t t = 0; t < tests.size(); ++t) {
     TestFit& fit = result.tests[t];
     const Measurement& record = tests[t].record;
@@ -47,6 +48,17 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
       from_records = from_records && !fit.noise_estimated[static_cast<size_t>(c)];
       const Eigen::VectorXd r =
           (fit.simulated.values.col(c) - record.values.col(c)) / fit.noise_std[c];
+      // Most of an unfitted channel's residual power in its mean: a sensor offset.
+      const double mean = r.mean();
+      if (fit.offset.size() == 0 && offset_hint.empty() && r.size() > 1 &&
+          mean * mean > 0.5 * r.squaredNorm() / static_cast<double>(r.size()) &&
+          std::abs(mean) > 3) {
+        offset_hint = fmt::format(
+            "; the residual of {} is mostly a constant ({:.3g} {}, {:.3g} times the noise): an "
+            "offset of the sensor, which updating.fit_offsets: true fits",
+            record.channels[static_cast<size_t>(c)], -mean * fit.noise_std[c],
+            record.units[static_cast<size_t>(c)], std::abs(mean));
+      }
       Whiteness(r, options.whiteness_lags, &fit.whiteness_q[c], &fit.whiteness_p[c],
                 &fit.correlation_time[c]);
       // A residual white at the 0.1% level is not inflated for its sampling wiggle.
@@ -77,17 +89,17 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
     result.credibility.push_back(fmt::format(
         "the re-simulation misses the records by {:.3g} times their noise (chi^2/dof = {:.4g} > "
         "{}): a local minimum, or a model that lacks something; no parameter is determined by "
-        "this fit",
+        "this fit{}",
         std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof,
-        options.max_chi_square_per_dof));
+        options.max_chi_square_per_dof, offset_hint));
   } else if (structured) {
     result.credibility.push_back(fmt::format(
         "the residual is {:.3g} times the records' noise (chi^2/dof = {:.4g}) and not white "
         "(correlation time {:.3g} samples on {}): the excess is signal the model does not "
         "reproduce, a local minimum or a model that lacks something; no parameter is determined "
-        "by this fit",
-        std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof, worst_time,
-        worst_channel));
+        "by this fit{}",
+        std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof, worst_time, worst_channel,
+        offset_hint));
   } else {
     if (excess > kNoticeableExcess) {
       result.credibility.push_back(fmt::format(
