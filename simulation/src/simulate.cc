@@ -1,7 +1,11 @@
 #include "mbid/simulation/simulate.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
@@ -16,6 +20,27 @@ namespace {
 constexpr CvodesIntegrator::Realization kUnrealized = CvodesIntegrator::Realization::kNone;
 
 }  // namespace
+
+std::vector<std::string> FindStartFarFromRest(const model::MechanicalModel& model,
+                                              const Excitation& excitation) {
+  const InitialDeflection* deflection = excitation.get_if<InitialDeflection>();
+  if (deflection == nullptr) return {};
+  const Eigen::VectorXd start = deflection->CalcInitialCoordinates(model);
+  const Eigen::VectorXd rest = model.SolveStaticEquilibrium({});
+  const double given = start.lpNorm<Eigen::Infinity>();
+  Eigen::Index worst = 0;
+  const double away = (start - rest).cwiseAbs().maxCoeff(&worst);
+  // Twice the largest deflection given: the release is mostly the machine's sag, not the test.
+  if (!(away > 2 * given)) return {};
+  const std::string& name = model.coordinate_names()[static_cast<size_t>(worst)];
+  const std::string unit = model.coordinate_units()[static_cast<size_t>(worst)];
+  return {fmt::format(
+      "initial_deflection starts {} at {:.4g} {}, {:.4g} {} from where the machine rests with its "
+      "attached payload ({:.4g} {}): the coordinates count from q = 0, the unloaded rest, and "
+      "the release is mostly the machine settling under its payload; add the rest to the "
+      "deflection for a test about it",
+      name, start[worst], unit, away, unit, rest[worst], unit)};
+}
 
 SimulationResult Simulate(const model::MechanicalModel& model, const Excitation& excitation,
                           const SimulationOptions& options, const SensorOptions& sensors) {

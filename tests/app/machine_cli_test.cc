@@ -284,6 +284,42 @@ simulation: {duration_s: 1}
   EXPECT_DOUBLE_EQ(reader.ReadVector("/truth", "initial_q")(0), 0.01);
 }
 
+// A trial's case: a payload attached in the description rests the machine away from q = 0,
+// and initial_deflection's coordinates count from q = 0: 3 mrad given, the release was 60 mrad
+// from rest, silently. simulate now says so; without the payload it says nothing.
+TEST_F(MachineCliTest, ADeflectionFarFromTheLoadedRestIsWarnedOf) {
+  const auto arm = [&](double payload_kg) {
+    const fs::path scenario = dir_ / "arm.yaml";
+    std::ofstream(scenario) << R"(name: arm
+model:
+  type: multibody
+  bodies:
+    link: {parent: ground, joint: {type: revolute, coordinates: [q], axis: [0, 1, 0]}, mass_kg: 50.0, com_m: [0.5, 0, 0], inertia_kgm2: [1, 4, 4]}
+  springs:
+    q: {stiffness_Nm_per_rad: 3000.0, damping_Nms_per_rad: 15.0}
+  points:
+    tip: {body: link, at_m: [1, 0, 0]}
+  payload_point: tip
+  payload_mass_kg: )" << payload_kg
+                            << R"(
+  outputs: {q_out: {type: coordinate, coordinate: q}}
+excitation: {type: initial_deflection, deflection_rad: {q: 0.003}}
+simulation: {duration_s: 1}
+)";
+    return Run("simulate " + scenario.string() + " -o " + (dir_ / "arm.h5").string() +
+               " --overwrite");
+  };
+  // 20 kg at 1 m on 3000 N m/rad: a rest about 20 * 9.81 / 3000 = 0.065 rad from q = 0.
+  const CommandResult loaded = arm(20);
+  ASSERT_EQ(loaded.exit_code, 0) << loaded.err;
+  EXPECT_NE(loaded.err.find("from where the machine rests with its attached payload"),
+            std::string::npos)
+      << loaded.err;
+  const CommandResult bare = arm(0);
+  ASSERT_EQ(bare.exit_code, 0) << bare.err;
+  EXPECT_EQ(bare.err.find("warning"), std::string::npos) << bare.err;
+}
+
 struct BadMachine {
   const char* name;
   const char* from;

@@ -37,6 +37,13 @@ struct SimulationResult {
 SimulationResult Simulate(const model::MechanicalModel& model, const Excitation& excitation,
                           const SimulationOptions& options, const SensorOptions& sensors);
 
+// One line when an initial_deflection starts the machine far from where it rests: its
+// coordinates count from q = 0, the unloaded machine's rest, and a payload attached in the
+// description rests it elsewhere (a 20 kg payload on a double pendulum: 80 mrad away, for a
+// deflection of 4 mrad). Empty otherwise.
+std::vector<std::string> FindStartFarFromRest(const model::MechanicalModel& model,
+                                              const Excitation& excitation);
+
 // The state where a test's free decay begins: for a free decay the excitation's initial
 // coordinates at rest at t = 0; for a forced test (an impulse, a burst) the coordinates and
 // speeds where the forcing ends, integrated from rest through it.
