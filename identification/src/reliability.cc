@@ -12,8 +12,9 @@ namespace mbid::identification {
 
 bool IsDetermined(double frequency_hz, double std_frequency_hz, double decay_rate_per_s,
                   double std_decay_rate_per_s) {
+  // A negative decay within its std is no more determined than a positive one: its sign is not.
   return !(std_frequency_hz > 0.1 * frequency_hz ||
-           (decay_rate_per_s > 0 && std_decay_rate_per_s > decay_rate_per_s));
+           (decay_rate_per_s != 0 && std_decay_rate_per_s > std::abs(decay_rate_per_s)));
 }
 
 std::vector<std::string> RecordFaults(const AnalysisRecord& record) {
@@ -104,6 +105,14 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
     if (options.min_frequency_hz > 0 && mode.frequency_hz < 1.05 * options.min_frequency_hz) {
       reasons.push_back(fmt::format("the mode at {:.4g} Hz is at the bottom of the band ({} Hz)",
                                     mode.frequency_hz, options.min_frequency_hz));
+    }
+    // A mode that grows beyond its std is no free decay of a passive machine: a self-excited
+    // vibration (which a damper sizing must know of), or a record that is not a free decay.
+    if (mode.decay_rate_per_s < -3 * mode.std_decay_rate_per_s) {
+      result->warnings.push_back(fmt::format(
+          "the mode at {:.4g} Hz grows (decay rate {:.3g} +- {:.2g} 1/s): no free decay of a "
+          "passive machine does; a self-excited vibration, or a record that is not a free decay",
+          mode.frequency_hz, mode.decay_rate_per_s, mode.std_decay_rate_per_s));
     }
     if (!IsDetermined(mode.frequency_hz, mode.std_frequency_hz, mode.decay_rate_per_s,
                       mode.std_decay_rate_per_s)) {

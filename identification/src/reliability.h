@@ -15,8 +15,8 @@ namespace mbid::identification {
 std::vector<std::string> RecordFaults(const AnalysisRecord& record);
 
 // Whether the record determines a mode: the standard deviation of its frequency within 10 % of
-// the frequency and that of its decay rate within the decay rate (a NaN deviation, not
-// computed, passes). AssessReliability calls a mode that fails "undetermined".
+// the frequency and that of its decay rate within the decay rate's magnitude (a NaN deviation,
+// not computed, passes). AssessReliability calls a mode that fails "undetermined".
 bool IsDetermined(double frequency_hz, double std_frequency_hz, double decay_rate_per_s,
                   double std_decay_rate_per_s);
 
