@@ -5,14 +5,6 @@
 #include "mbid/identification/spectrum.h"
 
 namespace mbid::identification {
-namespace {
-
-constexpr Eigen::Index kLongestSegment = 2048;
-constexpr Eigen::Index kBandBins = 32;
-// Two bands at least, so that a band above the analysed one exists.
-constexpr Eigen::Index kShortestSegment = 2 * kBandBins;
-constexpr double kPowerRatio = 10;
-constexpr double kRoundOff = 1e-12;
 
 // Squared amplitude spectrum of `segment` mirrored (its periodic extension continuous).
 Eigen::MatrixXd MirroredPower(const Eigen::MatrixXd& segment, double sample_interval_s,
@@ -28,6 +20,15 @@ Eigen::MatrixXd MirroredPower(const Eigen::MatrixXd& segment, double sample_inte
   *frequency_hz = spectrum.frequency_hz;
   return spectrum.amplitude.array().square();
 }
+
+namespace {
+
+constexpr Eigen::Index kLongestSegment = 2048;
+constexpr Eigen::Index kBandBins = 32;
+// Two bands at least, so that a band above the analysed one exists.
+constexpr Eigen::Index kShortestSegment = 2 * kBandBins;
+constexpr double kPowerRatio = 10;
+constexpr double kRoundOff = 1e-12;
 
 }  // namespace
 

@@ -10,6 +10,11 @@
 
 namespace mbid::identification {
 
+// Squared amplitude spectrum (samples + 1 bins x channels) of `segment` mirrored: its periodic
+// extension is continuous, so its ends leak nothing and its start is not windowed away.
+Eigen::MatrixXd MirroredPower(const Eigen::MatrixXd& segment, double sample_interval_s,
+                              Eigen::VectorXd* frequency_hz);
+
 // The highest frequency (Hz) at which the start of `residual` (samples x channels at the full
 // sample rate: the record `values` less its fitted modes) holds 10 times the power its end
 // holds, in bands of 32 bins of the spectra of its first and last 2048 samples, or halves if it

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "coloured_noise.h"
 #include "mbid/common/channel_fault.h"
 #include "residual_windows.h"
 
@@ -74,6 +75,22 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
         "start before the free decay)",
         from_s, from_s + windows.excess->samples * tau, windows.excess->power_ratio);
     (windows.excess->power_ratio >= 3 ? reasons : result->warnings).push_back(what);
+  }
+  // Coloured noise: a mode significant against the variance but not against the residual's
+  // level near its frequency (coloured_noise.h).
+  const std::vector<double> local =
+      CalcLocalSignificance(DecimatedResidual(record, estimate), record.decimated_interval_s,
+                            estimate.fit.residual_variance, result->modes);
+  for (size_t k = 0; k < result->modes.size(); ++k) {
+    const IdentifiedMode& mode = result->modes[k];
+    if (mode.significant && mode.combination.empty() && local[k] < result->significance_threshold) {
+      reasons.push_back(fmt::format(
+          "the mode at {:.4g} Hz stands out from the record's noise (significance {:.3g}) but not "
+          "from the residual's own level near its frequency ({:.3g}, threshold {:.3g}): noise "
+          "that is not white there (ambient vibration, a sensor's low-frequency noise) may make "
+          "it",
+          mode.frequency_hz, mode.significance, local[k], result->significance_threshold));
+    }
   }
   result->residual_to_noise = ratios;
   result->residual_window_ratio = windows.channel_ratio;

@@ -1,0 +1,75 @@
+#include "coloured_noise.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "out_of_band.h"
+
+namespace mbid::identification {
+namespace {
+
+// Bins of the near band at least: the mean of n bins of a mirrored spectrum (one degree of
+// freedom each) scatters by sqrt(2 / n), 0.18 at 64.
+constexpr Eigen::Index kNearBins = 64;
+
+// Half-power bandwidth (Hz), at least the record's resolution.
+double Bandwidth(const IdentifiedMode& mode, double duration_s) {
+  return std::max(std::abs(mode.decay_rate_per_s) / M_PI, 1 / duration_s);
+}
+
+}  // namespace
+
+std::vector<double> CalcLocalSignificance(const Eigen::MatrixXd& residual, double sample_interval_s,
+                                          const Eigen::VectorXd& residual_variance,
+                                          const std::vector<IdentifiedMode>& modes) {
+  std::vector<double> local;
+  for (const IdentifiedMode& mode : modes) local.push_back(mode.significance);
+  const Eigen::Index samples = residual.rows();
+  if (samples < 4 * kNearBins || modes.empty()) return local;
+  Eigen::VectorXd frequency_hz;
+  const Eigen::MatrixXd power = MirroredPower(residual, sample_interval_s, &frequency_hz);
+  const Eigen::Index bins = power.rows();
+  const double duration_s = static_cast<double>(samples) * sample_interval_s;
+  // Each channel's mean over the band, without the constant bin.
+  const Eigen::RowVectorXd mean = power.bottomRows(bins - 1).colwise().mean();
+  for (size_t k = 0; k < modes.size(); ++k) {
+    const IdentifiedMode& mode = modes[k];
+    const double width = Bandwidth(mode, duration_s);
+    const auto near_another = [&](double f) {
+      for (const IdentifiedMode& other : modes) {
+        if (std::abs(f - other.frequency_hz) < 2 * Bandwidth(other, duration_s)) return true;
+      }
+      return false;
+    };
+    std::vector<Eigen::Index> near;
+    for (double outer = 8 * width; near.size() < static_cast<size_t>(kNearBins); outer *= 1.5) {
+      near.clear();
+      for (Eigen::Index b = 1; b < bins; ++b) {
+        const double distance = std::abs(frequency_hz(b) - mode.frequency_hz);
+        if (distance >= 2 * width && distance <= outer && !near_another(frequency_hz(b))) {
+          near.push_back(b);
+        }
+      }
+      if (outer > frequency_hz(bins - 1)) break;  // the whole band
+    }
+    if (near.size() < static_cast<size_t>(kNearBins)) continue;
+    // Above the mean by more than three of its scatter: a level of its own.
+    const double margin = 1 + 3 * std::sqrt(2.0 / static_cast<double>(near.size()));
+    double weights = 0, weighted = 0;
+    for (Eigen::Index c = 0; c < residual.cols(); ++c) {
+      double level = 0;
+      for (Eigen::Index b : near) level += power(b, c);
+      level /= static_cast<double>(near.size());
+      const double factor = mean(c) > 0 ? std::max(1.0, level / mean(c) / margin) : 1.0;
+      const double amplitude = c < mode.amplitude.size() ? mode.amplitude(c) : 0;
+      const double weight =
+          residual_variance(c) > 0 ? amplitude * amplitude / residual_variance(c) : 0;
+      weights += weight;
+      weighted += weight / factor;
+    }
+    if (weights > 0) local[k] = mode.significance * weighted / weights;
+  }
+  return local;
+}
+
+}  // namespace mbid::identification
