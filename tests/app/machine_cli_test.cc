@@ -16,6 +16,17 @@ const fs::path kScenarios = fs::path(MBID_SOURCE_DIR) / "scenarios";
 
 class MachineCliTest : public CommandTest {};
 
+// A cart on a prismatic spring (1e6 N/m, 1000 kg: 5.03 Hz), released from 10 mm.
+constexpr const char* kSlide = R"(model:
+  type: multibody
+  bodies:
+    cart: {parent: ground, joint: {type: prismatic, coordinates: [x], axis: [1, 0, 0]}, mass_kg: 1000.0, inertia_kgm2: [100, 100, 100]}
+  springs:
+    x: {stiffness_N_per_m: 1.0e6, damping_Ns_per_m: 2000.0}
+  outputs: {x_cart: {type: coordinate, coordinate: x}}
+excitation: {type: initial_deflection, deflection_m: {x: 0.01}}
+)";
+
 TEST_F(MachineCliTest, ExcavatorRunPassesAndRecoversItsJoints) {
   const fs::path out = dir_ / "excavator";
   const CommandResult result =
@@ -232,16 +243,8 @@ TEST_F(MachineCliTest, UpdateTakesTheCoordinateChannelsSimulateWrites) {
 // a length, reported in m (it was labelled rad), and recovered within 4 of its std.
 TEST_F(MachineCliTest, AFittedSlideDeflectionIsALength) {
   const fs::path scenario = dir_ / "slide.yaml";
-  std::ofstream(scenario) << R"(name: slide
-model:
-  type: multibody
-  bodies:
-    cart: {parent: ground, joint: {type: prismatic, coordinates: [x], axis: [1, 0, 0]}, mass_kg: 1000.0, inertia_kgm2: [100, 100, 100]}
-  springs:
-    x: {stiffness_N_per_m: 1.0e6, damping_Ns_per_m: 2000.0}
-  outputs: {x_cart: {type: coordinate, coordinate: x}}
-excitation: {type: initial_deflection, deflection_m: {x: 0.01}}
-simulation: {duration_s: 2}
+  std::ofstream(scenario) << "name: slide\n"
+                          << kSlide << R"(simulation: {duration_s: 2}
 sensors: {sample_rate_hz: 200, channels: [x_cart], noise_std_m: 1.0e-5, seed: 3}
 updating: {fit_initial_deflection: true, global_search: {enabled: false}}
 )";
@@ -264,17 +267,7 @@ updating: {fit_initial_deflection: true, global_search: {enabled: false}}
 // that lists none; and its initial deflection, a length, is labelled m (it was rad).
 TEST_F(MachineCliTest, ADescriptionWithoutSensorsRecordsItsOutputs) {
   const fs::path scenario = dir_ / "bare.yaml";
-  std::ofstream(scenario) << R"(name: bare
-model:
-  type: multibody
-  bodies:
-    cart: {parent: ground, joint: {type: prismatic, coordinates: [x], axis: [1, 0, 0]}, mass_kg: 1000.0, inertia_kgm2: [100, 100, 100]}
-  springs:
-    x: {stiffness_N_per_m: 1.0e6, damping_Ns_per_m: 2000.0}
-  outputs: {x_cart: {type: coordinate, coordinate: x}}
-excitation: {type: initial_deflection, deflection_m: {x: 0.01}}
-simulation: {duration_s: 1}
-)";
+  std::ofstream(scenario) << "name: bare\n" << kSlide << "simulation: {duration_s: 1}\n";
   const fs::path record = dir_ / "bare.h5";
   const CommandResult result = Run("simulate " + scenario.string() + " -o " + record.string());
   ASSERT_EQ(result.exit_code, 0) << result.err;

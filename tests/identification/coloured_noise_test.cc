@@ -1,7 +1,7 @@
 // Modes of noise that is not white (coloured_noise.h): a trial's 2 and 7 Hz decay under AR(1)
 // noise of coefficient 0.9, whose power gathers below about 2 Hz, gave 1-4 extra modes there,
-// "reliable" in 12 records of 30 (the same records: 0 of 30 now, 11 of 12 seeds here). The same decay under white noise of the same level stays
-// reliable with its two modes.
+// "reliable" in 12 records of 30 (the same records: 0 of 30 now, 11 of 12 seeds here). The same
+// decay under white noise of the same level stays reliable with its two modes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,17 +12,6 @@
 
 namespace mbid::identification {
 namespace {
-
-// 2 Hz at 1 % and 7 Hz at 2 % (half the amplitude), 30 s at 100 Hz.
-testing::SignalSpec TwoModeDecay() {
-  testing::SignalSpec spec;
-  spec.channels = {"x"};
-  spec.sample_interval_s = 0.01;
-  spec.samples = 3000;
-  spec.modes = {{2.0 * std::sqrt(1 - 0.01 * 0.01), 0.01 * 2 * M_PI * 2, {1.0}, {0.4}},
-                {7.0 * std::sqrt(1 - 0.02 * 0.02), 0.02 * 2 * M_PI * 7, {0.5}, {1.3}}};
-  return spec;
-}
 
 // Unit-variance noise, white (coefficient 0) or AR(1), from `seed`.
 Eigen::VectorXd UnitNoise(Eigen::Index samples, double coefficient, std::uint64_t seed) {
@@ -48,7 +37,7 @@ bool HasAnotherMode(const ModalResult& result) {
 }
 
 TEST(ColouredNoiseTest, ModesOfRedNoiseAreNotReliable) {
-  const testing::SignalSpec spec = TwoModeDecay();
+  const testing::SignalSpec spec = testing::TwoAndSevenHertzDecay();
   const Eigen::MatrixXd clean = testing::Synthesize(spec);
   int with_noise_modes = 0;
   for (std::uint64_t seed = 1; seed <= 4; ++seed) {
@@ -65,7 +54,7 @@ TEST(ColouredNoiseTest, ModesOfRedNoiseAreNotReliable) {
 }
 
 TEST(ColouredNoiseTest, WhiteNoiseLeavesTheTwoModesReliable) {
-  const testing::SignalSpec spec = TwoModeDecay();
+  const testing::SignalSpec spec = testing::TwoAndSevenHertzDecay();
   const Eigen::MatrixXd clean = testing::Synthesize(spec);
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
     Eigen::MatrixXd values = clean;

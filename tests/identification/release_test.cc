@@ -381,12 +381,7 @@ TEST(ReleaseTest, AHeavilyDampedModeOfAShortRecordIsNotDecimatedAway) {
 // band stopped at 6.3 Hz (decimation 6), the mode was found at its top and every record was
 // flagged. A mode at the top of a band the spectrum chose is analysed again in a wider one.
 TEST(ReleaseTest, AModeAtTheTopOfTheChosenBandIsAnalysedInAWiderOne) {
-  testing::SignalSpec spec;
-  spec.channels = {"x"};
-  spec.sample_interval_s = 0.01;
-  spec.samples = 3000;
-  spec.modes = {{2.0 * std::sqrt(1 - 0.01 * 0.01), 0.01 * 2 * M_PI * 2, {1.0}, {0.4}},
-                {7.0 * std::sqrt(1 - 0.02 * 0.02), 0.02 * 2 * M_PI * 7, {0.5}, {1.3}}};
+  const testing::SignalSpec spec = testing::TwoAndSevenHertzDecay();
   std::mt19937_64 rng(2);
   const Eigen::MatrixXd values =
       testing::AddNoise(testing::Synthesize(spec), Eigen::VectorXd::Constant(1, 1e-2), &rng);

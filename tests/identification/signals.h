@@ -167,4 +167,16 @@ inline bool Mentions(const std::vector<std::string>& lines, const std::string& w
   return false;
 }
 
+// A trial's decay: 2 Hz at 1 % and 7 Hz at 2 % damping (half the amplitude), one channel, 30 s
+// at 100 Hz.
+inline SignalSpec TwoAndSevenHertzDecay() {
+  SignalSpec spec;
+  spec.channels = {"x"};
+  spec.sample_interval_s = 0.01;
+  spec.samples = 3000;
+  spec.modes = {{2.0 * std::sqrt(1 - 0.01 * 0.01), 0.01 * 2 * M_PI * 2, {1.0}, {0.4}},
+                {7.0 * std::sqrt(1 - 0.02 * 0.02), 0.02 * 2 * M_PI * 7, {0.5}, {1.3}}};
+  return spec;
+}
+
 }  // namespace mbid::testing
