@@ -80,6 +80,10 @@ TEST_F(MachineCliTest, FreeCoordinateIsARigidBodyMotion) {
   for (const nlohmann::json& mode : modes) rigid += mode.value("rigid_body", false) ? 1 : 0;
   EXPECT_EQ(rigid, 2);
   EXPECT_EQ(modes.size(), 4u);  // boom and stick ring, the swing's double pole at 0
+  // No rest to start from, and none asked for (the start-far-from-rest check once failed here).
+  const CommandResult simulated =
+      Run("simulate " + scenario.string() + " -o " + (dir_ / "free.h5").string());
+  EXPECT_EQ(simulated.exit_code, 0) << simulated.err;
   // One local fit (CI time): the global search's design would add 6 s and nothing this test
   // looks at.
   std::ofstream(scenario, std::ios::app) << "updating: {global_search: {enabled: false}}\n";
@@ -308,6 +312,12 @@ simulation: {duration_s: 1}
   EXPECT_NE(loaded.err.find("from where the machine rests with its attached payload"),
             std::string::npos)
       << loaded.err;
+  // mbid run says it too, among its warnings.
+  const CommandResult run = Run("run " + (dir_ / "arm.yaml").string() + " -o " +
+                                (dir_ / "arm-run").string() + " --quiet");
+  EXPECT_NE(run.err.find("from where the machine rests with its attached payload"),
+            std::string::npos)
+      << run.err;
   const CommandResult bare = arm(0);
   ASSERT_EQ(bare.exit_code, 0) << bare.err;
   EXPECT_EQ(bare.err.find("warning"), std::string::npos) << bare.err;

@@ -29,6 +29,7 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
         simulation::Simulate(model, excitation, scenario.simulation, scenario.sensors);
     test.measured = test.simulation->measured;
     test.exact = test.simulation->exact;
+    test.simulation_warnings = simulation::FindStartFarFromRest(model, excitation);
     say(fmt::format("simulated the test: {} ({} samples x {} channels, {} CVODES {} steps)",
                     excitation.type_name(), test.measured.samples(), test.measured.channel_count(),
                     test.simulation->statistics.steps,
@@ -159,8 +160,10 @@ std::vector<std::string> CollectWarnings(const CycleResult& cycle, bool with_imp
   std::vector<std::string> seen, warnings;
   for (const RunTest& test : cycle.tests) {
     const std::string prefix = cycle.tests.size() > 1 ? "test " + test.name + ": " : "";
-    std::vector<std::string> lines;
-    if (test.import && with_import) lines = test.import->warnings;
+    std::vector<std::string> lines = test.simulation_warnings;
+    if (test.import && with_import) {
+      lines.insert(lines.end(), test.import->warnings.begin(), test.import->warnings.end());
+    }
     lines.insert(lines.end(), test.identified.warnings.begin(), test.identified.warnings.end());
     lines.insert(lines.end(), test.tuned.warnings.begin(), test.tuned.warnings.end());
     for (const std::string& line : lines) {

@@ -49,9 +49,9 @@ struct CycleResult {
 // several tests is judged on.
 std::map<std::string, double> CalcWorstCorrelation(const std::vector<RunTest>& tests);
 
-// The tests' warnings: the reading's (with `with_import`), the identification's and the fits',
-// each prefixed "test NAME: " when there are several tests; a line shared by jointly tuned tests
-// once.
+// The tests' warnings: the simulation's, the reading's (with `with_import`), the
+// identification's and the fits', each prefixed "test NAME: " when there are several tests; a
+// line shared by jointly tuned tests once.
 std::vector<std::string> CollectWarnings(const CycleResult& cycle, bool with_import);
 
 // Runs the cycle on `scenario`. Throws InputError on bad input (records, settings) and

@@ -35,6 +35,7 @@ struct RunTest {
   // the release on it); unset when the record was not cut.
   std::optional<Measurement> recorded;
   std::optional<simulation::SimulationResult> simulation;  // a simulated test's integration
+  std::vector<std::string> simulation_warnings;  // of the test as simulated (FindStartFarFromRest)
   identification::ModalResult identified;
   std::shared_ptr<const updating::CharacteristicResult> algebraic;  // Route 1, if it ran
   std::string start_note;                                           // where Route 2 started
