@@ -394,6 +394,57 @@ TEST(CredibilityTest, ColouredExcessOverTheNoiseDeterminesNothing) {
   // so does a white residual at the noise (WhiteResidualAtTheNoiseIsCredible).
 }
 
+// White noise plus a sinusoid at 0.3 of the sample rate: a model's mode a little off, as a
+// trial's gantry left at 8 Hz. Its autocorrelations alternate in sign, so their sum (the
+// correlation time) is clamped to 1, and the rule that asked for a correlation time above 1
+// never fired: a trolley mass 7.5 % off gave c_lift 29,600 std from the truth, "passed".
+Eigen::VectorXd OscillatingExcess(Eigen::Index count, double amplitude, double noise_std,
+                                  std::uint64_t seed) {
+  Eigen::VectorXd residual = Ar1Noise(count, 0.0, noise_std, seed);
+  for (Eigen::Index i = 0; i < count; ++i) {
+    residual[i] += amplitude * std::cos(2 * M_PI * 0.3 * static_cast<double>(i) + 0.4);
+  }
+  return residual;
+}
+
+TEST(CredibilityTest, AnOscillatingExcessDeterminesNothing) {
+  // Amplitude 0.8 over unit noise: chi^2/dof 1 + 0.8^2 / 2 = 1.32.
+  const UpdateResult result = AssessResidual(OscillatingExcess(4000, 0.8, 1.0, 16));
+  EXPECT_NEAR(result.chi_square_per_dof, 1.32, 0.07);
+  EXPECT_EQ(result.tests[0].correlation_time[0], 1.0);  // the clamp
+  EXPECT_FALSE(result.explains_records);
+  EXPECT_FALSE(result.parameters[0].determined);
+  EXPECT_NE(result.parameters[0].why_undetermined.find("not white"), std::string::npos)
+      << result.parameters[0].why_undetermined;
+}
+
+TEST(CredibilityTest, OneChannelsExcessDoesNotHideInThePooledChiSquare) {
+  // Channel psi: the oscillating excess (1.32 of its noise); phi: white at 0.8 of its stated
+  // noise (weights that overstate it, as an identification's residual may). Pooled chi^2/dof
+  // (1.32 + 0.64) / 2 = 0.98: below any excess, while psi alone is far above its noise.
+  TestRecord test;
+  UpdateResult result = FitWithResidual(OscillatingExcess(4000, 0.8, 1.0, 17), &test);
+  test.record.channels = {"psi", "phi"};
+  test.record.units = {"rad", "rad"};
+  test.record.values = Eigen::MatrixXd::Zero(4000, 2);
+  TestFit& fit = result.tests[0];
+  fit.channels = test.record.channels;
+  fit.noise_std = Eigen::VectorXd::Ones(2);
+  fit.noise_estimated = {false, false};
+  const Eigen::VectorXd psi = fit.simulated.values.col(0);
+  fit.simulated = test.record;
+  fit.simulated.values.col(0) = psi;
+  fit.simulated.values.col(1) = Ar1Noise(4000, 0.0, 0.8, 18);
+  result.final_cost = fit.simulated.values.squaredNorm() / 2;
+  AssessCredibility(result, {test}, UpdateOptions());
+  EXPECT_LT(result.chi_square_per_dof, 1.05);
+  EXPECT_FALSE(result.explains_records);
+  EXPECT_FALSE(result.parameters[0].determined);
+  ASSERT_FALSE(result.credibility.empty());
+  EXPECT_NE(result.credibility[0].find("the residual of psi of t is"), std::string::npos)
+      << result.credibility[0];
+}
+
 TEST(CredibilityTest, AnIntervalReachingABoundIsUndetermined) {
   // 1% std: the interval is 1e7 */ exp(0.02) = [9.80e6, 1.02e7]. A lower bound at 9.9e6 lies
   // inside it: the records allow the bound itself, so the estimate is the bound's, not theirs.

@@ -34,6 +34,14 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
   double worst_time = 1;
   std::string worst_channel;
   std::string offset_hint;
+  // The least white residual (Ljung-Box), and the channel whose own excess over its noise is
+  // significant and not white: an oscillating misfit (a model's mode a little off) has a
+  // correlation time of 1, its autocorrelations alternating in sign, and one channel's misfit
+  // can hide in the records' pooled chi^2.
+  double least_white_p = kWhitenessLevel;
+  std::string least_white_channel;
+  double channel_excess = kStructuredExcess;
+  std::string excess_channel;
   for (size_t t = 0; t < tests.size(); ++t) {
     TestFit& fit = result.tests[t];
     const Measurement& record = tests[t].record;
@@ -61,10 +69,24 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
       }
       Whiteness(r, options.whiteness_lags, &fit.whiteness_q[c], &fit.whiteness_p[c],
                 &fit.correlation_time[c]);
+      const std::string channel = fit.channels[static_cast<size_t>(c)] + " of " + fit.name;
       // A residual white at the 0.1% level is not inflated for its sampling wiggle.
       if (fit.whiteness_p[c] < kWhitenessLevel && fit.correlation_time[c] > worst_time) {
         worst_time = fit.correlation_time[c];
-        worst_channel = fit.channels[static_cast<size_t>(c)] + " of " + fit.name;
+        worst_channel = channel;
+      }
+      if (fit.whiteness_p[c] < least_white_p) {
+        least_white_p = fit.whiteness_p[c];
+        least_white_channel = channel;
+      }
+      const double samples = static_cast<double>(r.size());
+      const double chi_square = r.squaredNorm();
+      if (fit.whiteness_p[c] < kWhitenessLevel && chi_square / samples > channel_excess &&
+          boost::math::cdf(boost::math::complement(
+              boost::math::chi_squared_distribution<double, internal::DistributionPolicy>(samples),
+              chi_square)) < kWhitenessLevel) {
+        channel_excess = chi_square / samples;
+        excess_channel = channel;
       }
     }
   }
@@ -79,12 +101,13 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
   // Noise is white or coloured but has the records' level: a residual significantly above it
   // that is also not white holds signal the model does not reproduce (a local minimum, or a
   // model that lacks something); a white excess is a noise level stated too low.
-  const bool structured =
-      !misfit && from_records && result.chi_square_per_dof > kStructuredExcess &&
-      !worst_channel.empty() &&
+  const bool pooled =
+      from_records && result.chi_square_per_dof > kStructuredExcess &&
+      !least_white_channel.empty() &&
       boost::math::cdf(boost::math::complement(
           boost::math::chi_squared_distribution<double, internal::DistributionPolicy>(dof),
           2 * result.final_cost)) < kWhitenessLevel;
+  const bool structured = !misfit && from_records && (pooled || !excess_channel.empty());
   if (misfit) {
     result.credibility.push_back(fmt::format(
         "the re-simulation misses the records by {:.3g} times their noise (chi^2/dof = {:.4g} > "
@@ -93,13 +116,22 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
         std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof,
         options.max_chi_square_per_dof, offset_hint));
   } else if (structured) {
-    result.credibility.push_back(fmt::format(
-        "the residual is {:.3g} times the records' noise (chi^2/dof = {:.4g}) and not white "
-        "(correlation time {:.3g} samples on {}): the excess is signal the model does not "
-        "reproduce, a local minimum or a model that lacks something; no parameter is determined "
-        "by this fit{}",
-        std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof, worst_time, worst_channel,
-        offset_hint));
+    const std::string where =
+        pooled ? fmt::format(
+                     "the residual is {:.3g} times the records' noise (chi^2/dof = {:.4g}) "
+                     "and not white (Ljung-Box p = {:.2g} on {})",
+                     std::sqrt(result.chi_square_per_dof), result.chi_square_per_dof, least_white_p,
+                     least_white_channel)
+               : fmt::format(
+                     "the residual of {} is {:.3g} times its noise (chi^2 per sample "
+                     "{:.4g}, {:.4g} over all records) and not white",
+                     excess_channel, std::sqrt(channel_excess), channel_excess,
+                     result.chi_square_per_dof);
+    result.credibility.push_back(
+        where +
+        ": the excess is signal the model does not reproduce, a local minimum or a model that "
+        "lacks something; no parameter is determined by this fit" +
+        offset_hint);
   } else {
     if (excess > kNoticeableExcess) {
       result.credibility.push_back(fmt::format(
