@@ -10,15 +10,21 @@
 namespace mbid::identification {
 namespace {
 
-// log P(chi-square(2 m) > x) = -x/2 + log(sum_(i<m) (x/2)^i / i!).
+// log P(chi-square(2 m) > x) = -x/2 + log(sum_(i<m) (x/2)^i / i!), the sum in logarithms about
+// its largest term (at i = x/2, or m - 1): the terms themselves overflow a double from x of about
+// 1400 (the residual windows' 800 degrees of freedom met x = 5000 in the bisection below, and
+// their threshold stuck at its upper end, 12 times the noise's power).
 double LogChiSquareSurvival(double x, int m) {
-  double term = 1.0;
-  double sum = 1.0;
-  for (int i = 1; i < m; ++i) {
-    term *= 0.5 * x / i;
-    sum += term;
+  const double log_half_x = std::log(std::max(0.5 * x, std::numeric_limits<double>::min()));
+  const int peak = std::clamp(static_cast<int>(0.5 * x), 0, m - 1);
+  const double largest = peak * log_half_x - std::lgamma(peak + 1.0);
+  double sum = 0;
+  double log_term = 0;  // log of (x/2)^i / i!
+  for (int i = 0; i < m; ++i) {
+    if (i > 0) log_term += log_half_x - std::log(static_cast<double>(i));
+    sum += std::exp(log_term - largest);
   }
-  return -0.5 * x + std::log(sum);
+  return -0.5 * x + largest + std::log(sum);
 }
 
 }  // namespace
@@ -53,7 +59,8 @@ double CalcChiSquareThreshold(int m, double probability) {
   const double target = std::log(probability);
   // The survival function decreases in x: bisection.
   double low = 0;
-  double high = 1e4;
+  // Far above the mean 2 m: 50 standard deviations sqrt(4 m) beyond it.
+  double high = std::max(1e4, 2.0 * m + 100 * std::sqrt(static_cast<double>(m)));
   for (int i = 0; i < 200; ++i) {
     const double mid = 0.5 * (low + high);
     (LogChiSquareSurvival(mid, m) > target ? low : high) = mid;

@@ -11,6 +11,7 @@
 
 #include "mbid/identification/identify.h"
 #include "mbid/identification/modal_result.h"
+#include "mbid/identification/significance.h"
 #include "signals.h"
 
 namespace mbid::identification {
@@ -56,6 +57,60 @@ TEST(ResidualWindowsTest, ADecayingComponentAtTheStartIsFound) {
   EXPECT_NEAR(windows.excess->power_ratio, 3.37, 0.6);
   EXPECT_NEAR(windows.channel_ratio(0), 5.74, 1.2);
   EXPECT_LT(windows.channel_ratio(1), 2.5);
+}
+
+TEST(ResidualWindowsTest, ThresholdsOfManyDegreesOfFreedomAreTheChiSquaresOwn) {
+  // P(chi-square(2 m) > x) summed its Poisson terms as doubles, which overflow from x of about
+  // 1400: 50 windows of 400 samples x 2 channels (800 degrees of freedom) got a threshold of
+  // 1e4 / 800 = 12.5 times the noise's power, and no window of a long record was ever judged.
+  // Wilson-Hilferty's cube approximation, within 1e-3 at these degrees of freedom: the upper
+  // 2e-5 point (z = 4.107) of chi-square(800) is 800 (1 - 2/7200 + 4.107 sqrt(2/7200))^3 = 975.
+  const double z = 4.107;
+  for (const int dof : {800, 8000}) {
+    const double nu = dof;
+    const double expected = nu * std::pow(1 - 2 / (9 * nu) + z * std::sqrt(2 / (9 * nu)), 3);
+    EXPECT_NEAR(CalcChiSquareThreshold(dof / 2, 2e-5), expected, 2e-3 * expected) << dof;
+  }
+  // A long record: 20000 x 2 samples, a component in the first window with 4 times the noise's
+  // power (mean over the channels 2.5): found; the noise alone: nothing.
+  std::mt19937_64 rng(9);
+  Eigen::MatrixXd residual = WhiteNoise(20000, 2, &rng);
+  EXPECT_FALSE(
+      AnalyseResidualWindows(Eigen::MatrixXd::Ones(20000, 2), residual, 1e-3).excess.has_value());
+  for (int j = 0; j < 400; ++j) residual(j, 0) += std::sqrt(6.0) * std::cos(0.7 * j);
+  const ResidualWindows windows =
+      AnalyseResidualWindows(Eigen::MatrixXd::Ones(20000, 2), residual, 1e-3);
+  ASSERT_TRUE(windows.excess.has_value());
+  EXPECT_EQ(windows.excess->first_sample, 0);
+  EXPECT_NEAR(windows.excess->power_ratio, 2.5, 0.3);
+}
+
+// A trial's record: 2 channels at 1 kHz, 20 s, a 10 Hz mode (0.3 1/s) and a 108 Hz one at 20 %
+// damping (138 1/s, gone in 40 ms), both of amplitude 1 against noise of 0.02. The automatic
+// band was re-chosen for the burst (decimation 2), but the decimation filter's output starts 40
+// samples in, after the burst: one mode, "reliable". The full-rate residual shows the burst.
+TEST(ResidualWindowsTest, AModeLostToTheDecimationFiltersEdgeIsSeenAtFullRate) {
+  testing::SignalSpec spec;
+  spec.channels = {"a", "b"};
+  spec.sample_interval_s = 1e-3;
+  spec.samples = 20000;
+  const double omega = 2 * M_PI * 110;
+  spec.modes = {{10.0, 0.3, {1.0, 0.6}, {0.0, 0.0}},
+                {omega * std::sqrt(1 - 0.04) / (2 * M_PI), 0.2 * omega, {1.0, 1.0}, {0.0, M_PI}}};
+  std::mt19937_64 rng(3);
+  const Eigen::MatrixXd values =
+      testing::AddNoise(testing::Synthesize(spec), Eigen::Vector2d(0.02, 0.02), &rng);
+  IdentificationOptions options;
+  options.release = ReleaseMode::kNone;
+  const ModalResult result = Identify(testing::MakeRecord(spec, values), options);
+  if (result.modes.size() == 2) {  // found after all: then to its std (4 of them)
+    EXPECT_NEAR(result.modes[1].decay_rate_per_s, spec.modes[1].decay_per_s,
+                4 * result.modes[1].std_decay_rate_per_s);
+  } else {  // as measured: the burst is no mode here, and the result says so
+    EXPECT_FALSE(result.reliable);
+    EXPECT_TRUE(testing::Mentions(result.reasons, "the residual from 0 to"))
+        << ::testing::PrintToString(result.reasons);
+  }
 }
 
 TEST(ResidualWindowsTest, AnAbsorbedModeIsSaid) {
