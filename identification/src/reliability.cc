@@ -92,6 +92,45 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
         from_s, from_s + windows.excess->samples * tau, windows.excess->power_ratio);
     (windows.excess->power_ratio >= 3 ? reasons : result->warnings).push_back(what);
   }
+  // Noise shared by channels (one sensor logged twice, a logger's common ground): the standard
+  // deviations and the significance take the channels' noise as independent, and are too small
+  // by up to the square root of the channels sharing it (a trial's 8 copies of one sensor: z up
+  // to 10, spurious modes "reliable"). Correlated residuals say so: independent noise keeps
+  // their correlation within a few 1 / sqrt(samples).
+  {
+    const Eigen::MatrixXd residual = DecimatedResidual(record, estimate);
+    const Eigen::Index n = residual.rows();
+    // A noiseless record's round-off (AssessReliability's floor) is shared by construction.
+    const auto noise = [&](Eigen::Index c) {
+      return residual.col(c).norm() >
+             10 * std::sqrt(static_cast<double>(n)) * RoundOffNoiseStd(record.decimated, c);
+    };
+    const double limit =
+        std::max(0.3, 5 / std::sqrt(static_cast<double>(std::max<Eigen::Index>(n, 1))));
+    Eigen::Index worst_a = -1, worst_b = -1;
+    double worst = limit;
+    for (Eigen::Index a = 0; a < residual.cols(); ++a) {
+      const double norm_a = residual.col(a).norm();
+      for (Eigen::Index b = a + 1; b < residual.cols(); ++b) {
+        const double norm_b = residual.col(b).norm();
+        if (!noise(a) || !noise(b)) continue;
+        const double rho = residual.col(a).dot(residual.col(b)) / (norm_a * norm_b);
+        if (std::abs(rho) > worst) {
+          worst = std::abs(rho);
+          worst_a = a;
+          worst_b = b;
+        }
+      }
+    }
+    if (worst_a >= 0) {
+      reasons.push_back(fmt::format(
+          "the residuals of channels {} and {} are correlated ({:.2f}): noise they share (one "
+          "sensor logged twice, a common ground) makes the standard deviations and the "
+          "significance, which take the channels' noise as independent, too small",
+          result->channels[static_cast<size_t>(worst_a)],
+          result->channels[static_cast<size_t>(worst_b)], worst));
+    }
+  }
   // Coloured noise: a mode significant against the variance but not against the residual's
   // level near its frequency (coloured_noise.h).
   const std::vector<double> local =
