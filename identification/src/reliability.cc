@@ -188,10 +188,19 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
     }
     if (!IsDetermined(mode.frequency_hz, mode.std_frequency_hz, mode.decay_rate_per_s,
                       mode.std_decay_rate_per_s)) {
-      const std::string what = fmt::format(
-          "the mode at {:.4g} Hz is undetermined (std of frequency {:.3g} Hz, of decay {:.3g} "
-          "1/s)",
-          mode.frequency_hz, mode.std_frequency_hz, mode.std_decay_rate_per_s);
+      // Its frequency determined, its decay not: say which, and what such a mode may be.
+      const bool decay_only = !(mode.std_frequency_hz > 0.1 * mode.frequency_hz);
+      const std::string what =
+          decay_only
+              ? fmt::format(
+                    "the decay rate of the mode at {:.4g} Hz is undetermined ({:.3g} +- {:.2g} "
+                    "1/s): too short a record for its damping, or a tone that does not decay "
+                    "(mains hum, a rotating part)",
+                    mode.frequency_hz, mode.decay_rate_per_s, mode.std_decay_rate_per_s)
+              : fmt::format(
+                    "the mode at {:.4g} Hz is undetermined (std of frequency {:.3g} Hz, of decay "
+                    "{:.3g} 1/s)",
+                    mode.frequency_hz, mode.std_frequency_hz, mode.std_decay_rate_per_s);
       // A combination tone is no mode of the structure: its spread says nothing of theirs.
       if (mode.combination.empty()) {
         reasons.push_back(what);
