@@ -12,6 +12,8 @@
 
 #include "crane_fixture.h"
 #include "mbid/common/error.h"
+#include "mbid/common/yaml_reader.h"
+#include "mbid/model/model_factory.h"
 #include "oscillator_fixture.h"
 
 namespace mbid::updating {
@@ -194,6 +196,47 @@ TEST(PlanCraneTest, AfterThePapersLoadDropAnEtaDeflectionDeterminesDEta) {
   EXPECT_NEAR(fitted.relative_std, expected_at_truth, 0.1 * expected_at_truth);
   // And the value: within 4 of its standard deviations of the truth (44000 N m s/rad).
   EXPECT_LT(std::abs(fitted.value - drop.model->GetParameter("d_eta")), 4 * fitted.std);
+}
+
+// A trial's plan ranked a test that deflects a gantry's roll but records no sensor that sees
+// it, and promised c_roll to 2 %: the model's nonlinear coupling gives the Fisher matrix some
+// information, which no fit can use (the test, run, found no mode at all). The excavator arm's
+// swing is such a mode for its two inclinometers (UnseenModesTest): a release of all three
+// joints recorded by them alone leaves c_swing and d_swing undetermined; with the lateral
+// accelerometer, determined.
+TEST(PlanTest, ACandidateThatDoesNotSeeAModeDeterminesNoneOfItsParameters) {
+  const auto arm = model::MakeModel(
+      YamlReader::FromFile(std::string(MBID_SOURCE_DIR) + "/scenarios/excavator-arm.yaml")
+          .Child("model"));
+  const auto release = [](const std::string& name, const std::vector<std::string>& channels) {
+    TestDesign design;
+    design.name = name;
+    simulation::InitialDeflection deflection;
+    deflection.deflection_rad = {{"swing", 0.002}, {"boom", -0.0015}, {"stick", 0.002}};
+    design.excitation = deflection;
+    design.simulation.duration_s = 2.0;
+    design.sensors.sample_rate_hz = 100.0;
+    design.sensors.channels = channels;
+    for (const std::string& channel : channels) {
+      design.sensors.noise_std[channel] = channel == "a_bucket_y" ? 2e-3 : 1e-5;
+    }
+    return design;
+  };
+  const std::vector<PlanCandidate> candidates{
+      {"inclinometers", nullptr, release("inclinometers", {"boom_incl", "stick_incl"})},
+      {"lateral", nullptr, release("lateral", {"boom_incl", "stick_incl", "a_bucket_y"})}};
+  const TestPlan plan = PlanNextTest(*arm, {}, candidates, PlanOptions());
+  for (const CandidateScore& candidate : plan.candidates) {
+    SCOPED_TRACE(candidate.name);
+    const bool blind = candidate.name == "inclinometers";
+    const std::vector<std::string> expected_unseen =
+        blind ? std::vector<std::string>{"c_swing", "d_swing"} : std::vector<std::string>{};
+    EXPECT_EQ(candidate.unseen, expected_unseen);
+    for (size_t k = 0; k < plan.parameters.size(); ++k) {
+      const bool swing = plan.parameters[k] == "c_swing" || plan.parameters[k] == "d_swing";
+      EXPECT_EQ(candidate.determined[k], !(blind && swing)) << plan.parameters[k];
+    }
+  }
 }
 
 TEST(PlanTest, RejectsNoCandidates) {

@@ -6,10 +6,12 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <set>
 #include <thread>
 
 #include "mbid/common/eigen_decompositions.h"
 #include "mbid/common/error.h"
+#include "mbid/updating/credibility.h"
 #include "plan_internal.h"
 
 namespace mbid::updating {
@@ -157,6 +159,19 @@ TestPlan PlanNextTest(const model::MechanicalModel& model, const std::vector<Tes
     const ExpectedUncertainty expected = CalcExpectedUncertainty(total, options.rank_tolerance);
     score.relative_std = expected.relative_std;
     score.rank = expected.rank;
+    // A candidate whose channels do not see a parameter's modes (a roll deflected, recorded
+    // without a lateral sensor) still has Fisher information on it, from the model's nonlinear
+    // coupling: a trial's plan promised c_roll to 2 %, and the test, run, found no mode at all.
+    const TestDesign& test = candidates[i].test;
+    const std::set<std::string> channels(test.sensors.channels.begin(),
+                                         test.sensors.channels.end());
+    for (const UnseenParameter& found :
+         FindUnseenParameters(*models[recorded.size() + i], channels, plan.parameters)) {
+      const Eigen::Index k = std::find(plan.parameters.begin(), plan.parameters.end(), found.name) -
+                             plan.parameters.begin();
+      score.relative_std[k] = plan.current_relative_std[k];
+      score.unseen.push_back(found.name);
+    }
     for (Eigen::Index k = 0; k < n; ++k) {
       score.determined.push_back(score.relative_std[k] <= options.undetermined_relative_std);
     }

@@ -54,27 +54,22 @@ std::vector<double> Visibility(const model::LinearModel& linear,
 
 }  // namespace
 
-std::vector<std::string> MarkUnseenParameters(const model::MechanicalModel& model,
-                                              const std::vector<TestRecord>& tests,
-                                              UpdateResult& result) {
-  std::vector<std::string> unseen;
-  std::set<std::string> channels;
-  for (const TestRecord& test : tests) {
-    channels.insert(test.record.channels.begin(), test.record.channels.end());
-  }
-  std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
-  ApplyEstimates(result, *tuned);
-  const model::LinearModel linear = tuned->Linearize();
+std::vector<UnseenParameter> FindUnseenParameters(const model::MechanicalModel& model,
+                                                  const std::set<std::string>& channels,
+                                                  const std::vector<std::string>& parameters) {
+  std::vector<UnseenParameter> unseen;
+  const model::LinearModel linear = model.Linearize();
   const std::vector<model::Mode> modes = model::CalcModes(linear);
   if (modes.empty()) return unseen;
   const std::vector<double> visibility = Visibility(linear, modes, channels);
   if (std::all_of(visibility.begin(), visibility.end(), [](double v) { return v > kVisible; })) {
     return unseen;  // every mode is seen: nothing to check
   }
-  for (ParameterEstimate& p : result.parameters) {
-    if (!p.test.empty() || !p.determined || !std::isfinite(p.value) || p.value == 0) continue;
-    std::unique_ptr<model::MechanicalModel> moved = tuned->Clone();
-    moved->SetParameter(p.name, p.value * (1 + kStep));
+  for (const std::string& name : parameters) {
+    const double value = model.GetParameter(name);
+    if (!std::isfinite(value) || value == 0) continue;
+    std::unique_ptr<model::MechanicalModel> moved = model.Clone();
+    moved->SetParameter(name, value * (1 + kStep));
     const std::vector<model::Mode> after = model::CalcModes(moved->Linearize());
     if (after.size() != modes.size()) continue;
     // Each mode's relative change, matched to the nearest pole after the step.
@@ -91,12 +86,37 @@ std::vector<std::string> MarkUnseenParameters(const model::MechanicalModel& mode
       if (visibility[k] > kVisible) seen = std::max(seen, change[k]);
     }
     if (!(largest > 0) || seen > kSeenShare * largest) continue;
-    std::vector<std::string> acted_on;  // the unseen modes it moves
+    UnseenParameter found{name, {}};
     for (size_t k = 0; k < modes.size(); ++k) {
       if (visibility[k] <= kVisible && change[k] > kSeenShare * largest) {
-        acted_on.push_back(fmt::format("{:.3g} Hz", modes[k].frequency_hz()));
+        found.modes_hz.push_back(modes[k].frequency_hz());
       }
     }
+    unseen.push_back(std::move(found));
+  }
+  return unseen;
+}
+
+std::vector<std::string> MarkUnseenParameters(const model::MechanicalModel& model,
+                                              const std::vector<TestRecord>& tests,
+                                              UpdateResult& result) {
+  std::vector<std::string> unseen;
+  std::set<std::string> channels;
+  for (const TestRecord& test : tests) {
+    channels.insert(test.record.channels.begin(), test.record.channels.end());
+  }
+  std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
+  ApplyEstimates(result, *tuned);
+  std::vector<std::string> candidates;
+  for (const ParameterEstimate& p : result.parameters) {
+    if (p.test.empty() && p.determined) candidates.push_back(p.name);
+  }
+  for (const UnseenParameter& found : FindUnseenParameters(*tuned, channels, candidates)) {
+    ParameterEstimate& p =
+        *std::find_if(result.parameters.begin(), result.parameters.end(),
+                      [&](const ParameterEstimate& e) { return e.name == found.name; });
+    std::vector<std::string> acted_on;  // the unseen modes it moves
+    for (double hz : found.modes_hz) acted_on.push_back(fmt::format("{:.3g} Hz", hz));
     p.determined = false;
     p.why_undetermined = fmt::format(
         "the records' channels ({}) do not see the modes it acts on in the linearized model "

@@ -181,6 +181,7 @@ nlohmann::json CandidateScoresToJson(
       determined[plan.parameters[k]] = static_cast<bool>(candidate.determined[k]);
     }
     item["determined"] = determined;
+    item["unseen"] = candidate.unseen;  // its channels do not see their modes
     item["rank"] = candidate.rank;
     item["ridge"] = NumberOrNull(candidate.ridge);
     for (size_t i = 0; i < file.candidates.size(); ++i) {

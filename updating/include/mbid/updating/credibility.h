@@ -1,5 +1,7 @@
 #pragma once
 
+#include <set>
+#include <string>
 #include <vector>
 
 #include "mbid/updating/output_error.h"
@@ -28,6 +30,17 @@ bool MarkIfSpreadUndetermined(ParameterEstimate& p, double std_inflation,
 // its standard deviation assumes: an excavator's c_swing came out 27 standard deviations off,
 // "determined". Such parameters are marked undetermined with the reason (and a warning);
 // returns their names.
+// A parameter of `model` (at its values) whose modes the `channels` do not see in its
+// linearization, with the frequencies (Hz) of those modes: the test of MarkUnseenParameters
+// below, for the plan's candidate tests too.
+struct UnseenParameter {
+  std::string name;
+  std::vector<double> modes_hz;
+};
+std::vector<UnseenParameter> FindUnseenParameters(const model::MechanicalModel& model,
+                                                  const std::set<std::string>& channels,
+                                                  const std::vector<std::string>& parameters);
+
 std::vector<std::string> MarkUnseenParameters(const model::MechanicalModel& model,
                                               const std::vector<TestRecord>& tests,
                                               UpdateResult& result);

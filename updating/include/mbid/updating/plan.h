@@ -59,7 +59,11 @@ struct CandidateScore {
   Eigen::MatrixXd fisher;        // the candidate's own F
   Eigen::VectorXd relative_std;  // expected, with the recorded tests; +Inf: undetermined
   std::vector<bool> determined;  // relative_std <= undetermined_relative_std
-  int rank = 0;                  // of the recorded tests and this candidate together
+  // Parameters whose modes the candidate's channels do not see in its linearized model
+  // (credibility.h's FindUnseenParameters): its information on them is a second-order effect
+  // whose standard deviation does not hold, so they keep the recorded tests' relative_std.
+  std::vector<std::string> unseen;
+  int rank = 0;  // of the recorded tests and this candidate together
   simulation::IntegratorStatistics statistics;
 };
 
