@@ -282,6 +282,11 @@ TEST(OutputErrorTest, IterationLimitIsNoConvergenceNotSuccess) {
   EXPECT_EQ(result.termination, UpdateResult::Termination::kNoConvergence) << result.message;
   EXPECT_EQ(result.termination_name(), "no_convergence");
   EXPECT_FALSE(result.message.empty());
+  // Not at a minimum: no standard deviation holds, and none is reported as if it did.
+  for (const ParameterEstimate& p : result.parameters) {
+    EXPECT_FALSE(p.determined) << p.name;
+    EXPECT_NE(p.why_undetermined.find("no convergence"), std::string::npos) << p.why_undetermined;
+  }
 }
 
 TEST(OutputErrorTest, FailingSimulationIsAFailureResult) {

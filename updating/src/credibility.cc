@@ -196,7 +196,14 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
   result.undetermined.clear();
   for (ParameterEstimate& p : result.parameters) {
     SetInterval(p, result.std_inflation);
-    if (!faulty.empty() && p.test.empty()) {
+    if (result.termination == UpdateResult::Termination::kNoConvergence) {
+      // Not at a minimum: the curvature there is no standard deviation of anything (a fit of two
+      // springs in series stopped after 50 iterations with c_u1 16 of its stds off, unmarked).
+      p.determined = false;
+      p.why_undetermined =
+          "the fit stopped before reaching a minimum (no convergence): its standard deviation "
+          "does not hold";
+    } else if (!faulty.empty() && p.test.empty()) {
       p.determined = false;
       p.why_undetermined = faulty;
     } else if (misfit && p.test.empty()) {
