@@ -402,14 +402,7 @@ TEST(ReleaseTest, AModeAtTheTopOfTheChosenBandIsAnalysedInAWiderOne) {
 // heavy mode: one mode, "reliable". The full-rate residual's first window holds 1000 times its
 // power elsewhere; analysed again at the full rate, both modes come back.
 TEST(ReleaseTest, AModeGoneBeforeTheDecimationFiltersFirstOutputIsAnalysedAtFullRate) {
-  testing::SignalSpec spec;
-  spec.channels = {"a", "b"};
-  spec.sample_interval_s = 0.005;
-  spec.samples = 2000;
-  const double omega = 2 * M_PI * 5;
-  spec.modes = {
-      {1.3, 0.1, {1.0, 0.5}, {0.0, 0.0}},
-      {omega * std::sqrt(1 - 0.45 * 0.45) / (2 * M_PI), 0.45 * omega, {1.0, 1.0}, {0.0, M_PI}}};
+  const testing::SignalSpec spec = testing::LightBesideHeavy(1.3, 0.1, 0.5, 5, 0.45, 0.005, 2000);
   std::mt19937_64 rng(2);
   const Eigen::MatrixXd values =
       testing::AddNoise(testing::Synthesize(spec), Eigen::Vector2d(0.01, 0.01), &rng);

@@ -90,13 +90,7 @@ TEST(ResidualWindowsTest, ThresholdsOfManyDegreesOfFreedomAreTheChiSquaresOwn) {
 // band was re-chosen for the burst (decimation 2), but the decimation filter's output starts 40
 // samples in, after the burst: one mode, "reliable". The full-rate residual shows the burst.
 TEST(ResidualWindowsTest, AModeLostToTheDecimationFiltersEdgeIsSeenAtFullRate) {
-  testing::SignalSpec spec;
-  spec.channels = {"a", "b"};
-  spec.sample_interval_s = 1e-3;
-  spec.samples = 20000;
-  const double omega = 2 * M_PI * 110;
-  spec.modes = {{10.0, 0.3, {1.0, 0.6}, {0.0, 0.0}},
-                {omega * std::sqrt(1 - 0.04) / (2 * M_PI), 0.2 * omega, {1.0, 1.0}, {0.0, M_PI}}};
+  const testing::SignalSpec spec = testing::LightBesideHeavy(10, 0.3, 0.6, 110, 0.2, 1e-3, 20000);
   std::mt19937_64 rng(3);
   const Eigen::MatrixXd values =
       testing::AddNoise(testing::Synthesize(spec), Eigen::Vector2d(0.02, 0.02), &rng);

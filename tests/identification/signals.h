@@ -179,4 +179,23 @@ inline SignalSpec TwoAndSevenHertzDecay() {
   return spec;
 }
 
+// Two channels: a light mode (`light_hz`, `light_decay_per_s`; amplitudes 1 and `light_b`) and
+// a heavily damped one (natural `heavy_hz`, damping ratio `heavy_zeta`; amplitudes 1 and -1),
+// as a machine's ring-down with a fast-decaying part.
+inline SignalSpec LightBesideHeavy(double light_hz, double light_decay_per_s, double light_b,
+                                   double heavy_hz, double heavy_zeta, double interval_s,
+                                   int samples) {
+  SignalSpec spec;
+  spec.channels = {"a", "b"};
+  spec.sample_interval_s = interval_s;
+  spec.samples = samples;
+  const double omega = 2 * M_PI * heavy_hz;
+  spec.modes = {{light_hz, light_decay_per_s, {1.0, light_b}, {0.0, 0.0}},
+                {omega * std::sqrt(1 - heavy_zeta * heavy_zeta) / (2 * M_PI),
+                 heavy_zeta * omega,
+                 {1.0, 1.0},
+                 {0.0, M_PI}}};
+  return spec;
+}
+
 }  // namespace mbid::testing
