@@ -235,6 +235,11 @@ TEST(PlanTest, ACandidateThatDoesNotSeeAModeDeterminesNoneOfItsParameters) {
     for (size_t k = 0; k < plan.parameters.size(); ++k) {
       const bool swing = plan.parameters[k] == "c_swing" || plan.parameters[k] == "d_swing";
       EXPECT_EQ(candidate.determined[k], !(blind && swing)) << plan.parameters[k];
+      // Left out of what the candidate adds, so of its score too.
+      if (blind && swing) {
+        EXPECT_TRUE(candidate.fisher.row(static_cast<Eigen::Index>(k)).isZero())
+            << plan.parameters[k];
+      }
     }
   }
 }

@@ -141,9 +141,24 @@ TestPlan PlanNextTest(const model::MechanicalModel& model, const std::vector<Tes
     const FisherInformation& information = jobs[recorded.size() + i].result;
     CandidateScore score;
     score.name = candidates[i].name;
-    score.fisher = information.matrix;
     score.statistics = information.statistics;
-    const Eigen::MatrixXd total = plan.recorded_fisher + information.matrix;
+    // A candidate whose channels do not see a parameter's modes (a roll deflected, recorded
+    // without a lateral sensor) still has Fisher information on it, from the model's nonlinear
+    // coupling: a trial's plan promised c_roll to 2 % and ranked the test second; run, it found
+    // no mode at all. That information is no fit's to use: its rows and columns are left out.
+    score.fisher = information.matrix;
+    const TestDesign& test = candidates[i].test;
+    const std::set<std::string> channels(test.sensors.channels.begin(),
+                                         test.sensors.channels.end());
+    for (const UnseenParameter& found :
+         FindUnseenParameters(*models[recorded.size() + i], channels, plan.parameters)) {
+      const Eigen::Index k = std::find(plan.parameters.begin(), plan.parameters.end(), found.name) -
+                             plan.parameters.begin();
+      score.fisher.row(k).setZero();
+      score.fisher.col(k).setZero();
+      score.unseen.push_back(found.name);
+    }
+    const Eigen::MatrixXd total = plan.recorded_fisher + score.fisher;
     score.score = CalcLogDetWithRidge(total, options.ridge, &score.ridge);
     if (!recorded.empty()) {
       // The recorded tests' log det with the same ridge: the difference is the candidate's.
@@ -159,19 +174,6 @@ TestPlan PlanNextTest(const model::MechanicalModel& model, const std::vector<Tes
     const ExpectedUncertainty expected = CalcExpectedUncertainty(total, options.rank_tolerance);
     score.relative_std = expected.relative_std;
     score.rank = expected.rank;
-    // A candidate whose channels do not see a parameter's modes (a roll deflected, recorded
-    // without a lateral sensor) still has Fisher information on it, from the model's nonlinear
-    // coupling: a trial's plan promised c_roll to 2 %, and the test, run, found no mode at all.
-    const TestDesign& test = candidates[i].test;
-    const std::set<std::string> channels(test.sensors.channels.begin(),
-                                         test.sensors.channels.end());
-    for (const UnseenParameter& found :
-         FindUnseenParameters(*models[recorded.size() + i], channels, plan.parameters)) {
-      const Eigen::Index k = std::find(plan.parameters.begin(), plan.parameters.end(), found.name) -
-                             plan.parameters.begin();
-      score.relative_std[k] = plan.current_relative_std[k];
-      score.unseen.push_back(found.name);
-    }
     for (Eigen::Index k = 0; k < n; ++k) {
       score.determined.push_back(score.relative_std[k] <= options.undetermined_relative_std);
     }

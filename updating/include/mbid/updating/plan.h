@@ -56,12 +56,12 @@ struct CandidateScore {
   double score = 0;
   double gain = std::numeric_limits<double>::quiet_NaN();
   double ridge = 0;              // r added to the sum (absolute)
-  Eigen::MatrixXd fisher;        // the candidate's own F
+  Eigen::MatrixXd fisher;        // the candidate's own F, without its `unseen` parameters
   Eigen::VectorXd relative_std;  // expected, with the recorded tests; +Inf: undetermined
   std::vector<bool> determined;  // relative_std <= undetermined_relative_std
   // Parameters whose modes the candidate's channels do not see in its linearized model
   // (credibility.h's FindUnseenParameters): its information on them is a second-order effect
-  // whose standard deviation does not hold, so they keep the recorded tests' relative_std.
+  // no fit can use, left out of `fisher`, the score and the standard deviations.
   std::vector<std::string> unseen;
   int rank = 0;  // of the recorded tests and this candidate together
   simulation::IntegratorStatistics statistics;
