@@ -109,7 +109,7 @@ std::vector<std::string> MarkUnseenParameters(const model::MechanicalModel& mode
   ApplyEstimates(result, *tuned);
   std::vector<std::string> candidates;
   for (const ParameterEstimate& p : result.parameters) {
-    if (p.test.empty() && p.determined) candidates.push_back(p.name);
+    if (p.test.empty()) candidates.push_back(p.name);
   }
   for (const UnseenParameter& found : FindUnseenParameters(*tuned, channels, candidates)) {
     ParameterEstimate& p =
@@ -117,12 +117,16 @@ std::vector<std::string> MarkUnseenParameters(const model::MechanicalModel& mode
                       [&](const ParameterEstimate& e) { return e.name == found.name; });
     std::vector<std::string> acted_on;  // the unseen modes it moves
     for (double hz : found.modes_hz) acted_on.push_back(fmt::format("{:.3g} Hz", hz));
-    p.determined = false;
-    p.why_undetermined = fmt::format(
+    // Said first where another rule already left it undetermined (alternative minima that
+    // differ in it): this one is why no test of these channels can settle it.
+    const std::string why = fmt::format(
         "the records' channels ({}) do not see the modes it acts on in the linearized model "
         "({}): only the model's nonlinear coupling carries it, and its standard deviation does "
         "not hold",
         fmt::join(channels, ", "), fmt::join(acted_on, ", "));
+    p.why_undetermined =
+        p.determined || p.why_undetermined.empty() ? why : why + "; and " + p.why_undetermined;
+    p.determined = false;
     if (std::find(result.undetermined.begin(), result.undetermined.end(), p.name) ==
         result.undetermined.end()) {
       result.undetermined.push_back(p.name);
