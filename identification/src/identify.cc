@@ -137,7 +137,10 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
     // gone by then (5 Hz at 45 % damping, 200 Hz: 14 1/s) is in the full-rate residual's first
     // window only. Analysed at the full rate, up to a size where that stays cheap.
     const ResidualWindows full =
-        AnalyseResidualWindows(record.values, residual, options.significance_false_alarm);
+        AnalyseResidualWindows(record.values,
+                               BandLimited(residual, record.sample_interval_s,
+                                           std::max(record.flat_frequency_hz, burst_hz)),
+                               options.significance_false_alarm);
     // Said only where it, not a band above the spectrum's, asks for the full rate.
     const bool hidden_start =
         full.excess && full.excess->first_sample == 0 && full.excess->power_ratio >= 3 &&

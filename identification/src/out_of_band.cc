@@ -1,6 +1,9 @@
 #include "out_of_band.h"
 
 #include <algorithm>
+#include <complex>
+#include <unsupported/Eigen/FFT>
+#include <vector>
 
 #include "mbid/identification/spectrum.h"
 
@@ -19,6 +22,36 @@ Eigen::MatrixXd MirroredPower(const Eigen::MatrixXd& segment, double sample_inte
   const Spectrum spectrum = CalcSpectrum(mirrored, sample_interval_s, options);
   *frequency_hz = spectrum.frequency_hz;
   return spectrum.amplitude.array().square();
+}
+
+Eigen::MatrixXd BandLimited(const Eigen::MatrixXd& values, double sample_interval_s,
+                            double top_hz) {
+  const Eigen::Index n = values.rows();
+  Eigen::MatrixXd limited(n, values.cols());
+  // Padded with zeros to a power of two (a length with a large prime factor costs the FFT
+  // quadratic time): the zeros meet the mirror at the record's end, never at its start.
+  Eigen::Index length = 1;
+  while (length < 2 * n) length *= 2;
+  Eigen::FFT<double> fft;
+  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
+  std::vector<double> mirrored(static_cast<size_t>(length));
+  std::vector<std::complex<double>> spectrum;
+  for (Eigen::Index c = 0; c < values.cols(); ++c) {
+    std::fill(mirrored.begin(), mirrored.end(), 0.0);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      mirrored[static_cast<size_t>(n - 1 - j)] = values(j, c);
+      mirrored[static_cast<size_t>(n + j)] = values(j, c);
+    }
+    fft.fwd(spectrum, mirrored);
+    for (size_t b = 0; b < spectrum.size(); ++b) {
+      if (static_cast<double>(b) / (static_cast<double>(length) * sample_interval_s) > top_hz) {
+        spectrum[b] = 0;
+      }
+    }
+    fft.inv(mirrored, spectrum);
+    for (Eigen::Index j = 0; j < n; ++j) limited(j, c) = mirrored[static_cast<size_t>(n + j)];
+  }
+  return limited;
 }
 
 namespace {

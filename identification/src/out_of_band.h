@@ -15,6 +15,11 @@ namespace mbid::identification {
 Eigen::MatrixXd MirroredPower(const Eigen::MatrixXd& segment, double sample_interval_s,
                               Eigen::VectorXd* frequency_hz);
 
+// `values` (samples x channels) without what lies above `top_hz`: each column mirrored about its
+// start (so that its start is filtered as well as its middle, unlike a decimation filter's
+// output), its FFT cut above `top_hz`, transformed back. Its last samples may ring.
+Eigen::MatrixXd BandLimited(const Eigen::MatrixXd& values, double sample_interval_s, double top_hz);
+
 // The highest frequency (Hz) at which the start of `residual` (samples x channels at the full
 // sample rate: the record `values` less its fitted modes) holds 10 times the power its end
 // holds, in bands of 32 bins of the spectra of its first and last 2048 samples, or halves if it

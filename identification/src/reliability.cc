@@ -7,6 +7,7 @@
 
 #include "coloured_noise.h"
 #include "mbid/common/channel_fault.h"
+#include "out_of_band.h"
 #include "residual_windows.h"
 
 namespace mbid::identification {
@@ -72,11 +73,17 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   // gone by then (110 Hz at 10-40 % damping on a 1 kHz record) leaves no trace in the decimated
   // residual, only in the full-rate one. Without a band of the user's (which may leave such
   // modes out on purpose), that one is judged too.
+  // Only in the analysed band (what lies above it, harmonics of a nonlinear machine at a high
+  // rate, is not the modes' to explain) and only at the start, which the decimated record
+  // misses.
   if (record.decimation > 1 && options.max_frequency_hz <= 0 &&
       result->reconstruction.rows() == record.values.rows()) {
-    ResidualWindows full = AnalyseResidualWindows(
-        record.values, record.values - result->reconstruction, options.significance_false_alarm);
-    if (full.excess &&
+    ResidualWindows full =
+        AnalyseResidualWindows(record.values,
+                               BandLimited(record.values - result->reconstruction,
+                                           record.sample_interval_s, record.flat_frequency_hz),
+                               options.significance_false_alarm);
+    if (full.excess && full.excess->first_sample == 0 &&
         (!windows.excess || full.excess->power_ratio > windows.excess->power_ratio)) {
       windows.excess = full.excess;
       tau = record.sample_interval_s;
