@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "out_of_band.h"
 
@@ -32,21 +33,26 @@ std::vector<double> CalcLocalSignificance(const Eigen::MatrixXd& residual, doubl
   const double duration_s = static_cast<double>(samples) * sample_interval_s;
   // Each channel's mean over the band, without the constant bin.
   const Eigen::RowVectorXd mean = power.bottomRows(bins - 1).colwise().mean();
+  // Bins within 2 bandwidths of any mode (the mode's own included): its fit's notch, or
+  // another mode's residual, not the noise's level.
+  std::vector<bool> at_a_mode(static_cast<size_t>(bins), false);
+  for (const IdentifiedMode& mode : modes) {
+    const double width = Bandwidth(mode, duration_s);
+    for (Eigen::Index b = 0; b < bins; ++b) {
+      if (std::abs(frequency_hz(b) - mode.frequency_hz) < 2 * width) {
+        at_a_mode[static_cast<size_t>(b)] = true;
+      }
+    }
+  }
   for (size_t k = 0; k < modes.size(); ++k) {
     const IdentifiedMode& mode = modes[k];
     const double width = Bandwidth(mode, duration_s);
-    const auto near_another = [&](double f) {
-      for (const IdentifiedMode& other : modes) {
-        if (std::abs(f - other.frequency_hz) < 2 * Bandwidth(other, duration_s)) return true;
-      }
-      return false;
-    };
     std::vector<Eigen::Index> near;
     for (double outer = 8 * width; near.size() < static_cast<size_t>(kNearBins); outer *= 1.5) {
       near.clear();
       for (Eigen::Index b = 1; b < bins; ++b) {
-        const double distance = std::abs(frequency_hz(b) - mode.frequency_hz);
-        if (distance >= 2 * width && distance <= outer && !near_another(frequency_hz(b))) {
+        if (!at_a_mode[static_cast<size_t>(b)] &&
+            std::abs(frequency_hz(b) - mode.frequency_hz) <= outer) {
           near.push_back(b);
         }
       }

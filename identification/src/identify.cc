@@ -136,15 +136,13 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
     // The decimated record starts half the filter's length in (20 samples per factor): a mode
     // gone by then (5 Hz at 45 % damping, 200 Hz: 14 1/s) is in the full-rate residual's first
     // window only. Analysed at the full rate, up to a size where that stays cheap.
-    const ResidualWindows full =
-        AnalyseResidualWindows(record.values,
-                               BandLimited(residual, record.sample_interval_s,
-                                           std::max(record.flat_frequency_hz, burst_hz)),
-                               options.significance_false_alarm);
+    const std::optional<ResidualWindows::Excess> start = FindExcessAtTheStart(
+        record.values, residual, record.sample_interval_s,
+        std::max(record.flat_frequency_hz, burst_hz), options.significance_false_alarm);
     // Said only where it, not a band above the spectrum's, asks for the full rate.
-    const bool hidden_start =
-        full.excess && full.excess->first_sample == 0 && full.excess->power_ratio >= 3 &&
-        record.values.rows() <= kLongestFullRateReanalysis && (top_hz <= 0 || wider.decimation > 1);
+    const bool hidden_start = start && start->power_ratio >= 3 &&
+                              record.values.rows() <= kLongestFullRateReanalysis &&
+                              (top_hz <= 0 || wider.decimation > 1);
     if (hidden_start) wider.decimation = 1;
     if ((top_hz > 0 || hidden_start) && wider.decimation < record.decimation) {
       ModalResult again = Identify(measurement, wider, origin);
@@ -154,7 +152,7 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
                     "the full-rate residual's first {:.4g} s hold {:.3g} times its power "
                     "elsewhere, before the decimation filter's first output at the {:.4g} "
                     "Hz its spectrum showed (decimation {})",
-                    full.excess->samples * record.sample_interval_s, full.excess->power_ratio,
+                    start->samples * record.sample_interval_s, start->power_ratio,
                     record.flat_frequency_hz, record.decimation)
               : fmt::format("{} the {:.4g} Hz its spectrum showed (decimation {})",
                             top_hz == edge_hz

@@ -7,7 +7,6 @@
 
 #include "coloured_noise.h"
 #include "mbid/common/channel_fault.h"
-#include "out_of_band.h"
 #include "residual_windows.h"
 
 namespace mbid::identification {
@@ -65,8 +64,9 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   // warning only: weak combination tones of an accelerometer's centripetal terms leave 2.1 times
   // (a drill mast's record), as does a pair of boom modes at 10 times the noise that a stronger
   // mode absorbed (2.2-2.4).
-  ResidualWindows windows = AnalyseResidualWindows(
-      record.decimated, DecimatedResidual(record, estimate), options.significance_false_alarm);
+  const Eigen::MatrixXd decimated_residual = DecimatedResidual(record, estimate);
+  ResidualWindows windows = AnalyseResidualWindows(record.decimated, decimated_residual,
+                                                   options.significance_false_alarm);
   double tau = record.decimated_interval_s;
   double start_s = record.decimated_start_time_s;
   // The decimation filter's output starts half its length in (20 samples per factor): a mode
@@ -78,14 +78,11 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   // misses.
   if (record.decimation > 1 && options.max_frequency_hz <= 0 &&
       result->reconstruction.rows() == record.values.rows()) {
-    ResidualWindows full =
-        AnalyseResidualWindows(record.values,
-                               BandLimited(record.values - result->reconstruction,
-                                           record.sample_interval_s, record.flat_frequency_hz),
-                               options.significance_false_alarm);
-    if (full.excess && full.excess->first_sample == 0 &&
-        (!windows.excess || full.excess->power_ratio > windows.excess->power_ratio)) {
-      windows.excess = full.excess;
+    const std::optional<ResidualWindows::Excess> start = FindExcessAtTheStart(
+        record.values, record.values - result->reconstruction, record.sample_interval_s,
+        record.flat_frequency_hz, options.significance_false_alarm);
+    if (start && (!windows.excess || start->power_ratio > windows.excess->power_ratio)) {
+      windows.excess = start;
       tau = record.sample_interval_s;
       start_s = record.start_time_s;
     }
@@ -105,23 +102,23 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   // to 10, spurious modes "reliable"). Correlated residuals say so: independent noise keeps
   // their correlation within a few 1 / sqrt(samples).
   {
-    const Eigen::MatrixXd residual = DecimatedResidual(record, estimate);
-    const Eigen::Index n = residual.rows();
+    const Eigen::Index n = decimated_residual.rows();
+    const Eigen::RowVectorXd norm = decimated_residual.colwise().norm();
     // A noiseless record's round-off (AssessReliability's floor) is shared by construction.
     const auto noise = [&](Eigen::Index c) {
-      return residual.col(c).norm() >
+      return norm(c) >
              10 * std::sqrt(static_cast<double>(n)) * RoundOffNoiseStd(record.decimated, c);
     };
     const double limit =
         std::max(0.3, 5 / std::sqrt(static_cast<double>(std::max<Eigen::Index>(n, 1))));
     Eigen::Index worst_a = -1, worst_b = -1;
     double worst = limit;
-    for (Eigen::Index a = 0; a < residual.cols(); ++a) {
-      const double norm_a = residual.col(a).norm();
-      for (Eigen::Index b = a + 1; b < residual.cols(); ++b) {
-        const double norm_b = residual.col(b).norm();
-        if (!noise(a) || !noise(b)) continue;
-        const double rho = residual.col(a).dot(residual.col(b)) / (norm_a * norm_b);
+    for (Eigen::Index a = 0; a < decimated_residual.cols(); ++a) {
+      if (!noise(a)) continue;
+      for (Eigen::Index b = a + 1; b < decimated_residual.cols(); ++b) {
+        if (!noise(b)) continue;
+        const double rho =
+            decimated_residual.col(a).dot(decimated_residual.col(b)) / (norm(a) * norm(b));
         if (std::abs(rho) > worst) {
           worst = std::abs(rho);
           worst_a = a;
@@ -141,7 +138,7 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   // Coloured noise: a mode significant against the variance but not against the residual's
   // level near its frequency (coloured_noise.h).
   const std::vector<double> local =
-      CalcLocalSignificance(DecimatedResidual(record, estimate), record.decimated_interval_s,
+      CalcLocalSignificance(decimated_residual, record.decimated_interval_s,
                             estimate.fit.residual_variance, result->modes);
   for (size_t k = 0; k < result->modes.size(); ++k) {
     const IdentifiedMode& mode = result->modes[k];

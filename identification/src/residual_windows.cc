@@ -6,6 +6,7 @@
 
 #include "estimate.h"
 #include "mbid/identification/significance.h"
+#include "out_of_band.h"
 
 namespace mbid::identification {
 
@@ -47,6 +48,16 @@ ResidualWindows AnalyseResidualWindows(const Eigen::MatrixXd& values,
     result.excess = ResidualWindows::Excess{static_cast<int>(worst) * length, length, ratio};
   }
   return result;
+}
+
+std::optional<ResidualWindows::Excess> FindExcessAtTheStart(const Eigen::MatrixXd& values,
+                                                            const Eigen::MatrixXd& residual,
+                                                            double sample_interval_s, double top_hz,
+                                                            double false_alarm) {
+  const ResidualWindows windows =
+      AnalyseResidualWindows(values, BandLimited(residual, sample_interval_s, top_hz), false_alarm);
+  if (!windows.excess || windows.excess->first_sample != 0) return std::nullopt;
+  return windows.excess;
 }
 
 }  // namespace mbid::identification

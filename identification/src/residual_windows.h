@@ -30,4 +30,12 @@ struct ResidualWindows {
 ResidualWindows AnalyseResidualWindows(const Eigen::MatrixXd& values,
                                        const Eigen::MatrixXd& residual, double false_alarm);
 
+// The excess of a full-rate `residual` (of `values`) in its first window, judged in the band up
+// to `top_hz` (out_of_band.h's BandLimited): what a decimated analysis, whose filter's output
+// starts half its length in, cannot see. None when the first window is not the excess.
+std::optional<ResidualWindows::Excess> FindExcessAtTheStart(const Eigen::MatrixXd& values,
+                                                            const Eigen::MatrixXd& residual,
+                                                            double sample_interval_s, double top_hz,
+                                                            double false_alarm);
+
 }  // namespace mbid::identification
