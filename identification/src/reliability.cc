@@ -71,11 +71,9 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   double start_s = record.decimated_start_time_s;
   // The decimation filter's output starts half its length in (20 samples per factor): a mode
   // gone by then (110 Hz at 10-40 % damping on a 1 kHz record) leaves no trace in the decimated
-  // residual, only in the full-rate one. Without a band of the user's (which may leave such
-  // modes out on purpose), that one is judged too.
-  // Only in the analysed band (what lies above it, harmonics of a nonlinear machine at a high
-  // rate, is not the modes' to explain) and only at the start, which the decimated record
-  // misses.
+  // residual, only in the full-rate one's start. Without a band of the user's (which may leave
+  // such modes out on purpose), that start is judged too, in the analysed band (what lies above
+  // it, harmonics of a nonlinear machine at a high rate, is not the modes' to explain).
   if (record.decimation > 1 && options.max_frequency_hz <= 0 &&
       result->reconstruction.rows() == record.values.rows()) {
     const std::optional<ResidualWindows::Excess> start = FindExcessAtTheStart(
