@@ -291,17 +291,24 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   // that matches the identified poles (complete_starts) and the best of them explains the
   // records to their noise, so that no other minimum can fit better and an equally good one
   // would be among them.
-  bool settled = false;
+  bool settled = false, settled_by_caller = false;
   if (search.complete_starts) {
+    const Run* least = nullptr;
     for (const Run& run : full) {
-      settled = settled || (!run.failed && Converged(run.fit) && run.fit.explains_records);
+      if (run.failed || !Converged(run.fit)) continue;
+      settled = settled || run.fit.explains_records;
+      if (least == nullptr || run.fit.final_cost < least->fit.final_cost) least = &run;
+    }
+    if (!settled && least != nullptr && search.explains_records) {
+      settled = settled_by_caller = search.explains_records(least->fit);
     }
   }
   const int design_count = settled ? 0 : search.design_starts;
   if (settled) {
-    result.notes.push_back(
+    result.notes.push_back(fmt::format(
         "no space-filling design: the given starts hold every set that matches the identified "
-        "poles, and the best of them fits the records to their noise");
+        "poles, and the best of them fits the records to their noise{}",
+        settled_by_caller ? " (once its releases are placed)" : ""));
   }
   Screened screened = std::move(early);
   if (!design_with_primary) {

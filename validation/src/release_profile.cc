@@ -111,17 +111,24 @@ void WidenForReleases(const std::map<std::string, double>& added_variance,
   }
 }
 
-std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& model,
-                                               std::vector<updating::TestRecord>* records,
-                                               const updating::UpdateOptions& options,
-                                               updating::UpdateResult* best) {
-  std::vector<std::string> lines;
-  std::vector<size_t> detected;
+ReleasePlacement FindReleasePlacement(const model::MechanicalModel& model,
+                                      const std::vector<updating::TestRecord>& tests,
+                                      const updating::UpdateOptions& options,
+                                      const updating::UpdateResult& from) {
+  ReleasePlacement placement;
+  placement.from_cost = from.final_cost;
+  for (const updating::ParameterEstimate& p : from.parameters) placement.from[p.name] = p.value;
+  placement.records = tests;
+  placement.fit = from;
+  std::vector<updating::TestRecord>* records = &placement.records;
+  updating::UpdateResult* best = &placement.fit;
+  std::vector<size_t>& detected = placement.detected;
   for (size_t t = 0; t < records->size(); ++t) {
     if ((*records)[t].release_detected) detected.push_back(t);
   }
   if (detected.empty() || best->termination == updating::UpdateResult::Termination::kFailure) {
-    return lines;
+    detected.clear();
+    return placement;
   }
   // The weights the best fit used, kept for every fit of the profile: costs must compare.
   for (size_t t = 0; t < records->size() && t < best->tests.size(); ++t) {
@@ -132,8 +139,12 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
   }
   std::vector<Measurement> as_detected;
   for (size_t t : detected) as_detected.push_back((*records)[t].record);
-  std::vector<double> shift(detected.size(), 0.0), sigma(detected.size(), NAN);
-  std::vector<bool> placed(detected.size(), false);
+  std::vector<double>& shift = placement.shift_s;
+  std::vector<double>& sigma = placement.std_s;
+  std::vector<bool>& placed = placement.placed;
+  shift.assign(detected.size(), 0.0);
+  sigma.assign(detected.size(), NAN);
+  placed.assign(detected.size(), false);
   // Per test and shared parameter, how far the parameter moves per second of the test's release.
   std::vector<std::map<std::string, double>> release_slope(detected.size());
   // Each sweep's move of each release, the last sweep's kept.
@@ -271,14 +282,39 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
     }
   }
   // What each release's uncertainty moves each shared parameter by: its slope times the std.
-  std::map<std::string, double> added_variance;
   for (size_t i = 0; i < detected.size(); ++i) {
     if (!placed[i]) continue;
     for (const auto& [name, slope] : release_slope[i]) {
-      added_variance[name] += slope * sigma[i] * slope * sigma[i];
+      placement.added_variance[name] += slope * sigma[i] * slope * sigma[i];
     }
   }
-  WidenForReleases(added_variance, options, best);
+  return placement;
+}
+
+bool ReleasePlacement::From(const updating::UpdateResult& other) const {
+  if (!(other.final_cost == from_cost) || other.parameters.size() != from.size()) return false;
+  for (const updating::ParameterEstimate& p : other.parameters) {
+    const auto value = from.find(p.name);
+    if (value == from.end() || !(value->second == p.value)) return false;
+  }
+  return true;
+}
+
+std::vector<std::string> TakeReleasePlacement(const ReleasePlacement& placement,
+                                              std::vector<updating::TestRecord>* records,
+                                              const updating::UpdateOptions& options,
+                                              updating::UpdateResult* best) {
+  std::vector<std::string> lines;
+  const std::vector<size_t>& detected = placement.detected;
+  if (detected.empty()) return lines;
+  const std::vector<double>& shift = placement.shift_s;
+  const std::vector<double>& sigma = placement.std_s;
+  const std::vector<bool>& placed = placement.placed;
+  *records = placement.records;
+  if (std::find(placed.begin(), placed.end(), true) != placed.end()) {
+    *best = Merge(*best, placement.fit);
+  }
+  WidenForReleases(placement.added_variance, options, best);
   for (size_t i = 0; i < detected.size(); ++i) {
     const std::string& name = (*records)[detected[i]].name;
     if (detected[i] < best->tests.size() && placed[i]) {
@@ -296,10 +332,18 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
         "{}: the fit places the release {:.3g} ms {} the detected instant (+- {:.2g} ms, {:.2g} "
         "samples); the standard deviations include what that uncertainty moves",
         name, 1e3 * std::abs(shift[i]), shift[i] < 0 ? "before" : "after", 1e3 * sigma[i],
-        sigma[i] / as_detected[i].sample_interval_s));
+        sigma[i] / placement.records[detected[i]].record.sample_interval_s));
   }
   for (const std::string& line : lines) best->warnings.push_back(line);
   return lines;
+}
+
+std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& model,
+                                               std::vector<updating::TestRecord>* records,
+                                               const updating::UpdateOptions& options,
+                                               updating::UpdateResult* best) {
+  return TakeReleasePlacement(FindReleasePlacement(model, *records, options, *best), records,
+                              options, best);
 }
 
 }  // namespace mbid::validation

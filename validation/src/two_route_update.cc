@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <optional>
 #include <vector>
 
 #include "mbid/updating/credibility.h"
@@ -112,18 +113,33 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
                                        const std::function<void(const std::string&)>& say) {
   const std::vector<updating::SearchStart> starts =
       StartFromAlgebraicRoute(algebraic, &settings, start, note);
+  const bool detected =
+      std::any_of(records.begin(), records.end(),
+                  [](const updating::TestRecord& r) { return r.release_detected; });
+  // A release found in a record is placed by the fit too (release_profile.h). Before that, its
+  // fit leaves a misfit of a fraction of a sample that would call for the search's design; so
+  // the search asks whether the placed fit explains the records, and that placement is kept.
+  std::optional<ReleasePlacement> early;
+  if (detected) {
+    settings.global_search.explains_records = [&](const updating::UpdateResult& fit) {
+      early = FindReleasePlacement(model, records, settings.options, fit);
+      return early->fit.explains_records;
+    };
+  }
   updating::GlobalSearchResult search = updating::SearchGlobally(
       model, records, settings.options, *start, starts, settings.global_search, say);
   if (algebraic != nullptr) {
     updating::MarkAlgebraicAmbiguity(*algebraic, search.best, 0.1, search.judged_starts);
   }
-  // A release found in a record is placed by the fit too (release_profile.h); records cut
-  // elsewhere are fitted as they are, without a copy.
+  // Records cut elsewhere are fitted as they are, without a copy.
   std::vector<updating::TestRecord> placed;
-  if (std::any_of(records.begin(), records.end(),
-                  [](const updating::TestRecord& r) { return r.release_detected; })) {
+  if (detected) {
     placed = records;
-    PlaceDetectedReleases(model, &placed, settings.options, &search.best);
+    if (early.has_value() && early->From(search.best)) {
+      TakeReleasePlacement(*early, &placed, settings.options, &search.best);
+    } else {
+      PlaceDetectedReleases(model, &placed, settings.options, &search.best);
+    }
   }
   if (search.best.termination != updating::UpdateResult::Termination::kFailure) {
     updating::MarkUnseenParameters(model, records, search.best);

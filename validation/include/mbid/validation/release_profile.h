@@ -27,6 +27,33 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
                                                const updating::UpdateOptions& options,
                                                updating::UpdateResult* best);
 
+// PlaceDetectedReleases in two steps, so that a caller can place the releases from a fit before
+// it knows whether that fit will be the result (the global search asks whether its best given
+// start explains the records once placed: GlobalSearchOptions::explains_records).
+struct ReleasePlacement {
+  std::vector<updating::TestRecord> records;     // the releases moved to where the fit placed them
+  updating::UpdateResult fit;                    // the fit at the placed releases
+  std::vector<size_t> detected;                  // tests with a detected release (none: nothing)
+  std::vector<double> shift_s, std_s;            // per detected test: the placed shift and its std
+  std::vector<bool> placed;                      // per detected test: the cost had a least point
+  std::map<std::string, double> added_variance;  // what the releases' uncertainty adds
+  // Whether `fit` is the one the placement started from (the same cost and values).
+  bool From(const updating::UpdateResult& other) const;
+
+  double from_cost = 0;
+  std::map<std::string, double> from;
+};
+ReleasePlacement FindReleasePlacement(const model::MechanicalModel& model,
+                                      const std::vector<updating::TestRecord>& records,
+                                      const updating::UpdateOptions& options,
+                                      const updating::UpdateResult& from);
+// Moves `records` and `best` (the fit the placement started from, perhaps marked since) to the
+// placement, widens its standard deviations; returns one line per test.
+std::vector<std::string> TakeReleasePlacement(const ReleasePlacement& placement,
+                                              std::vector<updating::TestRecord>* records,
+                                              const updating::UpdateOptions& options,
+                                              updating::UpdateResult* best);
+
 // Widens each shared parameter's std (and interval) of `best` by the variance the releases'
 // uncertainty adds to it (by name), and marks a parameter the widened spread no longer
 // determines (UpdateOptions::undetermined_relative_std, an interval reaching a bound)
