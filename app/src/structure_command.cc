@@ -167,7 +167,8 @@ int RunStructureCommand(const std::string& scenario_path,
   options.quiet = common.quiet;
   // Detected releases are placed by the full model's fit, as `mbid update` places them; every
   // candidate is fitted to the placed records.
-  options.after_reference = validation::PlaceDetectedReleases;
+  // Asked by the reference's search first too, as in TuneModel (release_profile.h).
+  options.after_reference = validation::PlaceReleasesEarly(*model, &options.search);
   const updating::StructureRanking ranking = updating::RankStructures(candidates, records, options);
   const updating::UpdateResult& reference = ranking.reference_search.best;
   validation::PlaceReleases(reference, &tests);

@@ -273,6 +273,10 @@ TEST_F(RunRecordsTest, StructurePlacesADetectedReleaseBeforeRanking) {
   EXPECT_NEAR(full["cost"].get<double>(), n / 2, 4 * std::sqrt(n / 2));
   EXPECT_NEAR(structure["release"][0]["release_time_s"].get<double>(), 0.5,
               4 * structure["release"][0]["release_std_s"].get<double>());
+  // The reference's search asks for the placement first, as `mbid update`'s does: Route 1's sets
+  // explain the placed record, so no design (before: 12 design points, 3.5 times the time).
+  EXPECT_EQ(structure["reference_search"]["screened"].get<int>(), 0)
+      << structure["reference_search"].dump();
 }
 
 // A field record as a logger keeps it: one second at rest at the deflection before the release,

@@ -514,5 +514,55 @@ TEST(GlobalSearchTest, ListsTheGivenStartsTheRecordsJudged) {
   EXPECT_FALSE(result.non_unique);
 }
 
+// A caller that places something after the search (detected releases: release_profile.h) may
+// know better than the fit itself whether the best given start explains the records
+// (GlobalSearchOptions::explains_records). The oscillator's release with a 3 Hz hum the model
+// cannot explain: asked only with complete starts and no fit explaining the records itself, of
+// the least-cost fit with the search's own records and options; its yes skips the design, its
+// no keeps it.
+TEST(GlobalSearchTest, TheCallerJudgesTheBestGivenStartWhenItsFitDoesNot) {
+  const std::unique_ptr<model::MechanicalModel> truth = testing::MakeOscillator();
+  const TestDesign design = testing::OscillatorRelease("release", 0.01, 1e-5);
+  Measurement record =
+      simulation::Simulate(*truth, design.excitation, design.simulation, design.sensors).measured;
+  for (Eigen::Index i = 0; i < record.values.rows(); ++i) {
+    // 20 times the noise: a residual no fit of the oscillator explains.
+    record.values(i, 0) +=
+        2e-4 * std::sin(2 * M_PI * 3.0 * (record.start_time_s + i * record.sample_interval_s));
+  }
+  const TestRecord test{"release", record, design.excitation, design.sensors.noise_std};
+  UpdateOptions options;
+  options.quiet = true;
+  options.integrator = design.simulation.integrator;
+  for (const char* name : {"c_angle", "d_angle"}) {
+    options.parameters.push_back({name, truth->GetParameter(name)});
+  }
+  GlobalSearchOptions search;
+  search.design_starts = 2;
+  search.pole_equivalent_starts = false;
+  search.complete_starts = true;
+  int asked = 0;
+  bool answer = true;
+  search.explains_records = [&](const std::vector<TestRecord>& tests, const UpdateOptions& given,
+                                const UpdateResult& fit) {
+    ++asked;
+    EXPECT_EQ(tests.size(), 1u);
+    EXPECT_EQ(given.parameters.size(), 2u);
+    EXPECT_FALSE(fit.explains_records);  // else the caller is not asked
+    return answer;
+  };
+  const GlobalSearchResult settled = SearchGlobally(*truth, {test}, options, "route1", {}, search);
+  ASSERT_EQ(settled.best.termination, UpdateResult::Termination::kConverged);
+  EXPECT_FALSE(settled.best.explains_records);
+  EXPECT_EQ(asked, 1);
+  EXPECT_EQ(settled.screened, 0);
+  answer = false;
+  EXPECT_EQ(SearchGlobally(*truth, {test}, options, "route1", {}, search).screened, 2);
+  EXPECT_EQ(asked, 2);
+  search.complete_starts = false;  // the design runs anyway: nothing to ask
+  EXPECT_EQ(SearchGlobally(*truth, {test}, options, "route1", {}, search).screened, 2);
+  EXPECT_EQ(asked, 2);
+}
+
 }  // namespace
 }  // namespace mbid::updating

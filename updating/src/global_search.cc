@@ -300,7 +300,7 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
       if (least == nullptr || run.fit.final_cost < least->fit.final_cost) least = &run;
     }
     if (!settled && least != nullptr && search.explains_records) {
-      settled = settled_by_caller = search.explains_records(least->fit);
+      settled = settled_by_caller = search.explains_records(tests, options, least->fit);
     }
   }
   const int design_count = settled ? 0 : search.design_starts;

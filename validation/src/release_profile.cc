@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "mbid/identification/release.h"
 #include "mbid/updating/credibility.h"
@@ -344,6 +345,25 @@ std::vector<std::string> PlaceDetectedReleases(const model::MechanicalModel& mod
                                                updating::UpdateResult* best) {
   return TakeReleasePlacement(FindReleasePlacement(model, *records, options, *best), records,
                               options, best);
+}
+
+ReleasePlacer PlaceReleasesEarly(const model::MechanicalModel& model,
+                                 updating::GlobalSearchOptions* search) {
+  auto kept = std::make_shared<std::optional<ReleasePlacement>>();
+  search->explains_records = [kept, &model](const std::vector<updating::TestRecord>& tests,
+                                            const updating::UpdateOptions& options,
+                                            const updating::UpdateResult& fit) {
+    *kept = FindReleasePlacement(model, tests, options, fit);
+    return (*kept)->fit.explains_records;
+  };
+  return
+      [kept](const model::MechanicalModel& placed_model, std::vector<updating::TestRecord>* records,
+             const updating::UpdateOptions& options, updating::UpdateResult* best) {
+        if (kept->has_value() && (*kept)->From(*best)) {
+          return TakeReleasePlacement(**kept, records, options, best);
+        }
+        return PlaceDetectedReleases(placed_model, records, options, best);
+      };
 }
 
 }  // namespace mbid::validation

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <optional>
 #include <vector>
 
 #include "mbid/updating/credibility.h"
@@ -119,13 +118,8 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
   // A release found in a record is placed by the fit too (release_profile.h). Before that, its
   // fit leaves a misfit of a fraction of a sample that would call for the search's design; so
   // the search asks whether the placed fit explains the records, and that placement is kept.
-  std::optional<ReleasePlacement> early;
-  if (detected) {
-    settings.global_search.explains_records = [&](const updating::UpdateResult& fit) {
-      early = FindReleasePlacement(model, records, settings.options, fit);
-      return early->fit.explains_records;
-    };
-  }
+  const ReleasePlacer place =
+      detected ? PlaceReleasesEarly(model, &settings.global_search) : ReleasePlacer();
   updating::GlobalSearchResult search = updating::SearchGlobally(
       model, records, settings.options, *start, starts, settings.global_search, say);
   if (algebraic != nullptr) {
@@ -135,11 +129,7 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
   std::vector<updating::TestRecord> placed;
   if (detected) {
     placed = records;
-    if (early.has_value() && early->From(search.best)) {
-      TakeReleasePlacement(*early, &placed, settings.options, &search.best);
-    } else {
-      PlaceDetectedReleases(model, &placed, settings.options, &search.best);
-    }
+    place(model, &placed, settings.options, &search.best);
   }
   if (search.best.termination != updating::UpdateResult::Termination::kFailure) {
     updating::MarkUnseenParameters(model, records, search.best);

@@ -56,8 +56,10 @@ struct GlobalSearchOptions {
   // not the last word: records whose detected release the caller places after the search
   // (validation/release_profile.h), where a release a fraction of a sample off leaves a misfit
   // the placed fit does not have. Asked of the best given start when complete_starts and no
-  // fit explains the records itself; unset: the fits' own judgment.
-  std::function<bool(const UpdateResult&)> explains_records;
+  // fit explains the records itself, with the search's own records and options; unset: the
+  // fits' own judgment.
+  std::function<bool(const std::vector<TestRecord>&, const UpdateOptions&, const UpdateResult&)>
+      explains_records;
   // Otherwise the sets with the best end's own poles (eq. 7 on its exact modes: joints that
   // trade roles) are fitted too; each is a candidate alternative the design may have missed.
   bool pole_equivalent_starts = true;

@@ -1,10 +1,12 @@
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "mbid/model/mechanical_model.h"
+#include "mbid/updating/global_search.h"
 #include "mbid/updating/output_error.h"
 
 namespace mbid::validation {
@@ -53,6 +55,17 @@ std::vector<std::string> TakeReleasePlacement(const ReleasePlacement& placement,
                                               std::vector<updating::TestRecord>* records,
                                               const updating::UpdateOptions& options,
                                               updating::UpdateResult* best);
+
+// What a search whose detected releases are placed after it (TuneModel, `mbid structure`)
+// wires in, for `model`: `search`'s explains_records places the releases from the fit it is
+// asked about and keeps that placement; the function returned (PlaceDetectedReleases'
+// signature) takes the kept placement when the search's result is the fit it started from, or
+// places them anew.
+using ReleasePlacer = std::function<std::vector<std::string>(
+    const model::MechanicalModel&, std::vector<updating::TestRecord>*,
+    const updating::UpdateOptions&, updating::UpdateResult*)>;
+ReleasePlacer PlaceReleasesEarly(const model::MechanicalModel& model,
+                                 updating::GlobalSearchOptions* search);
 
 // Widens each shared parameter's std (and interval) of `best` by the variance the releases'
 // uncertainty adds to it (by name), and marks a parameter the widened spread no longer
