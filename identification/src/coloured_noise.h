@@ -14,14 +14,17 @@
 
 namespace mbid::identification {
 
-// Per mode of `modes`: its significance with each channel's share (amplitude^2 / residual
-// variance) divided by how far the residual's power near the mode's frequency stands above its
-// mean over the band, where it stands significantly above it. The near band: 2 to 8 half-power
-// bandwidths (at least the record's resolution) either side, widened to 64 bins, without the
-// bins within 2 bandwidths of any mode. `residual` is samples x channels at `sample_interval_s`;
-// `residual_variance` per channel.
-std::vector<double> CalcLocalSignificance(const Eigen::MatrixXd& residual, double sample_interval_s,
-                                          const Eigen::VectorXd& residual_variance,
-                                          const std::vector<IdentifiedMode>& modes);
+// How much more noise a mode sees near its frequency than the variance says: each channel's
+// residual power 2 to 8 half-power bandwidths (at least the record's resolution) either side,
+// widened to 64 bins, without the bins within 2 bandwidths of any mode, over its mean over the
+// band, where it stands significantly above it (else 1); the channels combined as their shares
+// of the mode's information (amplitude^2 / residual variance) combine. A mode's significance is
+// divided by it, and its variances multiplied (the Cramer-Rao bound of a damped sinusoid in
+// noise of spectral density S near it scales with S, not with the variance). `residual` is
+// samples x channels at `sample_interval_s`; `residual_variance` per channel. 1 per mode where
+// the record is too short to tell (fewer than 256 samples).
+std::vector<double> CalcLocalNoiseRatio(const Eigen::MatrixXd& residual, double sample_interval_s,
+                                        const Eigen::VectorXd& residual_variance,
+                                        const std::vector<IdentifiedMode>& modes);
 
 }  // namespace mbid::identification
