@@ -108,28 +108,30 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
   const updating::TestFit& fit = test.tuned.tests.front();
   const Eigen::VectorXd& k = fit.correlation;
   test.reasons.clear();
+  // What else `passed` needs (the contract's three-valued verdict): each missing one makes the
+  // test inconclusive, never passed.
+  std::vector<std::string> missing;
   for (Eigen::Index c = 0; c < k.size(); ++c) {
     if (!(k(c) >= settings.min_correlation)) {
       const std::string& channel = fit.channels[static_cast<size_t>(c)];
       std::string reason = fmt::format("K({}) = {:.4f} is below the threshold {}", channel, k(c),
                                        settings.min_correlation);
       // A re-simulation that leaves the record's noise and no more cannot correlate better:
-      // say so, so that the user sees the failure is the channel's (too little signal), not
-      // necessarily the model's.
+      // the channel has too little signal to judge the model by, which does not refute it (a
+      // machine's exact model failed on a channel of a part that does not move). Inconclusive.
       if (c < fit.noise_std.size() && c < fit.residual_rms.size() &&
           fit.residual_rms[c] <= kNoiseLevelRatio * fit.noise_std[c]) {
-        reason += fmt::format(
-            " (its residual, rms {:.3g}, is at the record's noise level, {:.3g}: the channel has "
-            "too little signal above its noise to reach the threshold)",
-            fit.residual_rms[c], fit.noise_std[c]);
+        missing.push_back(
+            reason + fmt::format(" (its residual, rms {:.3g}, is at the record's noise level, "
+                                 "{:.3g}: the channel has too little signal above its noise to "
+                                 "reach the threshold, and cannot judge the model)",
+                                 fit.residual_rms[c], fit.noise_std[c]));
+      } else {
+        test.reasons.push_back(reason);
       }
-      test.reasons.push_back(reason);
     }
   }
   const bool correlates = k.size() > 0 && test.reasons.empty();
-  // What else `passed` needs (the contract's three-valued verdict): each missing one makes the
-  // test inconclusive, never passed.
-  std::vector<std::string> missing;
   for (const std::string& reason : test.identified.reasons) {
     missing.push_back("identification unreliable: " + reason);
   }
