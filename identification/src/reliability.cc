@@ -193,6 +193,16 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
           mode.frequency_hz, top_hz,
           record.decimation > 1 ? fmt::format(", decimation {}", record.decimation) : ""));
     }
+    // Less than a cycle in the analysed record: a slow trend or drift fits as well as a mode (a
+    // 0.02 Hz sine over 20 s, 0.4 of a cycle, came out as a "reliable" 0.021 Hz mode).
+    const double duration_s =
+        static_cast<double>(record.decimated.rows()) * record.decimated_interval_s;
+    if (mode.frequency_hz * duration_s < 1) {
+      reasons.push_back(fmt::format(
+          "the mode at {:.4g} Hz completes {:.2g} of a cycle in the analysed {:.4g} s: a trend or "
+          "drift cannot be told from it (remove_drift, or a longer record)",
+          mode.frequency_hz, mode.frequency_hz * duration_s, duration_s));
+    }
     if (options.min_frequency_hz > 0 && mode.frequency_hz < 1.05 * options.min_frequency_hz) {
       reasons.push_back(fmt::format("the mode at {:.4g} Hz is at the bottom of the band ({} Hz)",
                                     mode.frequency_hz, options.min_frequency_hz));

@@ -739,5 +739,35 @@ TEST(IdentifyTest, PureNoiseFindsNoModes) {
   }
 }
 
+// Less than a cycle of a slow oscillation in the record (a trial's 0.02 Hz sine trend over
+// 20 s, 0.4 of a cycle) fits as a "mode" as well as a trend: it came out as a reliable 0.021 Hz
+// mode in 6 of 20 records. A mode that completes less than a cycle in the analysed record is
+// said so, and the result is unreliable; the two true modes are still found.
+TEST(IdentifyTest, AModeOfLessThanACycleInTheRecordIsNotReliable) {
+  testing::SignalSpec spec;
+  spec.channels = {"a", "b", "c"};
+  spec.sample_interval_s = 0.02;  // 50 Hz, 20 s
+  spec.samples = 1000;
+  const double half_pi = M_PI / 2;
+  spec.modes = {{0.8, 0.1005, {1.0, 0.5, -0.3}, {0, 0, 0}},
+                {2.9, 0.2734, {0.3, -0.6, 0.8}, {0, 0, 0}},
+                {0.02, 0.0, {0.05, 0.05, 0.05}, {-half_pi, -half_pi, -half_pi}}};  // the trend
+  std::mt19937_64 rng(5);
+  Eigen::MatrixXd values =
+      testing::AddNoise(testing::Synthesize(spec), Eigen::VectorXd::Constant(3, 2e-3), &rng);
+  values.rowwise() += Eigen::RowVector3d(5.0, -3.0, 0.7);  // the sensors' zero offsets
+  IdentificationOptions whole;
+  whole.release = ReleaseMode::kNone;  // the record is the decay from its first sample
+  const ModalResult result = Identify(testing::MakeRecord(spec, values), whole);
+  EXPECT_FALSE(result.reliable);
+  EXPECT_TRUE(testing::Mentions(result.reasons, "of a cycle in the analysed"))
+      << ::testing::PrintToString(result.reasons);
+  int found = 0;
+  for (const IdentifiedMode& mode : result.modes) {
+    found += std::abs(mode.frequency_hz - 0.8) < 0.01 || std::abs(mode.frequency_hz - 2.9) < 0.01;
+  }
+  EXPECT_EQ(found, 2);
+}
+
 }  // namespace
 }  // namespace mbid::identification
