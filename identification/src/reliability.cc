@@ -203,6 +203,17 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
           "drift cannot be told from it (remove_drift, or a longer record)",
           mode.frequency_hz, mode.frequency_hz * duration_s, duration_s));
     }
+    // The refinement admits growth by e over the record at most (decay -1 / its duration,
+    // refinement.cc): a mode that ends there was pushed to the bound, where its standard
+    // deviation means nothing (a numerically differentiated channel's end gave a 31 Hz "mode" at
+    // exactly that growth, "reliable", in trial records).
+    if (mode.decay_rate_per_s <= -0.99 / duration_s) {
+      reasons.push_back(fmt::format(
+          "the mode at {:.4g} Hz grows at the fit's limit ({:.3g} 1/s: by e over the analysed "
+          "{:.4g} s): the fit pushed it to its bound, and no free decay's mode grows (an edge "
+          "effect of the record, noise)",
+          mode.frequency_hz, mode.decay_rate_per_s, duration_s));
+    }
     if (options.min_frequency_hz > 0 && mode.frequency_hz < 1.05 * options.min_frequency_hz) {
       reasons.push_back(fmt::format("the mode at {:.4g} Hz is at the bottom of the band ({} Hz)",
                                     mode.frequency_hz, options.min_frequency_hz));

@@ -769,5 +769,27 @@ TEST(IdentifyTest, AModeOfLessThanACycleInTheRecordIsNotReliable) {
   EXPECT_EQ(found, 2);
 }
 
+// The refinement admits growth by e over the record at most (a decay of -1 / its duration): a
+// component that grows faster ends at that bound, where its standard deviation means nothing
+// (a numerically differentiated channel's end made a 31 Hz "mode" there, reliable, in trial
+// records). A tone growing by e^2 over 20 s beside a decaying mode: said, not reliable.
+TEST(IdentifyTest, AModeAtTheFitsGrowthLimitIsNotReliable) {
+  testing::SignalSpec spec;
+  spec.channels = {"x", "y"};
+  spec.sample_interval_s = 0.01;  // 100 Hz, 20 s
+  spec.samples = 2000;
+  spec.modes = {{1.7, 0.107, {1.0, 0.5}, {0.0, 0.3}}, {31.0, -0.1, {0.02, 0.01}, {0.5, 1.0}}};
+  std::mt19937_64 rng(3);
+  IdentificationOptions whole;
+  whole.release = ReleaseMode::kNone;
+  const ModalResult result = Identify(
+      testing::MakeRecord(spec, testing::AddNoise(testing::Synthesize(spec),
+                                                  Eigen::VectorXd::Constant(2, 2e-3), &rng)),
+      whole);
+  EXPECT_FALSE(result.reliable);
+  EXPECT_TRUE(testing::Mentions(result.reasons, "grows at the fit's limit"))
+      << ::testing::PrintToString(result.reasons);
+}
+
 }  // namespace
 }  // namespace mbid::identification
