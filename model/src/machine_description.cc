@@ -28,13 +28,6 @@ std::string JoinNames(const std::vector<std::string>& names) {
   return text.empty() ? "(none)" : text;
 }
 
-bool IsIdentifier(const std::string& name) {
-  return !name.empty() && std::isalpha(static_cast<unsigned char>(name[0])) &&
-         name.find_first_not_of(
-             "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
-             std::string::npos;
-}
-
 void CheckInertia(const BodyDescription& body, const std::string& field) {
   const Eigen::Matrix3d& I = body.inertia_kgm2;
   if (!I.allFinite()) Fail(field, "non-finite inertia", "finite values in kg*m^2");
@@ -60,6 +53,13 @@ void CheckInertia(const BodyDescription& body, const std::string& field) {
 }
 
 }  // namespace
+
+bool IsIdentifier(const std::string& name) {
+  return !name.empty() && std::isalpha(static_cast<unsigned char>(name[0])) &&
+         name.find_first_not_of(
+             "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
+             std::string::npos;
+}
 
 std::vector<std::string> MachineDescription::coordinates() const {
   std::vector<std::string> names;

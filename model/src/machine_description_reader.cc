@@ -260,8 +260,15 @@ MachineDescription ReadMachineDescription(const YamlReader& model) {
     result.com_m = Vector3(body, "com_m", context, Eigen::Vector3d::Zero());
     result.inertia_kgm2 = Inertia(body, context);
     machine.bodies.push_back(std::move(result));
-    // Springs and outputs name coordinates: a duplicate must be reported as such first.
+    // Springs and outputs name coordinates: a bad name or a duplicate must be reported as such
+    // first (not as a spring's unknown coordinate offering the bad name as the fix).
     const std::vector<std::string> coordinates = machine.coordinates();
+    for (const std::string& coordinate : machine.bodies.back().joint.coordinates) {
+      if (!IsIdentifier(coordinate)) {
+        body.Child("joint").FailAt("coordinates", "coordinate name '" + coordinate + "'",
+                                   "letters, digits and '_', starting with a letter");
+      }
+    }
     for (size_t i = 0; i < coordinates.size(); ++i) {
       if (std::find(coordinates.begin(), coordinates.begin() + static_cast<long>(i),
                     coordinates[i]) != coordinates.begin() + static_cast<long>(i)) {

@@ -585,6 +585,9 @@ INSTANTIATE_TEST_SUITE_P(
                 "not defined above"},
         BadCase{"coordinate twice", "coordinates: [c]", "coordinates: [a]",
                 "model.bodies.jib.joint.coordinates", "twice"},
+        // Not reported as the spring's unknown coordinate offering the bad name as the fix.
+        BadCase{"coordinate not an identifier", "coordinates: [c]", "coordinates: [\"c c\"]",
+                "model.bodies.jib.joint.coordinates", "letters, digits and '_'"},
         // Its second coordinate's spring must not be reported first.
         BadCase{"universal joint with one coordinate", "coordinates: [a, b]", "coordinates: [a]",
                 "model.bodies.mast.joint.coordinates", "expected 2 for this joint type"},

@@ -73,6 +73,10 @@ struct OutputDescription {
   bool body_frame = false;  // direction fixed in the body (true) or in ground (false)
 };
 
+// A name of the description (body, coordinate, point): letters, digits and '_', starting with a
+// letter.
+bool IsIdentifier(const std::string& name);
+
 struct MachineDescription {
   double gravity_mps2 = 9.81;  // along -z of ground
   std::vector<BodyDescription> bodies;
