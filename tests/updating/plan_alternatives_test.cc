@@ -73,6 +73,20 @@ TEST(PlanAlternativesTest, SeparationIsTheClosedFormChiSquareAndDecidesWhoCannot
   EXPECT_FALSE(quiet.cannot_separate[0]);
   EXPECT_LT(noisy.separation[0] + alternative.cost_excess, 0.1 * plan.thresholds[0]);
   EXPECT_TRUE(noisy.cannot_separate[0]);
+  // Between them, noise giving a separation of ~2: below the threshold without noise (2 + 0.5
+  // against 6.04), but the test's noise adds 2 d.e of std 2 sqrt(2) = 2.8, and its upper 5 %
+  // point (2.5 + 1.645 x 2.8 = 7.2) is above it: the candidate may separate them, not certain.
+  const AlternativesPlan middle = PlanAtAlternatives(
+      *oscillator, recorded,
+      {{"middle", nullptr, testing::OscillatorRelease("middle", 0.01, 8.7e-4)}},
+      PlanNextTest(*oscillator, recorded,
+                   {{"middle", nullptr, testing::OscillatorRelease("middle", 0.01, 8.7e-4)}},
+                   options),
+      {alternative}, options, 201, 0.05);
+  const double separation = middle.candidates[0].separation[0];
+  EXPECT_NEAR(separation, 2.0, 0.5);  // 150 x (1e-4 / 8.7e-4)^2
+  EXPECT_LT(separation + alternative.cost_excess, middle.thresholds[0]);
+  EXPECT_FALSE(middle.candidates[0].cannot_separate[0]);
   // Scores: one per alternative, and the worst is the lower of the best's and the alternative's.
   ASSERT_EQ(quiet.scores.size(), 1u);
   double at_best_quiet = 0;

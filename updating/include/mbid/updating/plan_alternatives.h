@@ -19,10 +19,11 @@ namespace mbid::updating {
 //   sum ((y_best - y_alternative) / sigma)^2 over the candidate's samples and channels, the
 //   candidate's outputs simulated without noise at both value sets. A joint re-fit moves the
 //   alternative to lower it, so it is an upper bound of what the candidate adds to the
-//   alternative's cost excess (2 x cost). When even the bound, added to the recorded tests'
-//   excess, stays below the F-test's threshold (k F(1 - significance; k, dof)), the candidate
-//   `cannot_separate` that alternative: a certain answer. Above it the candidate may separate
-//   them; only the test itself will say.
+//   alternative's cost excess (2 x cost) without noise; the test's noise adds a normal term of
+//   std 2 sqrt(separation). When even the bound plus that term's upper quantile at the
+//   significance, added to the recorded tests' excess, stays below the F-test's threshold
+//   (k F(1 - significance; k, dof)), the candidate `cannot_separate` that alternative. Above it
+//   the candidate may separate them; only the test itself will say.
 
 struct AlternativeMinimumValues {
   std::string label;                     // e.g. the starts that ended there
