@@ -4,12 +4,33 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace mbid {
 namespace {
 
 constexpr double kRatio = 30;       // see the header
 constexpr Eigen::Index kHalf = 16;  // half the window of the local spread
+
+// The step of a quantized channel (an ADC's least significant bit): the least non-zero change
+// between neighbouring samples, when at least 90 % of the changes are whole multiples of it;
+// else 0.
+double QuantizationStep(const Eigen::Ref<const Eigen::VectorXd>& values) {
+  double step = std::numeric_limits<double>::infinity();
+  for (Eigen::Index j = 1; j < values.size(); ++j) {
+    const double change = std::abs(values[j] - values[j - 1]);
+    if (change > 0) step = std::min(step, change);
+  }
+  if (!std::isfinite(step)) return 0;
+  Eigen::Index changes = 0, multiples = 0;
+  for (Eigen::Index j = 1; j < values.size(); ++j) {
+    const double ratio = std::abs(values[j] - values[j - 1]) / step;
+    if (ratio == 0) continue;
+    ++changes;
+    if (std::abs(ratio - std::round(ratio)) < 1e-3 * std::max(1.0, ratio)) ++multiples;
+  }
+  return multiples >= 0.9 * static_cast<double>(changes) ? step : 0;
+}
 
 }  // namespace
 
@@ -24,7 +45,10 @@ std::vector<Outlier> FindOutliers(const Eigen::Ref<const Eigen::VectorXd>& value
   for (Eigen::Index j = 1; j + 1 < n; ++j) {
     bend[j] = std::abs(values[j + 1] - 2 * values[j] + values[j - 1]);
   }
-  const double floor = 1e-9 * range;  // a noiseless, flat stretch has no spread
+  // A noiseless, flat stretch has no spread; a quantized channel's spread is at least its step:
+  // a 12-bit logger with the noise under one step moves by 0 or 1 step, and its median second
+  // difference is 0 (one step was called 8e5 times the local spread).
+  const double floor = std::max(1e-9 * range, QuantizationStep(values));
   std::vector<double> window;
   for (Eigen::Index j = 1; j + 1 < n; ++j) {
     if (bend[j] <= kRatio * floor) continue;
@@ -38,6 +62,15 @@ std::vector<Outlier> FindOutliers(const Eigen::Ref<const Eigen::VectorXd>& value
     std::nth_element(window.begin(), middle, window.end());
     const double ratio = bend[j] / std::max(*middle, floor);
     if (ratio <= kRatio) continue;
+    // A glitch of one or two samples bends the course at most two samples away; three and four
+    // away it is back (bends there no more than a tenth). A heavily damped mode near the sampling
+    // rate bends it for several samples, decaying: a 40 Hz mode at 30 % damping sampled at 200 Hz
+    // was called a glitch at its start.
+    double further = 0;
+    for (const Eigen::Index k : {j - 4, j - 3, j + 3, j + 4}) {
+      if (k >= 1 && k + 1 < n) further = std::max(further, bend[k]);
+    }
+    if (further > 0.1 * bend[j]) continue;
     if (!outliers.empty() && j - outliers.back().sample <= 2) {
       if (ratio > outliers.back().ratio) outliers.back() = {j, ratio};  // the same jump
     } else {

@@ -17,9 +17,13 @@ struct Outlier {
 };
 
 // Samples whose second difference y[j+1] - 2 y[j] + y[j-1] exceeds 30 times the median absolute
-// second difference of the 32 samples around it (those next to it left out): white noise
-// reaches 7 times with a 6-sigma sample, a smoothly sampled decay about 3 times. Adjacent
-// samples are one outlier. Channels under 16 samples are not judged.
+// second difference of the 32 samples around it (those next to it left out; at least the step
+// of a quantized channel), and whose course is back three and four samples away (second
+// differences there under a tenth of it): white noise reaches 7 times with a 6-sigma sample, a
+// smoothly sampled decay about 3 times, and a mode near the sampling rate that decays within a
+// few samples bends the course beyond (down to 30 % damping at 5 samples per period; at 50 % it
+// is called a glitch). Adjacent samples are one outlier. Channels under 16 samples are not
+// judged.
 std::vector<Outlier> FindOutliers(const Eigen::Ref<const Eigen::VectorXd>& values);
 
 // "channel psi jumps off its course at 3 s (41 times its local spread), and at 1 more sample: a
