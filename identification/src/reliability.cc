@@ -168,6 +168,7 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   }
   result->residual_to_noise = ratios;
   result->residual_window_ratio = windows.channel_ratio;
+  const bool any_correlates = (result->correlation.array() >= options.min_correlation).any();
   for (Eigen::Index c = 0; c < result->correlation.size(); ++c) {
     if (!(result->correlation(c) >= options.min_correlation)) {
       // A residual at the noise level is the noise: then the channel's signal is too weak for
@@ -179,9 +180,15 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
                     "channel has too little signal above its noise for a higher K",
                     ratios(c))
               : "the modes do not explain the record in the analysed band";
-      reasons.push_back(fmt::format(
-          "K = {:.3f} in channel {} is below min_correlation {}: {}", result->correlation(c),
-          result->channels[static_cast<size_t>(c)], options.min_correlation, why));
+      // Beside a channel that correlates, one whose residual is its noise (within the 1.2-1.4 an
+      // exact fit shows) carries too little of the modes to doubt them: said, not a reason (a
+      // channel of pure noise beside good ones made every record unreliable). When no channel
+      // correlates, the record as a whole is too weak: a reason.
+      const bool noise_only = ratios(c) > 0 && ratios(c) <= 1.5 && any_correlates;
+      (noise_only ? result->warnings : reasons)
+          .push_back(fmt::format("K = {:.3f} in channel {} is below min_correlation {}: {}",
+                                 result->correlation(c), result->channels[static_cast<size_t>(c)],
+                                 options.min_correlation, why));
     }
   }
   const double top_hz = std::min(record.max_frequency_hz, record.flat_frequency_hz);

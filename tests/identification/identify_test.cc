@@ -95,6 +95,26 @@ TEST(IdentifyTest, ANoiseLimitedCorrelationIsCalledSo) {
   EXPECT_EQ(result.reasons[0].find("do not explain"), std::string::npos) << result.reasons[0];
 }
 
+// Beside a channel that correlates, a channel of pure noise (a sensor on a part that does not
+// move, or a dead one with noise) says nothing against the modes: it is named in a warning, not
+// as a reason (a trial's 20 of 20 such records were unreliable). Alone, as above, it is a reason.
+TEST(IdentifyTest, APureNoiseChannelBesideAGoodOneIsAWarning) {
+  SignalSpec spec;
+  spec.channels = {"x", "quiet"};
+  spec.sample_interval_s = 0.01;
+  spec.samples = 2000;
+  spec.modes = {{1.5, 0.05, {1.0, 0.0}, {0.3, 0.0}}};
+  std::mt19937_64 rng(7);
+  const Eigen::MatrixXd noisy =
+      testing::AddNoise(Synthesize(spec), Eigen::Vector2d(2e-3, 2e-3), &rng);
+  const ModalResult result = Identify(MakeRecord(spec, noisy), {});
+  ASSERT_EQ(result.modes.size(), 1u);
+  EXPECT_NEAR(result.modes[0].frequency_hz, 1.5, 1e-3);
+  EXPECT_TRUE(result.reliable) << ::testing::PrintToString(result.reasons);
+  EXPECT_TRUE(testing::Mentions(result.warnings, "in channel quiet is below min_correlation"))
+      << ::testing::PrintToString(result.warnings);
+}
+
 // One channel x: 1.5 Hz at 5 % damping, 8 s at 100 Hz, 40 dB (seeded): reliable as recorded.
 SignalSpec OneDecaySpec() {
   SignalSpec spec;
