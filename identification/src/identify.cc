@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <optional>
 #include <vector>
 
 #include "clipped_start.h"
@@ -145,7 +146,15 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
                               (top_hz <= 0 || wider.decimation > 1);
     if (hidden_start) wider.decimation = 1;
     if ((top_hz > 0 || hidden_start) && wider.decimation < record.decimation) {
-      ModalResult again = Identify(measurement, wider, origin);
+      // The analysis again must not lose what this one found: a 2 kHz record of 0.5-3 Hz modes
+      // has no oscillation the full-rate Hankel matrix resolves, and failed with "no modes".
+      std::optional<ModalResult> again;
+      std::string failure;
+      try {
+        again = Identify(measurement, wider, origin);
+      } catch (const NumericalError& error) {
+        failure = error.what();
+      }
       const std::string what =
           hidden_start
               ? fmt::format(
@@ -161,9 +170,16 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
                                               "to {:.4g} Hz, above",
                                               burst_hz),
                             record.flat_frequency_hz, record.decimation);
-      again.warnings.insert(again.warnings.begin(),
-                            fmt::format("{}: analysed with decimation {}", what, wider.decimation));
-      return again;
+      if (again) {
+        again->warnings.insert(
+            again->warnings.begin(),
+            fmt::format("{}: analysed with decimation {}", what, wider.decimation));
+        return *again;
+      }
+      result.warnings.push_back(
+          fmt::format("{}: analysed again with decimation {}, which failed ({}); the analysis with "
+                      "decimation {} stands",
+                      what, wider.decimation, failure, record.decimation));
     }
   }
   MarkCombinationTones(record, options, &result);
