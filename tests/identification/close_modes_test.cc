@@ -101,11 +101,8 @@ TEST(CloseModesTest, OneChannelsBeatingPairIsSplitAndDoubted) {
   const double first_hz = 10 * std::sqrt(1 - 0.01 * 0.01);  // damped
   const double second_hz = first_hz + 0.5 * decay / M_PI;   // half the half-power bandwidth
   spec.modes = {{first_hz, decay, {1.0}, {0.3}}, {second_hz, decay, {1.0}, {1.1}}};
-  std::mt19937_64 rng(1);
   const ModalResult result = Identify(
-      MakeRecord(spec,
-                 testing::AddNoise(Synthesize(spec), Eigen::VectorXd::Constant(1, 0.05), &rng)),
-      {});
+      MakeRecord(spec, testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(1, 0.05), 1)), {});
   EXPECT_FALSE(result.reliable);
   EXPECT_TRUE(testing::Mentions(result.reasons, "drifting with amplitude or two"))
       << ::testing::PrintToString(result.reasons);
@@ -131,11 +128,10 @@ TEST(CloseModesTest, TwoModesTheRecordTellsApartAreReliable) {
   const double decay_1 = 0.002 * 2 * M_PI * 1.0, decay_2 = 0.002 * 2 * M_PI * 1.02;
   spec.modes = {{1.0, decay_1, {1.0, 0.7, 0.4, 0.5}, {0, 0, 0, M_PI}},
                 {1.02, decay_2, {0.8, 0.9, 0.3, 1.0}, {0, M_PI, 0, 0}}};
-  std::mt19937_64 rng(4);
-  const ModalResult result = Identify(
-      testing::MakeRecord(
-          spec, testing::AddNoise(Synthesize(spec), Eigen::VectorXd::Constant(4, 0.01), &rng)),
-      {});
+  const ModalResult result =
+      Identify(testing::MakeRecord(
+                   spec, testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(4, 0.01), 4)),
+               {});
   ASSERT_EQ(result.modes.size(), 2u);
   EXPECT_TRUE(result.reliable) << ::testing::PrintToString(result.reasons);
   for (size_t k = 0; k < 2; ++k) {

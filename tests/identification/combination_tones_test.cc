@@ -40,9 +40,8 @@ SignalSpec ArmWithSumTone(double amplitude) {
 }
 
 ModalResult IdentifyArm(const SignalSpec& spec, int seed) {
-  std::mt19937_64 rng(seed);
   const Eigen::VectorXd noise = Eigen::Vector4d(2e-3, 2e-3, 2e-3, 2e-3);
-  return Identify(MakeRecord(spec, testing::AddNoise(Synthesize(spec), noise, &rng)), {});
+  return Identify(MakeRecord(spec, testing::SynthesizeNoisy(spec, noise, seed)), {});
 }
 
 TEST(CombinationTonesTest, AComponentAtTheSumOfTwoPolesIsATone) {

@@ -104,9 +104,7 @@ TEST(IdentifyTest, APureNoiseChannelBesideAGoodOneIsAWarning) {
   spec.sample_interval_s = 0.01;
   spec.samples = 2000;
   spec.modes = {{1.5, 0.05, {1.0, 0.0}, {0.3, 0.0}}};
-  std::mt19937_64 rng(7);
-  const Eigen::MatrixXd noisy =
-      testing::AddNoise(Synthesize(spec), Eigen::Vector2d(2e-3, 2e-3), &rng);
+  const Eigen::MatrixXd noisy = testing::SynthesizeNoisy(spec, Eigen::Vector2d(2e-3, 2e-3), 7);
   const ModalResult result = Identify(MakeRecord(spec, noisy), {});
   ASSERT_EQ(result.modes.size(), 1u);
   EXPECT_NEAR(result.modes[0].frequency_hz, 1.5, 1e-3);
@@ -496,10 +494,8 @@ TEST(IdentifyTest, AGrowingModeIsSaidToGrow) {
   spec.sample_interval_s = 0.01;
   spec.samples = 1000;
   spec.modes = {{2.0, -0.05, {1.0}, {0.3}}};
-  std::mt19937_64 rng(1);
   const ModalResult result = Identify(
-      MakeRecord(spec,
-                 testing::AddNoise(Synthesize(spec), Eigen::VectorXd::Constant(1, 1e-3), &rng)),
+      MakeRecord(spec, testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(1, 1e-3), 1)),
       IdentificationOptions());
   ASSERT_EQ(result.modes.size(), 1u);
   EXPECT_NEAR(result.modes[0].decay_rate_per_s, -0.05, 4 * result.modes[0].std_decay_rate_per_s);
@@ -772,9 +768,7 @@ TEST(IdentifyTest, AModeOfLessThanACycleInTheRecordIsNotReliable) {
   spec.modes = {{0.8, 0.1005, {1.0, 0.5, -0.3}, {0, 0, 0}},
                 {2.9, 0.2734, {0.3, -0.6, 0.8}, {0, 0, 0}},
                 {0.02, 0.0, {0.05, 0.05, 0.05}, {-half_pi, -half_pi, -half_pi}}};  // the trend
-  std::mt19937_64 rng(5);
-  Eigen::MatrixXd values =
-      testing::AddNoise(testing::Synthesize(spec), Eigen::VectorXd::Constant(3, 2e-3), &rng);
+  Eigen::MatrixXd values = testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(3, 2e-3), 5);
   values.rowwise() += Eigen::RowVector3d(5.0, -3.0, 0.7);  // the sensors' zero offsets
   IdentificationOptions whole;
   whole.release = ReleaseMode::kNone;  // the record is the decay from its first sample
@@ -799,13 +793,12 @@ TEST(IdentifyTest, AModeAtTheFitsGrowthLimitIsNotReliable) {
   spec.sample_interval_s = 0.01;  // 100 Hz, 20 s
   spec.samples = 2000;
   spec.modes = {{1.7, 0.107, {1.0, 0.5}, {0.0, 0.3}}, {31.0, -0.1, {0.02, 0.01}, {0.5, 1.0}}};
-  std::mt19937_64 rng(3);
   IdentificationOptions whole;
   whole.release = ReleaseMode::kNone;
-  const ModalResult result = Identify(
-      testing::MakeRecord(spec, testing::AddNoise(testing::Synthesize(spec),
-                                                  Eigen::VectorXd::Constant(2, 2e-3), &rng)),
-      whole);
+  const ModalResult result =
+      Identify(testing::MakeRecord(
+                   spec, testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(2, 2e-3), 3)),
+               whole);
   EXPECT_FALSE(result.reliable);
   EXPECT_TRUE(testing::Mentions(result.reasons, "grows at the fit's limit"))
       << ::testing::PrintToString(result.reasons);

@@ -323,9 +323,8 @@ TEST(ReleaseTest, OversampledRecordIsDecimatedAutomatically) {
   spec.samples = 100000;  // 1.95 s
   spec.modes = {
       {151.6, 3.0, {1.0}, {0.3}}, {420.0, 8.0, {0.5}, {-1.0}}, {980.0, 20.0, {0.3}, {2.0}}};
-  std::mt19937_64 rng(5);
   const Eigen::MatrixXd values =
-      testing::AddNoise(testing::Synthesize(spec), Eigen::VectorXd::Constant(1, 1e-3), &rng);
+      testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(1, 1e-3), 5);
   const ModalResult result = Identify(testing::MakeRecord(spec, values), IdentificationOptions());
   // The spectrum's top (about 1 kHz) x 1.25 inside 0.76 of the new Nyquist frequency: q = 15.
   EXPECT_GE(result.decimation, 10);
@@ -382,9 +381,8 @@ TEST(ReleaseTest, AHeavilyDampedModeOfAShortRecordIsNotDecimatedAway) {
 // flagged. A mode at the top of a band the spectrum chose is analysed again in a wider one.
 TEST(ReleaseTest, AModeAtTheTopOfTheChosenBandIsAnalysedInAWiderOne) {
   const testing::SignalSpec spec = testing::TwoAndSevenHertzDecay();
-  std::mt19937_64 rng(2);
   const Eigen::MatrixXd values =
-      testing::AddNoise(testing::Synthesize(spec), Eigen::VectorXd::Constant(1, 1e-2), &rng);
+      testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(1, 1e-2), 2);
   const ModalResult result = Identify(testing::MakeRecord(spec, values), IdentificationOptions());
   EXPECT_TRUE(result.reliable) << (result.reasons.empty() ? "" : result.reasons.front());
   EXPECT_TRUE(testing::Mentions(result.warnings, "a mode at 7"));
@@ -403,9 +401,7 @@ TEST(ReleaseTest, AModeAtTheTopOfTheChosenBandIsAnalysedInAWiderOne) {
 // power elsewhere; analysed again at the full rate, both modes come back.
 TEST(ReleaseTest, AModeGoneBeforeTheDecimationFiltersFirstOutputIsAnalysedAtFullRate) {
   const testing::SignalSpec spec = testing::LightBesideHeavy(1.3, 0.1, 0.5, 5, 0.45, 0.005, 2000);
-  std::mt19937_64 rng(2);
-  const Eigen::MatrixXd values =
-      testing::AddNoise(testing::Synthesize(spec), Eigen::Vector2d(0.01, 0.01), &rng);
+  const Eigen::MatrixXd values = testing::SynthesizeNoisy(spec, Eigen::Vector2d(0.01, 0.01), 2);
   IdentificationOptions options;
   options.release = ReleaseMode::kNone;
   const ModalResult result = Identify(testing::MakeRecord(spec, values), options);

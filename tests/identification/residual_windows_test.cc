@@ -91,9 +91,7 @@ TEST(ResidualWindowsTest, ThresholdsOfManyDegreesOfFreedomAreTheChiSquaresOwn) {
 // samples in, after the burst: one mode, "reliable". The full-rate residual shows the burst.
 TEST(ResidualWindowsTest, AModeLostToTheDecimationFiltersEdgeIsSeenAtFullRate) {
   const testing::SignalSpec spec = testing::LightBesideHeavy(10, 0.3, 0.6, 110, 0.2, 1e-3, 20000);
-  std::mt19937_64 rng(3);
-  const Eigen::MatrixXd values =
-      testing::AddNoise(testing::Synthesize(spec), Eigen::Vector2d(0.02, 0.02), &rng);
+  const Eigen::MatrixXd values = testing::SynthesizeNoisy(spec, Eigen::Vector2d(0.02, 0.02), 3);
   IdentificationOptions options;
   options.release = ReleaseMode::kNone;
   const ModalResult result = Identify(testing::MakeRecord(spec, values), options);

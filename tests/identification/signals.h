@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <string>
 #include <vector>
@@ -65,6 +66,13 @@ inline Eigen::MatrixXd AddNoise(const Eigen::MatrixXd& clean, const Eigen::Vecto
     for (Eigen::Index j = 0; j < clean.rows(); ++j) noisy(j, c) += noise_std(c) * normal(*rng);
   }
   return noisy;
+}
+
+// `spec` synthesized with white Gaussian noise of `noise_std` per channel, drawn from `seed`.
+inline Eigen::MatrixXd SynthesizeNoisy(const SignalSpec& spec, const Eigen::VectorXd& noise_std,
+                                       std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  return AddNoise(Synthesize(spec), noise_std, &rng);
 }
 
 // An aerial platform's load drop (200 Hz, 6 s, an inclinometer, two accelerometers and a gyro):
