@@ -193,6 +193,8 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
     }
   }
   const double top_hz = std::min(record.max_frequency_hz, record.flat_frequency_hz);
+  const double duration_s =
+      static_cast<double>(record.decimated.rows()) * record.decimated_interval_s;
   for (const IdentifiedMode& mode : result->modes) {
     if (mode.frequency_hz > 0.95 * top_hz) {
       reasons.push_back(fmt::format(
@@ -203,8 +205,6 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
     }
     // Less than a cycle in the analysed record: a slow trend or drift fits as well as a mode (a
     // 0.02 Hz sine over 20 s, 0.4 of a cycle, came out as a "reliable" 0.021 Hz mode).
-    const double duration_s =
-        static_cast<double>(record.decimated.rows()) * record.decimated_interval_s;
     if (mode.frequency_hz * duration_s < 1) {
       reasons.push_back(fmt::format(
           "the mode at {:.4g} Hz completes {:.2g} of a cycle in the analysed {:.4g} s: a trend or "
