@@ -377,6 +377,25 @@ double CalcStartCost(const model::MechanicalModel& model, const std::vector<Test
   return cost;
 }
 
+std::vector<Eigen::MatrixXd> CalcCovarianceAt(const model::MechanicalModel& model,
+                                              const std::vector<TestRecord>& tests,
+                                              const UpdateOptions& options,
+                                              const std::vector<Eigen::VectorXd>& points) {
+  FitProblem fit(model, tests, options);
+  std::vector<Eigen::MatrixXd> covariances;
+  for (const Eigen::VectorXd& point : points) {
+    fit.x = point;
+    ceres::CRSMatrix crs;
+    UpdateResult scratch;
+    if (fit.problem.Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &crs)) {
+      covariances.push_back(CalcCovariance(fit, crs, options, &scratch));
+    } else {
+      covariances.push_back(Eigen::MatrixXd::Constant(fit.count, fit.count, kNaN));
+    }
+  }
+  return covariances;
+}
+
 UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
                  const UpdateOptions& options, int first_stage, const std::string& stage_label,
                  const std::vector<double>* report_start) {

@@ -2,6 +2,7 @@
 
 // One fit of the output-error problem (UpdateModel's stages). Not part of the public API.
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -22,5 +23,13 @@ UpdateResult Fit(const model::MechanicalModel& model, const std::vector<TestReco
 // NumericalError if a simulation fails there.
 double CalcStartCost(const model::MechanicalModel& model, const std::vector<TestRecord>& tests,
                      const UpdateOptions& options);
+
+// The Fisher covariance (Ceres' coordinates, the unknowns' order; NaN rows in a flat direction)
+// at each of `points`, with the tests' weights as given. Each point costs one simulation with
+// sensitivities.
+std::vector<Eigen::MatrixXd> CalcCovarianceAt(const model::MechanicalModel& model,
+                                              const std::vector<TestRecord>& tests,
+                                              const UpdateOptions& options,
+                                              const std::vector<Eigen::VectorXd>& points);
 
 }  // namespace mbid::updating::internal

@@ -187,6 +187,7 @@ nlohmann::json UpdateResultToJson(const UpdateResult& result,
     if (!p.test.empty()) entry["test"] = p.test;
     if (!p.why_undetermined.empty()) entry["why_undetermined"] = p.why_undetermined;
     if (p.profile.computed) entry["profile"] = ProfileToJson(p.profile);
+    if (p.std_widening != 1) entry["std_widening"] = NumberOrNull(p.std_widening);
     parameters[p.name] = entry;
   }
   json["parameters"] = parameters;

@@ -133,6 +133,8 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
   }
   if (search.best.termination != updating::UpdateResult::Termination::kFailure) {
     updating::MarkUnseenParameters(model, records, search.best);
+    updating::WidenToTheIntervalEnds(model, placed.empty() ? records : placed, settings.options,
+                                     search.best);
   }
   if (settings.profile.enabled) {
     updating::ProfileLikelihood(model, placed.empty() ? records : placed, settings.options,

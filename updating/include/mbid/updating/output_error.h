@@ -165,6 +165,9 @@ struct ParameterEstimate {
   // alternatives, a Route-1 set): a judgment from outside this fit, which a refit of the same
   // minimum (a placed release, validation/release_profile.h) keeps.
   bool rival_differs = false;
+  // How much `std` was widened because the Fisher std at its interval's end is larger
+  // (WidenToTheIntervalEnds, credibility.h); 1 when not.
+  double std_widening = 1;
 };
 
 struct IterationRecord {
