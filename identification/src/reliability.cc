@@ -67,8 +67,9 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
   // (a drill mast's record), as does a pair of boom modes at 10 times the noise that a stronger
   // mode absorbed (2.2-2.4).
   const Eigen::MatrixXd decimated_residual = DecimatedResidual(record, estimate);
-  ResidualWindows windows = AnalyseResidualWindows(record.decimated, decimated_residual,
-                                                   options.significance_false_alarm);
+  ResidualWindows windows =
+      AnalyseResidualWindows(record.decimated, decimated_residual, options.significance_false_alarm,
+                             record.decimation == 1 ? 1 : 0);
   double tau = record.decimated_interval_s;
   double start_s = record.decimated_start_time_s;
   // The decimation filter's output starts half its length in (20 samples per factor): a mode

@@ -26,9 +26,13 @@ struct ResidualWindows {
 };
 
 // `values` is the record the residual is of: a window power under 1e-12 of its channel's mean
-// square is round-off (a noiseless record), never an excess.
+// square is round-off (a noiseless record), never an excess. With `start_band` > 0 (a full-rate
+// residual, not a decimation filter's output; band-limited by BandLimited to that fraction of
+// Nyquist, 1 when not) its start is judged in halves of a window too, down to 5 samples: a mode
+// gone within a few milliseconds.
 ResidualWindows AnalyseResidualWindows(const Eigen::MatrixXd& values,
-                                       const Eigen::MatrixXd& residual, double false_alarm);
+                                       const Eigen::MatrixXd& residual, double false_alarm,
+                                       double start_band = 0);
 
 // The excess of a full-rate `residual` (of `values`) in its first window, judged in the band up
 // to `top_hz` (out_of_band.h's BandLimited): what a decimated analysis, whose filter's output
