@@ -365,6 +365,28 @@ TEST(CredibilityTest, WhiteExcessOverTheNoiseOnlyInflates) {
   EXPECT_TRUE(result.parameters[0].determined);
 }
 
+TEST(CredibilityTest, AFewSamplesFarBeyondTheNoiseDetermineNothing) {
+  // A trial's hammer blow 10 % off: the misfit sits in the samples under the pulse (33 times the
+  // noise in one), the rest is white at the noise. Here: unit white noise with two samples at 30
+  // and -20: chi^2/dof 1 + 1300 / 4000 = 1.33 and white (Ljung-Box sees two spikes as noise), so
+  // it was taken for a noise level stated too low, and the parameter stayed determined.
+  // Gaussian noise passes 4.9 times its spread in one of 4000 samples with probability 1e-3.
+  Eigen::VectorXd residual = Ar1Noise(4000, 0.0, 1.0, 19);
+  residual[1] = 30;
+  residual[2] = -20;
+  const UpdateResult result = AssessResidual(residual);
+  EXPECT_FALSE(result.credible);
+  EXPECT_FALSE(result.explains_records);
+  EXPECT_FALSE(result.parameters[0].determined);
+  ASSERT_FALSE(result.credibility.empty());
+  EXPECT_NE(result.credibility[0].find("the residual of psi of t at 0.01 s is"), std::string::npos)
+      << result.credibility[0];
+  // The same excess spread over every sample (noise stated 15 % too low) is no spike: inflated.
+  const UpdateResult white = AssessResidual(Ar1Noise(4000, 0.0, 1.15, 19));
+  EXPECT_TRUE(white.explains_records);
+  EXPECT_TRUE(white.parameters[0].determined);
+}
+
 TEST(CredibilityTest, AResidualFarBelowTheWeightsSaysTheNoiseIsOverstated) {
   // White noise half the stated level (chi^2/dof 0.25, 5 sampling std below 1 is 0.89 at
   // 4000): the weights overstate the noise and the standard deviations are twice too large;
