@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -33,6 +34,46 @@ namespace {
 // The most samples a record is analysed again at its full rate for a start the decimation
 // filter hides (the full-rate analysis grows with the samples; longer records keep the flag).
 constexpr Eigen::Index kLongestFullRateReanalysis = 200000;
+
+// Later starts of the analysis, in fractions of the analysed duration, when no mode is found
+// from the first one.
+constexpr double kLaterStarts[] = {0.02, 0.05, 0.1, 0.2};
+
+// Set while Identify analyses from a later start: that analysis does not look further itself.
+thread_local bool later_start = false;
+
+// After "no modes found" from `start_s` (the analysed record's first time, `duration_s` long):
+// the analysis from later starts, the first that finds modes, with a warning; nullopt if none.
+// A strong non-oscillating part at the start (an overdamped joint's real poles: -138 and -3.4
+// 1/s beside a 4.59 Hz mode, a trial's machine) pulled every refined pole out of the band.
+std::optional<ModalResult> IdentifyFromLaterStart(const Measurement& measurement,
+                                                  const IdentificationOptions& options,
+                                                  const std::string& origin, double start_s,
+                                                  double duration_s, const std::string& reason) {
+  if (later_start || options.window_end_s < std::numeric_limits<double>::infinity()) {
+    return std::nullopt;
+  }
+  later_start = true;
+  std::optional<ModalResult> found;
+  for (const double fraction : kLaterStarts) {
+    IdentificationOptions later = options;
+    later.window_start_s = start_s + fraction * duration_s;
+    try {
+      found = Identify(measurement, later, origin);
+    } catch (const NumericalError&) {
+      continue;
+    }
+    found->warnings.insert(
+        found->warnings.begin(),
+        fmt::format("no modes found from {:.6g} s ({}): a strong part of the start that is no "
+                    "mode (an overdamped joint's decay, a sensor settling) can hide them; "
+                    "analysed from {:.6g} s",
+                    start_s, reason, later.window_start_s));
+    break;
+  }
+  later_start = false;
+  return found;
+}
 
 }  // namespace
 
@@ -67,6 +108,13 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
     estimate = FindMethod(options.method.name())->estimate(record, options);
     AddEstimate(record, options, &estimate, &result);
   } catch (const NumericalError& e) {
+    if (e.reason().rfind("no modes found", 0) == 0) {
+      const double duration_s =
+          static_cast<double>(record.values.rows() - 1) * record.sample_interval_s;
+      std::optional<ModalResult> later = IdentifyFromLaterStart(
+          measurement, options, origin, record.start_time_s, duration_s, e.reason());
+      if (later) return *later;
+    }
     // A clipped or glitched record is the likelier cause than the method: say so.
     std::string reason = e.reason();
     for (const std::string& fault : RecordFaults(record)) reason += "; " + fault;

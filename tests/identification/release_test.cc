@@ -479,5 +479,30 @@ TEST(ReleaseTest, AmplitudeDependentModeIsFlagged) {
   EXPECT_FALSE(result.reasons.empty());
 }
 
+// A trial's machine with an overdamped joint (real poles at -138 and -3.4 1/s beside a 4.59 Hz
+// mode at 3.7 %): the strong non-oscillating start pulled every refined pole out of the band,
+// and identify, update and run stopped with exit 3, "no modes found". The analysis now tries
+// later starts (2 % of the record first, here 0.1 s, when the -138 1/s part is gone) and finds
+// the mode within its standard deviations, saying from where. Here: the mode at amplitudes 1 and
+// 0.5, the real pole at 20 and -6, noise 0.01, 5 s at 200 Hz.
+TEST(ReleaseTest, ANonOscillatingStartThatHidesEveryModeIsLeftOut) {
+  testing::SignalSpec spec;
+  spec.channels = {"a", "b"};
+  spec.sample_interval_s = 0.005;
+  spec.samples = 1000;
+  spec.modes = {{4.5925, 1.0686, {1.0, 0.5}, {0.0, 0.0}}, {0.0, 138.0, {20.0, 6.0}, {0.0, M_PI}}};
+  IdentificationOptions options;
+  options.release = ReleaseMode::kNone;
+  const ModalResult result = Identify(
+      testing::MakeRecord(spec, testing::SynthesizeNoisy(spec, Eigen::Vector2d(0.01, 0.01), 1)),
+      options);
+  EXPECT_TRUE(result.reliable) << ::testing::PrintToString(result.reasons);
+  EXPECT_TRUE(testing::Mentions(result.warnings, "no modes found from 0 s"));
+  EXPECT_GT(result.start_time_s, 0.05);
+  ASSERT_EQ(result.modes.size(), 1u);
+  EXPECT_NEAR(result.modes[0].frequency_hz, 4.5925, 4 * result.modes[0].std_frequency_hz);
+  EXPECT_NEAR(result.modes[0].decay_rate_per_s, 1.0686, 4 * result.modes[0].std_decay_rate_per_s);
+}
+
 }  // namespace
 }  // namespace mbid::identification
