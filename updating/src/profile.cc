@@ -260,6 +260,11 @@ void ProfileLikelihood(const model::MechanicalModel& model, const std::vector<Te
   std::vector<Side> sides;
   for (size_t k = 0; k < best.parameters.size(); ++k) {
     if (!best.parameters[k].test.empty()) continue;
+    if (!profile.parameters.empty() &&
+        std::find(profile.parameters.begin(), profile.parameters.end(), best.parameters[k].name) ==
+            profile.parameters.end()) {
+      continue;
+    }
     for (double direction : {-1.0, 1.0}) {
       Side side;
       side.parameter = k;

@@ -26,6 +26,8 @@ struct ProfileOptions {
   // (about the same relative error of the interval's half-width).
   double tolerance = 0.05;
   int threads = 1;  // sides in parallel; each fit single-threaded, so the bits do not depend on it
+  // The shared parameters to profile; empty: every one.
+  std::vector<std::string> parameters;
 
   bool IsValid(std::string* why) const;
 };
