@@ -256,9 +256,21 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
   if (seconds_by_contract) unit = "s";
   // A logger's `time` in ms read as s makes every frequency 1000 times too low: a step of
   // 0.1 s or more (10 Hz or slower, where a ms clock of 10 kHz or slower lands) is said.
+  // A format whose time has no unit in the file (MAT, LVM without X_Unit_Label) is read in s.
+  const bool format_default = user_time_unit.empty() && table.time_unit_assumed;
   const auto say_if_slow = [&] {
     // (0.1 itself: a fitted step of 0.09999999999999999 s is 0.1 s.)
-    if (!seconds_by_contract || !(m->sample_interval_s * (1 + kTimeUniformityTolerance) >= 0.1)) {
+    if (!(seconds_by_contract || format_default) ||
+        !(m->sample_interval_s * (1 + kTimeUniformityTolerance) >= 0.1)) {
+      return;
+    }
+    if (format_default) {
+      report->warnings.push_back(fmt::format(
+          "the file's time ({}) states no unit and is read in s, as the {} format's readers "
+          "assume: a step of {:g} s ({:.3g} Hz); if it is in ms, give `time_unit: ms` in the "
+          "scenario's record entry (or --time-unit ms)",
+          table.time_where.empty() ? "the sample interval" : table.time_where, table.format,
+          m->sample_interval_s, 1 / m->sample_interval_s));
       return;
     }
     report->warnings.push_back(fmt::format(

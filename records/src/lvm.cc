@@ -383,6 +383,7 @@ class LvmReader {
     table.time_unit = "s";
     const std::string x_unit = KeyValue(first, "X_Unit_Label", 0);
     if (!x_unit.empty()) table.time_unit = x_unit;
+    table.time_unit_assumed = x_unit.empty();
     const std::string x_dimension = KeyValue(first, "X_Dimension", 0);
     if (!x_dimension.empty() && x_dimension != "Time") {
       throw InputError(path_, LineField(first.key_lines["X_Dimension"]),

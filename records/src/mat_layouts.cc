@@ -106,6 +106,7 @@ RawTable MatReader::ReadLabLayout() {
   RawTable table;
   table.format = "mat";
   table.time_unit = "s";
+  table.time_unit_assumed = true;  // a lab's file: MAT carries no units
   // (b) a struct with fields time and data.
   std::vector<std::string> structs;
   std::vector<std::string> matrices;

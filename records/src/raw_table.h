@@ -27,7 +27,10 @@ struct RawTable {
   // Time base: either a time column (`time`, in `time_unit`, NaN for a gap) or, when
   // `time` is empty, a uniform grid start + j * interval in `time_unit`.
   std::vector<double> time;
-  std::string time_unit;   // "" when the file states none
+  std::string time_unit;  // "" when the file states none
+  // `time_unit` is the format's default, not the file's word (a MAT file's time, an LVM file
+  // without X_Unit_Label): a logger's ms read as s goes unnoticed but for the step.
+  bool time_unit_assumed = false;
   std::string time_name;   // the time column's name in the file ("Zeit"), or ""
   std::string time_where;  // "column 1", ...
   double start = 0.0;

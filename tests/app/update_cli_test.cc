@@ -242,4 +242,27 @@ TEST_F(UpdateCliTest, ChannelsThatAreNotModelOutputsAreInvalidInput) {
   EXPECT_FALSE(fs::exists(dir_ / "u.h5"));
 }
 
+// A logger's time in ms read as s: a step of 10 "s" is a sample rate of 0.1 Hz, under every mode
+// of the crane (the lowest at 0.58 Hz). The fit would simulate the stretched record (a trial's
+// ran for more than 20 minutes); now it is exit 2 at once, naming the file, its time and the
+// likely cause, with nothing left behind.
+TEST_F(UpdateCliTest, ARecordSampledBelowEveryModeIsInvalidInput) {
+  const fs::path scenario = WriteScenario("reference-crane.yaml", "reference");
+  const fs::path data = dir_ / "ms.csv";
+  std::ofstream file(data);
+  file << "time,psi,phi\n";
+  for (int j = 0; j < 400; ++j) {
+    file << 10 * j << "," << 1e-3 * std::exp(-0.001 * j) * std::cos(0.04 * j) << ","
+         << 2e-3 * std::exp(-0.002 * j) * std::cos(0.09 * j) << "\n";
+  }
+  file.close();
+  const CommandResult result =
+      Run("update " + scenario.string() + " " + data.string() + " -o " + (dir_ / "u.h5").string());
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_NE(result.err.find("ms.csv:time: a sample rate of 0.1 Hz"), std::string::npos)
+      << result.err;
+  EXPECT_NE(result.err.find("below every mode of the model"), std::string::npos) << result.err;
+  EXPECT_FALSE(fs::exists(dir_ / "u.h5"));
+}
+
 }  // namespace

@@ -338,6 +338,36 @@ TEST(Lvm, AnIntervalPrintedToFewDigitsIsTheRoundRateItRoundsFrom) {
   EXPECT_EQ(ImportMeasurement(exact).sample_interval_s, 1.0 / 500);
 }
 
+// A logger's time in ms read as s makes every frequency 1000 times too low. An .lvm without
+// X_Unit_Label (and a MAT file, whose time has no unit) is read in s as the readers assume; a
+// step of 0.1 s or more is said, as for a CSV `time` column without a unit. With X_Unit_Label s
+// nothing is said.
+TEST(Lvm, ATimeWithoutUnitThatStepsSlowlyIsSaid) {
+  TempDir dir;
+  const auto lvm = [](const std::string& x_unit) {
+    std::string text =
+        "LabVIEW Measurement\t\nWriter_Version\t2\nSeparator\tTab\nDecimal_Separator\t.\n"
+        "X_Columns\tNo\n***End_of_Header***\t\n\nChannels\t1\t\nSamples\t8\t\n"
+        "Y_Unit_Label\tm/s^2\t\n" +
+        x_unit +
+        "X_Dimension\tTime\t\nX0\t0\t\nDelta_X\t5\t\n***End_of_Header***\t\nacc\tComment\n";
+    for (int j = 0; j < 8; ++j) text += std::to_string(0.1 * j) + "\n";
+    return text;
+  };
+  const std::string unlabelled = dir.File("ms.lvm");
+  WriteText(unlabelled, lvm(""));
+  ImportReport report;
+  EXPECT_EQ(ImportMeasurement(unlabelled, {}, &report).sample_interval_s, 5.0);
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("states no unit and is read in s"), std::string::npos)
+      << report.warnings[0];
+  const std::string labelled = dir.File("s.lvm");
+  WriteText(labelled, lvm("X_Unit_Label\ts\t\n"));
+  ImportReport stated;
+  ImportMeasurement(labelled, {}, &stated);
+  EXPECT_TRUE(stated.warnings.empty());
+}
+
 TEST(Lvm, SegmentThatDoesNotContinueIsAnError) {
   TempDir dir;
   const std::string path = dir.File("gap.lvm");

@@ -32,6 +32,7 @@ LoadedTest LoadTest(const std::string& path, const Scenario& scenario,
       records::ImportMeasurement(path, MergeImportOptions({}, overrides, &model), &test.import);
   // Checked before anything else is read from the file.
   RequireModelOutputs(test.record, path, model);
+  RequireSamplingOfAMode(test.record, path, model);
   // A simulated test carries its own scenario: its excitation is the one of this record (a load
   // drop and an initial deflection can then be fitted together).
   std::optional<simulation::Excitation> own =

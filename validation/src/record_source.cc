@@ -4,11 +4,14 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <set>
 
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
+#include "mbid/model/linear_model.h"
 #include "mbid/records/records.h"
 #include "mbid/simulation/scenario_sections.h"
 #include "mbid/validation/scenario.h"
@@ -128,6 +131,7 @@ LoadedRecord LoadRecord(const RecordSource& source, const model::MechanicalModel
   loaded.import = report;
   loaded.origin = source.file;
   RequireModelOutputs(loaded.measured, source.file, model);
+  RequireSamplingOfAMode(loaded.measured, source.file, model);
   loaded.excitation = source.excitation;
   loaded.excitation_origin = source.excitation_origin;
   if (!loaded.excitation && report.format == "hdf5") {
@@ -160,6 +164,24 @@ void RequireModelOutputs(const Measurement& record, const std::string& origin,
           fmt::format("{}, or coordinates ({})", OutputList(model), fmt::join(coordinates, ", ")));
     }
   }
+}
+
+void RequireSamplingOfAMode(const Measurement& record, const std::string& origin,
+                            const model::MechanicalModel& model) {
+  double lowest_hz = std::numeric_limits<double>::infinity();
+  for (const model::Mode& mode : model::CalcModes(model.Linearize())) {
+    if (mode.frequency_hz() > 0) lowest_hz = std::min(lowest_hz, mode.frequency_hz());
+  }
+  const double nyquist_hz = 0.5 / record.sample_interval_s;
+  if (!std::isfinite(lowest_hz) || lowest_hz <= nyquist_hz) return;
+  throw InputError(
+      origin, "time",
+      fmt::format("a sample rate of {:.4g} Hz (Nyquist {:.4g} Hz), below every mode "
+                  "of the model (the lowest at {:.4g} Hz): the record cannot show "
+                  "one; is its time in ms (`time_unit: ms` in the record entry, "
+                  "--time-unit ms)?",
+                  1 / record.sample_interval_s, nyquist_hz, lowest_hz),
+      fmt::format("a record sampled at {:.4g} Hz or more", std::ceil(2.1 * lowest_hz)));
 }
 
 }  // namespace mbid::validation

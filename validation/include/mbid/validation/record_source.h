@@ -50,6 +50,13 @@ struct LoadedRecord {
 // InputError naming "<path>:/scenario".
 std::optional<simulation::Excitation> ReadStoredExcitation(const std::string& path);
 
+// Throws InputError naming `origin` (key "time") when `record` is sampled below every oscillating
+// mode of `model` (its Nyquist frequency under the lowest): it cannot show one, and a time base
+// read 1000 times too long (a logger's ms read as s) is the likelier cause. A fit would simulate
+// the whole stretched record: 9500 s of a 2-5 Hz mast ran for more than 20 minutes.
+void RequireSamplingOfAMode(const Measurement& record, const std::string& origin,
+                            const model::MechanicalModel& model);
+
 // Throws InputError naming `origin` unless every channel of `record` is an output of `model`.
 void RequireModelOutputs(const Measurement& record, const std::string& origin,
                          const model::MechanicalModel& model);
