@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -73,6 +74,25 @@ std::optional<ModalResult> IdentifyFromLaterStart(const Measurement& measurement
   }
   later_start = false;
   return found;
+}
+
+// A sample interval known to +-u (relative) scales every frequency and decay rate by up to
+// 1 -+ u, the same for all: added to each std as a uniform error's u / sqrt(3). The damping ratio
+// does not depend on the time scale.
+void AddTimeBaseUncertainty(double u, ModalResult* result) {
+  if (!(u > 0)) return;
+  for (IdentifiedMode& mode : result->modes) {
+    mode.std_frequency_hz =
+        std::hypot(mode.std_frequency_hz, u * mode.frequency_hz / std::sqrt(3.0));
+    mode.std_decay_rate_per_s =
+        std::hypot(mode.std_decay_rate_per_s, u * mode.decay_rate_per_s / std::sqrt(3.0));
+  }
+  result->warnings.push_back(fmt::format(
+      "the record's sample interval is known to +-{:.2g} % only (its file prints it to few "
+      "digits): every frequency and decay rate may be off by as much, which their standard "
+      "deviations now include; the logger's exact rate (sample_rate_hz, --sample-rate-hz) "
+      "removes it",
+      100 * u));
 }
 
 }  // namespace
@@ -230,6 +250,7 @@ ModalResult Identify(const Measurement& measurement, const IdentificationOptions
                       what, wider.decimation, failure, record.decimation));
     }
   }
+  AddTimeBaseUncertainty(measurement.sample_interval_uncertainty, &result);
   MarkCombinationTones(record, options, &result);
   AssessReliability(record, options, estimate, &result);
   return result;

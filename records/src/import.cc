@@ -307,13 +307,27 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
                          "no sample rate, or the rate of the file's interval");
       }
       m->sample_interval_s = 1 / options.sample_rate_hz;
-    } else if (const std::optional<double> rate = RoundRate(m->sample_interval_s, resolution)) {
-      report->conversions.push_back(fmt::format(
-          "time: the sample interval {} {} is printed to {:.2g} % (the rate to {:.4g} Hz): read as "
-          "1/{} s, the round rate it rounds from (sample_rate_hz sets another)",
-          table.interval, unit, 50 * resolution / m->sample_interval_s,
-          0.5 * resolution / (m->sample_interval_s * m->sample_interval_s), *rate));
-      m->sample_interval_s = 1 / *rate;
+    } else {
+      // The print bounds the interval, not the rate the logger ran at (51200 / 30 = 1706.67 Hz
+      // prints as 0.000586, 51200 / 24 as 0.000469, which the roundest rate reads as 2130 Hz):
+      // every reading within those bounds is a guess, unless the print is exactly a whole rate's.
+      const double printed = m->sample_interval_s;
+      if (const std::optional<double> rate = RoundRate(printed, resolution)) {
+        report->conversions.push_back(fmt::format(
+            "time: the sample interval {} {} is printed to {:.2g} % (the rate to {:.4g} Hz): read "
+            "as 1/{} s, the round rate it rounds from (sample_rate_hz sets another)",
+            table.interval, unit, 50 * resolution / printed, 0.5 * resolution / (printed * printed),
+            *rate));
+        m->sample_interval_s = 1 / *rate;
+      }
+      // The reading's farthest distance to the printed bounds (the round rate may sit near one).
+      const double printed_rate = 1 / printed;
+      if (resolution > 0 &&
+          !(std::abs(printed_rate - std::round(printed_rate)) < 1e-9 * printed_rate)) {
+        const double tau = m->sample_interval_s;
+        m->sample_interval_uncertainty =
+            std::max(tau - (printed - 0.5 * resolution), printed + 0.5 * resolution - tau) / tau;
+      }
     }
     say_if_slow();
     return;

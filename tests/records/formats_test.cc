@@ -320,6 +320,9 @@ TEST(Lvm, AnIntervalPrintedToFewDigitsIsTheRoundRateItRoundsFrom) {
   ImportReport report;
   const Measurement m = ImportMeasurement(path, {}, &report);
   EXPECT_EQ(m.sample_interval_s, 1.0 / 3000);
+  // Still a guess within the print's bounds [3.325e-4, 3.335e-4] s: 1/3000 s is 8.3e-7 s from the
+  // lower one, 0.25 %, which every frequency read from the record carries.
+  EXPECT_NEAR(m.sample_interval_uncertainty, (1.0 / 3000 - 3.325e-4) * 3000, 1e-9);
   ASSERT_FALSE(report.conversions.empty());
   EXPECT_NE(report.conversions.back().find("read as 1/3000 s"), std::string::npos)
       << report.conversions.back();
@@ -336,6 +339,11 @@ TEST(Lvm, AnIntervalPrintedToFewDigitsIsTheRoundRateItRoundsFrom) {
   slow.replace(slow.find("0.000333"), 8, "0.002000");
   WriteText(exact, slow);
   EXPECT_EQ(ImportMeasurement(exact).sample_interval_s, 1.0 / 500);
+  // The print is exactly a whole rate's: taken as exact.
+  EXPECT_EQ(ImportMeasurement(exact).sample_interval_uncertainty, 0.0);
+  // A rate the user states is exact.
+  stated.sample_rate_hz = 3000;
+  EXPECT_EQ(ImportMeasurement(path, stated).sample_interval_uncertainty, 0.0);
 }
 
 // A logger's time in ms read as s makes every frequency 1000 times too low. An .lvm without

@@ -251,5 +251,24 @@ TEST(ProfileTest, AnUnfittedSensorOffsetIsNamedInTheMisfit) {
   }
 }
 
+// A record whose sample interval is known to +-u only (printed to few digits) scales every
+// frequency by up to u: a stiffness (omega^2 J) by 2 u, a damping (2 decay J) by u. Each is added
+// to the Fisher relative std as a uniform error's u / sqrt(3) (1e-3 here against Fisher's ~1e-4
+// for c at 1e-4 rad noise).
+TEST(ProfileTest, ATimeBaseKnownToAFewDigitsWidensStiffnessTwiceAsMuchAsDamping) {
+  Release release(1e-4);
+  const UpdateOptions options = release.Options();
+  const UpdateResult exact = UpdateModel(*release.truth, {release.test}, options);
+  release.test.record.sample_interval_uncertainty = 1e-3;
+  const UpdateResult printed = UpdateModel(*release.truth, {release.test}, options);
+  for (size_t k = 0; k < exact.parameters.size(); ++k) {
+    const ParameterEstimate& a = exact.parameters[k];
+    const ParameterEstimate& b = printed.parameters[k];
+    const double scale = a.name == "c_angle" ? 2e-3 : 1e-3;
+    EXPECT_NEAR(b.relative_std, std::hypot(a.relative_std, scale / std::sqrt(3.0)), 1e-9) << a.name;
+    EXPECT_NEAR(b.std, b.relative_std * b.value, 1e-9 * b.std) << a.name;
+  }
+}
+
 }  // namespace
 }  // namespace mbid::updating

@@ -253,6 +253,13 @@ Eigen::MatrixXd CalcCorrelation(const Eigen::MatrixXd& covariance) {
   return correlation;
 }
 
+// The largest relative uncertainty of the tests' sample intervals (Measurement's).
+double TimeBaseUncertainty(const std::vector<TestRecord>& tests) {
+  double u = 0;
+  for (const TestRecord& test : tests) u = std::max(u, test.record.sample_interval_uncertainty);
+  return u;
+}
+
 // Each unknown's estimate with its std, whether it is determined and at a bound; warnings for
 // the undetermined ones and for strongly correlated pairs.
 void AddEstimates(const FitProblem& fit, const std::vector<TestRecord>& tests,
@@ -277,6 +284,18 @@ void AddEstimates(const FitProblem& fit, const std::vector<TestRecord>& tests,
       estimate.relative_std = unknown.log_scale
                                   ? std_internal
                                   : std_internal / std::max(std::abs(estimate.value), 1e-6);
+    }
+    // A record's time base known to +-u (a sample interval printed to few digits) scales the
+    // frequencies by up to u: a stiffness (omega^2) by 2 u, a damping (decay) by u, as a uniform
+    // error's std u / sqrt(3).
+    const double time_scale =
+        unknown.kind == Unknown::Kind::kModel && unknown.name.size() > 2 &&
+                (unknown.name[0] == 'c' || unknown.name[0] == 'd') && unknown.name[1] == '_'
+            ? (unknown.name[0] == 'c' ? 2.0 : 1.0) * TimeBaseUncertainty(tests)
+            : 0.0;
+    if (time_scale > 0 && std::isfinite(estimate.relative_std)) {
+      estimate.relative_std = std::hypot(estimate.relative_std, time_scale / std::sqrt(3.0));
+      estimate.std = estimate.relative_std * std::abs(estimate.value);
     }
     estimate.determined = estimate.relative_std <= options.undetermined_relative_std;
     const double x_lower = unknown.ToInternal(unknown.lower);

@@ -16,6 +16,10 @@ struct Measurement {
   double sample_interval_s = 0.0;  // tau
   Eigen::MatrixXd values;          // samples x channels
   std::string source = "import";   // "simulation" | "import" | ...
+  // Relative half-width within which `sample_interval_s` is known, where a file prints it to few
+  // digits (an LVM's Delta_X 0.000586 for 1706.67 Hz: 8.5e-4); 0 when exact. Every frequency and
+  // decay rate read from the record carries it.
+  double sample_interval_uncertainty = 0.0;
 
   int samples() const { return static_cast<int>(values.rows()); }
   // Made by mbid itself (`mbid simulate` or synthetic modes): it starts at the excitation and has
