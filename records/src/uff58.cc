@@ -31,6 +31,7 @@ constexpr int kComplexDouble = 6;
 // Record 6, field 1: a time response; record 8, field 1: time (0: unknown, also accepted).
 constexpr int kTimeResponse = 1;
 constexpr int kSpecTime = 17;
+constexpr int kSpecAcceleration = 12;
 
 // Fixed-width field [begin, begin + width) of a record line, trimmed ("" past its end).
 std::string_view Column(std::string_view line, size_t begin, size_t width) {
@@ -249,6 +250,14 @@ void Uff58Reader::ReadDataset58(const std::vector<std::string_view>& id, int id_
   if (d.time_unit.empty()) d.time_unit = "s";  // every UFF unit system measures time in s
   const std::string_view r9 = NextRecord(d, 9);
   d.unit = Label(Column(r9, 46, 21));
+  // An acceleration (specific data type 12) in "g" is standard gravity in UFF's usage (test
+  // systems write it so), not the gram the unit library reads.
+  long long ordinate_data = 0;
+  if ((d.unit == "g" || d.unit == "G") &&
+      ParseInteger(Column(r9, 0, 10), -1000000, 1000000, &ordinate_data) &&
+      ordinate_data == kSpecAcceleration) {
+    d.unit = "gn";
+  }
   NextRecord(d, 10);
   NextRecord(d, 11);
 

@@ -183,6 +183,20 @@ std::string Dataset58(int function_type, int ordinate_type, int count, double in
 
 const std::vector<double> kSix = {1, 2, 3, 4, 5, 6};  // one full 6E13.5 line
 
+// Test systems label an acceleration (record 9's data type 12) in standard gravity "g"; the unit
+// library reads "g" as gram, and such files were refused. Read as gn (9.80665 m/s^2).
+TEST(Uff58, AnAccelerationInGIsStandardGravity) {
+  TempDir dir;
+  const std::string path = dir.File("g.uff");
+  std::string text = Dataset58(1, 2, 6, 0.01, kSix);
+  text.replace(text.find("m/s^2               \n"), 21, "g                   \n");
+  WriteText(path, text);
+  const Measurement m = ImportMeasurement(path);
+  ASSERT_EQ(m.units.size(), 1u);
+  EXPECT_EQ(m.units[0], "m/s^2");
+  EXPECT_NEAR(m.values(2, 0), 3 * 9.80665, 1e-9);
+}
+
 TEST(Uff58, TruncatedDatasetNamesIt) {
   TempDir dir;
   const std::string path = dir.File("cut.uff");
