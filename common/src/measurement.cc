@@ -165,7 +165,14 @@ double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin
             ? fmt::format("time {} s of sample {} repeats sample {}", time_s[j], j, j - 1)
             : fmt::format("time decreases from {} s (sample {}) to {} s (sample {})", time_s[j - 1],
                           j - 1, time_s[j], j);
-    throw InputError(origin, field_of_sample(j), problem, "strictly increasing time");
+    // A repeat in a column that rises overall is a time printed coarser than its step (200 Hz
+    // printed to 0.01 s): the logger's rate reads it.
+    const bool coarse = time_s[j] == time_s[j - 1] && time_s[n - 1] > time_s[0];
+    throw InputError(origin, field_of_sample(j), problem,
+                     coarse ? "strictly increasing time, or, for a time printed coarser than its "
+                              "step, the logger's sample rate (sample_rate_hz in the record "
+                              "entry, --sample-rate-hz)"
+                            : "strictly increasing time");
   }
   const double t0 = time_s[0];
   const double tau = (time_s[n - 1] - t0) / static_cast<double>(n - 1);

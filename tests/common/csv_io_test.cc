@@ -130,6 +130,9 @@ TEST(CsvBadInputTest, RepeatedTimeNamesTheLine) {
   const InputError e = c.Read();
   EXPECT_EQ(e.field(), "line 4");  // comment, header, first row, then the repeat
   EXPECT_THAT(e.problem(), HasSubstr("repeats"));
+  // A column that rises overall (200 Hz printed to 0.01 s) is a coarse print: the rate reads it.
+  const CsvCase coarse("time,psi\n0,1\n0.01,2\n0.01,3\n0.02,4\n");
+  EXPECT_THAT(coarse.Read().expected(), HasSubstr("--sample-rate-hz"));
 }
 
 TEST(CsvBadInputTest, NaNNamesLineAndColumn) {
