@@ -306,6 +306,26 @@ TEST(FacadeTest, AnOpenProfileMakesTheVerdictInconclusive) {
   EXPECT_TRUE(result.updated.parameters.at("c_alpha").determined);
 }
 
+// `passed` needs a credible fit. Weights that state the noise 30 % low (7e-6 rad against the
+// record's 1e-5) leave a white excess, chi^2/dof about 2, taken for a noise level stated too low:
+// the standard deviations are inflated by about 1.4 and every joint stays determined, but the fit
+// is not credible, and a trial's hammer blow 10 % off had passed the same way. Inconclusive, with
+// the credibility's reason.
+TEST(FacadeTest, AFitThatIsNotCredibleDoesNotPass) {
+  const mbid::ValidationResult result = mbid::RunValidationCycle(mbid::LoadScenarioFromText(
+      ReferenceText(4, "updating: {noise_std_rad: 7.0e-6, global_search: {enabled: false}}\n"),
+      "understated.yaml"));
+  EXPECT_FALSE(result.updated.credible);
+  EXPECT_TRUE(result.updated.undetermined.empty())
+      << ::testing::PrintToString(result.updated.undetermined);
+  EXPECT_EQ(result.verdict, mbid::Verdict::kInconclusive);
+  bool named = false;
+  for (const std::string& reason : result.reasons) {
+    named = named || reason.find("the fit is not credible") != std::string::npos;
+  }
+  EXPECT_TRUE(named) << ::testing::PrintToString(result.reasons);
+}
+
 // A channel whose noise alone keeps K below the threshold fails the verdict (the contract's
 // rule), and the reason says so; a model that cannot fit fails without that remark.
 TEST(FacadeTest, TooLittleSignalIsInconclusiveNotAFailure) {
