@@ -194,13 +194,13 @@ UnitConversion FindConversion(const std::string& from, const std::string& to,
   const UnitPtr b = Parse(to);
   if (!b) throw std::logic_error("mbid: target unit '" + to + "' unknown to udunits2");
   if (Dimension(a.get()) != Dimension(b.get()) || ut_are_convertible(a.get(), b.get()) == 0) {
-    // udunits' g is the gram: say how an accelerometer's g is written.
-    const bool gram = ApplyAliases(from) == "g" && Dimension(b.get()) == "m.s-2";
+    // udunits' g is the gram (and mg the milligram): say how an accelerometer's g is written.
+    const bool gram = Dimension(a.get()) == "kg" && Dimension(b.get()) == "m.s-2";
     throw InputError(
         source, field,
         fmt::format("unit '{}' ({}) cannot be converted to {}", from, Dimension(a.get()), to),
-        gram ? std::string("a unit of acceleration; standard gravity is written gn "
-                           "('g' is the gram)")
+        gram ? std::string("a unit of acceleration; standard gravity is written gn ('g' is the "
+                           "gram), milli-g '0.001 gn'")
              : fmt::format("a unit convertible to {} ({})", to, Dimension(b.get())));
   }
   cv_converter* converter = ut_get_converter(a.get(), b.get());

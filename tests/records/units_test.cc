@@ -78,6 +78,10 @@ TEST(UnitsTest, RefusesUnknownAndIncompatibleUnits) {
   // udunits' g is the gram: the message says how standard gravity is written.
   const InputError gram = CatchInputError([] { FindConversion("g", "m/s^2", "f", "c"); });
   EXPECT_THAT(gram.expected(), HasSubstr("gn"));
+  // And mg the milligram: a trial's milli-g accelerometer found no spelling that worked.
+  const InputError milli = CatchInputError([] { FindConversion("mg", "m/s^2", "f", "c"); });
+  EXPECT_THAT(milli.expected(), HasSubstr("'0.001 gn'"));
+  EXPECT_NEAR(FindConversion("0.001 gn", "m/s^2", "f", "c").scale, 9.80665e-3, 1e-15);
 }
 
 TEST(UnitsTest, ConcurrentUseIsSafe) {
