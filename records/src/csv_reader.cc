@@ -223,6 +223,7 @@ RawTable ReadCsv(const std::string& path) {
   // Names and units from the header and the units row.
   std::vector<NameAndUnit> columns;
   std::set<std::string> seen;
+  std::vector<std::string> repeated_at(header_cells.size());
   for (size_t c = 0; c < header_cells.size(); ++c) {
     NameAndUnit column = SplitNameUnit(header_cells[c]);
     const std::string row_unit = StripUnitBrackets(unit_cells[c]);
@@ -237,8 +238,7 @@ RawTable ReadCsv(const std::string& path) {
       column.unit = row_unit;
     }
     if (!column.name.empty() && !seen.insert(column.name).second) {
-      throw InputError(path, cell_field(header_line, c),
-                       "column name '" + column.name + "' appears twice", "unique column names");
+      repeated_at[c] = cell_field(header_line, c);
     }
     columns.push_back(column);
   }
@@ -463,6 +463,7 @@ RawTable ReadCsv(const std::string& path) {
     table.columns[c].name = columns[c].name;
     table.columns[c].unit = columns[c].unit;
     table.columns[c].where = fmt::format("column {}", file_column[c] + 1);
+    table.columns[c].name_repeated_at = repeated_at[file_column[c]];
     const FirstText& marks = text_in[file_column[c]];
     if (!marks.cell.empty()) {
       table.columns[c].text = fmt::format("'{}' at line {}", marks.cell, marks.line);

@@ -93,6 +93,12 @@ std::vector<Selected> SelectColumns(const RawTable& table, const std::string& pa
         throw InputError(path, column.where, "the column has no name",
                          "a name in the header, or a mapping `channels: {NAME: COLUMN}`");
       }
+      if (!column.name_repeated_at.empty()) {
+        throw InputError(path, column.name_repeated_at,
+                         "column name '" + column.name + "' appears twice",
+                         "unique column names, or channels mapped to column numbers "
+                         "(`channels: {NAME: 2}`, --channel NAME=2)");
+      }
       selected.push_back({column.name, &column, column.unit});
     }
     return selected;
@@ -100,7 +106,13 @@ std::vector<Selected> SelectColumns(const RawTable& table, const std::string& pa
   for (const auto& [channel, spec] : options.channel_columns) {
     const RawColumn* found = nullptr;
     for (const RawColumn& column : table.columns) {
-      if (column.name == spec) found = &column;
+      if (column.name != spec) continue;
+      if (found != nullptr) {
+        throw InputError(path, "channels." + channel,
+                         fmt::format("column name '{}' appears twice in the file", spec),
+                         ColumnList(table));
+      }
+      found = &column;
     }
     if (found == nullptr && IsNumber(spec)) {
       const size_t number = std::stoul(spec);
@@ -282,7 +294,7 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
   };
   const std::string field = table.time_name.empty()
                                 ? table.time_where
-                                : Describe({table.time_name, "", table.time_where, {}, {}});
+                                : Describe({table.time_name, "", table.time_where, {}, {}, {}});
   if (unit.empty()) {
     throw InputError(path, field, fmt::format("the time column '{}' has no unit", table.time_name),
                      fmt::format("a unit: a header '{0} [ms]' or '{0}_ms', a units row, or "

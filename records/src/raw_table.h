@@ -18,6 +18,9 @@ struct RawColumn {
   // A column of text, no number in it (a logger's status or event marks): "" for a column of
   // numbers, else its first text cell and where it is ("'OK' at line 2"). Not a channel.
   std::string text;
+  // Where the name repeats an earlier column's ("line 1, column 3"); "" when it is unique. Such a
+  // column is read by its number only: by name it is ambiguous.
+  std::string name_repeated_at;
 };
 
 struct RawTable {

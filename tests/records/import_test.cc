@@ -15,6 +15,7 @@
 namespace mbid::records {
 namespace {
 
+using mbid::testing::CatchInputError;
 using mbid::testing::Decay;
 using mbid::testing::MakeExport;
 using mbid::testing::Print;
@@ -77,6 +78,27 @@ TEST(ImportTest, DecimalCommaFlaggedWhenUsed) {
   EXPECT_THAT(report.dialect, HasSubstr("decimal comma"));
   EXPECT_DOUBLE_EQ(m.values(1, 0), 2.5e-3);  // 2,5 mm
   EXPECT_EQ(m.sample_interval_s, 0.5);
+}
+
+// Two inclinometers both headed "Incl" (a logger's default names): by name they are ambiguous,
+// by number each is its own. The file was refused whatever the mapping.
+TEST(ImportTest, TwoColumnsOfOneNameAreReadByNumber) {
+  TempDir dir;
+  const std::string path = dir.File("twins.csv");
+  WriteText(path, "t [s],Incl [rad],Incl [rad],Acc [m/s^2]\n0,1,2,3\n0.5,4,5,6\n1,7,8,9\n");
+  ImportOptions numbered;
+  numbered.channel_columns = {{"arm", "1"}, {"tower", "2"}, {"tip", "Acc"}};
+  const Measurement m = ImportMeasurement(path, numbered);
+  EXPECT_EQ(m.values(1, m.FindChannel("arm")), 4);
+  EXPECT_EQ(m.values(1, m.FindChannel("tower")), 5);
+  const InputError unmapped = CatchInputError([&] { ImportMeasurement(path); });
+  EXPECT_EQ(unmapped.field(), "line 1, column 3");
+  EXPECT_THAT(unmapped.expected(), HasSubstr("column numbers"));
+  ImportOptions by_name = numbered;
+  by_name.channel_columns = {{"arm", "Incl"}, {"tip", "Acc"}};
+  const InputError ambiguous = CatchInputError([&] { ImportMeasurement(path, by_name); });
+  EXPECT_EQ(ambiguous.field(), "channels.arm");
+  EXPECT_THAT(ambiguous.problem(), HasSubstr("appears twice"));
 }
 
 TEST(ImportTest, TabsBomCrlfAndBracketedUnitsWithStandardGravity) {
