@@ -79,11 +79,9 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
       // Against the residual's own spread (1.4826 median absolute values): a noise level stated
       // too low is the white excess below, not a spike.
       if (r.size() > 0) {
-        std::vector<double> magnitude(static_cast<size_t>(r.size()));
-        for (Eigen::Index j = 0; j < r.size(); ++j)
-          magnitude[static_cast<size_t>(j)] = std::abs(r[j]);
-        const auto middle = magnitude.begin() + static_cast<std::ptrdiff_t>(magnitude.size() / 2);
-        std::nth_element(magnitude.begin(), middle, magnitude.end());
+        Eigen::VectorXd magnitude = r.cwiseAbs();
+        double* const middle = magnitude.data() + magnitude.size() / 2;
+        std::nth_element(magnitude.data(), middle, magnitude.data() + magnitude.size());
         const double spread = 1.4826 * *middle;
         Eigen::Index largest = 0;
         const double peak = r.cwiseAbs().maxCoeff(&largest);

@@ -29,6 +29,14 @@ struct Unknown {
   double ToValue(double x) const { return log_scale ? std::exp(x) : x; }
 };
 
+// An estimate's value in Ceres' coordinate (log p on the log scale) and back.
+inline double ToInternal(const ParameterEstimate& p, double value) {
+  return p.log_scale ? std::log(value) : value;
+}
+inline double ToValue(const ParameterEstimate& p, double x) {
+  return p.log_scale ? std::exp(x) : x;
+}
+
 // The unknowns of `options.parameters` (all of the model's if empty) and the tests' nuisance
 // parameters (payload mass of a load drop, initial deflections), starts and bounds checked.
 std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,

@@ -25,8 +25,8 @@ constexpr double kWidening = 1.1;
 // where the estimate is 2 of that end's own standard deviations away.
 constexpr int kRounds = 2;
 
+// The larger ratio of the std at an end to the estimate's, and which end.
 struct Checked {
-  int index = 0;
   double ratio = 1;
   const char* end = "";
 };
@@ -49,10 +49,9 @@ std::vector<std::string> WidenToTheIntervalEnds(const model::MechanicalModel& mo
   Eigen::VectorXd x(count), lower(count), upper(count);
   for (int k = 0; k < count; ++k) {
     const ParameterEstimate& p = result.parameters[static_cast<size_t>(k)];
-    const auto internal = [&p](double v) { return p.log_scale ? std::log(v) : v; };
-    x[k] = internal(p.value);
-    lower[k] = internal(p.lower);
-    upper[k] = internal(p.upper);
+    x[k] = internal::ToInternal(p, p.value);
+    lower[k] = internal::ToInternal(p, p.lower);
+    upper[k] = internal::ToInternal(p, p.upper);
   }
   const double inflation = std::max(1.0, result.std_inflation);
   std::vector<int> active;
@@ -62,7 +61,6 @@ std::vector<std::string> WidenToTheIntervalEnds(const model::MechanicalModel& mo
       active.push_back(k);
     }
   }
-  std::vector<double> total(static_cast<size_t>(count), 1.0);
   std::vector<bool> flat(static_cast<size_t>(count), false);
   for (int round = 0; round < kRounds && !active.empty(); ++round) {
     // Each end of the linearized profile: the parameter 2 inflated stds out, the others moved
@@ -83,11 +81,11 @@ std::vector<std::string> WidenToTheIntervalEnds(const model::MechanicalModel& mo
       const int k = active[a];
       ParameterEstimate& p = result.parameters[static_cast<size_t>(k)];
       const double here = std::sqrt(result.covariance(k, k));
-      Checked worst{k, 1.0, ""};
+      Checked worst;
       for (int side = 0; side < 2; ++side) {
         const double there = at[2 * a + static_cast<size_t>(side)](k, k);
         const double ratio = there >= 0 && std::isfinite(there) ? std::sqrt(there) / here : kNaN;
-        if (!(ratio <= worst.ratio)) worst = {k, ratio, side == 0 ? "upper" : "lower"};
+        if (!(ratio <= worst.ratio)) worst = {ratio, side == 0 ? "upper" : "lower"};
       }
       if (!std::isfinite(worst.ratio)) {
         flat[static_cast<size_t>(k)] = true;
@@ -97,7 +95,7 @@ std::vector<std::string> WidenToTheIntervalEnds(const model::MechanicalModel& mo
             "the quadratic its standard deviation assumes",
             worst.end);
       } else if (worst.ratio > kWidening) {
-        total[static_cast<size_t>(k)] *= worst.ratio;
+        p.std_widening *= worst.ratio;
         p.std *= worst.ratio;
         p.relative_std *= worst.ratio;
         result.covariance.row(k) *= worst.ratio;
@@ -113,15 +111,13 @@ std::vector<std::string> WidenToTheIntervalEnds(const model::MechanicalModel& mo
   }
   for (int k = 0; k < count; ++k) {
     ParameterEstimate& p = result.parameters[static_cast<size_t>(k)];
-    const double ratio = total[static_cast<size_t>(k)];
-    if (ratio == 1.0 && !flat[static_cast<size_t>(k)]) continue;
-    p.std_widening = ratio;
+    if (p.std_widening == 1.0 && !flat[static_cast<size_t>(k)]) continue;
     widened.push_back(p.name);
     result.warnings.push_back(fmt::format(
         "{}: the records' information on it changes across its interval (little signal for "
         "it): its standard deviation at the interval's end is {:.3g} times the one at the "
         "estimate, and the larger is reported{}",
-        p.name, ratio, p.determined ? "" : "; " + p.why_undetermined));
+        p.name, p.std_widening, p.determined ? "" : "; " + p.why_undetermined));
     if (!p.determined && std::find(result.undetermined.begin(), result.undetermined.end(),
                                    p.name) == result.undetermined.end()) {
       result.undetermined.push_back(p.name);

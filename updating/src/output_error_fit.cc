@@ -260,12 +260,21 @@ double TimeBaseUncertainty(const std::vector<TestRecord>& tests) {
   return u;
 }
 
+// How a model parameter scales with the record's time base: a stiffness c_ as omega^2 (2), a
+// damping d_ as the decay rate (1); 0 for any other unknown.
+double TimeScaleExponent(const Unknown& unknown) {
+  const std::string& name = unknown.name;
+  if (unknown.kind != Unknown::Kind::kModel || name.size() <= 2 || name[1] != '_') return 0;
+  return name[0] == 'c' ? 2.0 : name[0] == 'd' ? 1.0 : 0.0;
+}
+
 // Each unknown's estimate with its std, whether it is determined and at a bound; warnings for
 // the undetermined ones and for strongly correlated pairs.
 void AddEstimates(const FitProblem& fit, const std::vector<TestRecord>& tests,
                   const UpdateOptions& options, UpdateResult* result) {
   const int count = fit.count;
   const Eigen::VectorXd& x = fit.x;
+  const double time_base = TimeBaseUncertainty(tests);
   for (int k = 0; k < count; ++k) {
     const Unknown& unknown = fit.unknowns[static_cast<size_t>(k)];
     ParameterEstimate estimate;
@@ -288,11 +297,7 @@ void AddEstimates(const FitProblem& fit, const std::vector<TestRecord>& tests,
     // A record's time base known to +-u (a sample interval printed to few digits) scales the
     // frequencies by up to u: a stiffness (omega^2) by 2 u, a damping (decay) by u, as a uniform
     // error's std u / sqrt(3).
-    const double time_scale =
-        unknown.kind == Unknown::Kind::kModel && unknown.name.size() > 2 &&
-                (unknown.name[0] == 'c' || unknown.name[0] == 'd') && unknown.name[1] == '_'
-            ? (unknown.name[0] == 'c' ? 2.0 : 1.0) * TimeBaseUncertainty(tests)
-            : 0.0;
+    const double time_scale = TimeScaleExponent(unknown) * time_base;
     if (time_scale > 0 && std::isfinite(estimate.relative_std)) {
       estimate.relative_std = std::hypot(estimate.relative_std, time_scale / std::sqrt(3.0));
       estimate.std = estimate.relative_std * std::abs(estimate.value);

@@ -20,6 +20,8 @@ namespace {
 
 using internal::FormatValue;
 using internal::StartNuisanceAt;
+using internal::ToInternal;
+using internal::ToValue;
 
 // One side's search, in Ceres' coordinate x (log p on the log scale) as the distance s >= 0
 // from the estimate.
@@ -36,11 +38,6 @@ struct Side {
   int fits = 0;
   std::string failure;
 };
-
-double ToInternal(const ParameterEstimate& p, double value) {
-  return p.log_scale ? std::log(value) : value;
-}
-double ToValue(const ParameterEstimate& p, double x) { return p.log_scale ? std::exp(x) : x; }
 
 class Profiler {
  public:
