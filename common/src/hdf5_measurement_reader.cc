@@ -74,22 +74,29 @@ std::vector<std::string> ReadChannelNames(const H5Reader& file, const std::strin
   return channels;
 }
 
-// The group's `time` dataset: in s, at least 2 samples.
-Eigen::VectorXd ReadTime(const H5Reader& file, const std::string& group) {
+// The group's `time` dataset in s, at least 2 samples: stated in s, or in the unit
+// `seconds_per_unit` converts (it names the unit it read the times in).
+Eigen::VectorXd ReadTime(const H5Reader& file, const std::string& group,
+                         const SecondsPerTimeUnit& seconds_per_unit, std::string* unit) {
   const std::string& path = file.path();
   const std::string time_path = group + "/time";
   if (!file.Exists(time_path)) {
     throw InputError(path, time_path, "missing dataset", "the sample times in seconds");
   }
   const Eigen::VectorXd time = file.ReadVector(group, "time");
-  RequireAttribute(file, time_path, "units", "units = 's'");
-  const std::string time_units = file.ReadUnits(group, "time");
-  if (time_units != "s") {
-    throw InputError(path, AttributeField(time_path, "units"), "is '" + time_units + "'", "'s'");
-  }
   const Eigen::Index n = time.size();
   if (n < 2) {
     throw InputError(path, time_path, fmt::format("has {} samples", n), "at least 2 samples");
+  }
+  if (seconds_per_unit) {
+    const std::string stated =
+        file.HasAttribute(time_path, "units") ? file.ReadUnits(group, "time") : "";
+    return seconds_per_unit(stated, AttributeField(time_path, "units"), unit) * time;
+  }
+  RequireAttribute(file, time_path, "units", "units = 's'");
+  *unit = file.ReadUnits(group, "time");
+  if (*unit != "s") {
+    throw InputError(path, AttributeField(time_path, "units"), "is '" + *unit + "'", "'s'");
   }
   return time;
 }
@@ -127,7 +134,7 @@ Eigen::VectorXd ReadChannel(const H5Reader& file, const std::string& group,
 
 }  // namespace
 
-Measurement H5Reader::ReadMeasurement() const {
+Measurement H5Reader::ReadMeasurement(const SecondsPerTimeUnit& seconds_per_unit) const {
   const std::string& path = impl_->path;
   CheckFormat(*this);
   const std::string group = "/measurement";
@@ -141,7 +148,8 @@ Measurement H5Reader::ReadMeasurement() const {
   const double interval = ReadDoubleAttribute(group, "sample_interval_s");
   if (HasAttribute(group, "source")) m.source = ReadStringAttribute(group, "source");
 
-  const Eigen::VectorXd time = ReadTime(*this, group);
+  std::string time_unit;
+  const Eigen::VectorXd time = ReadTime(*this, group, seconds_per_unit, &time_unit);
   const Eigen::Index n = time.size();
   m.values.resize(n, static_cast<Eigen::Index>(m.channels.size()));
   for (size_t c = 0; c < m.channels.size(); ++c) {
@@ -167,7 +175,8 @@ Measurement H5Reader::ReadMeasurement() const {
       std::abs(interval - tau) < std::max(kTimeUniformityTolerance * tau, 4 * fit_std);
   if (!std::isfinite(interval) || !(exact || std::abs(interval - tau) <= 2 * resolution)) {
     throw InputError(path, AttributeField(group, "sample_interval_s"),
-                     fmt::format("is {} s but {} has a step of {} s", interval, time_path, tau),
+                     fmt::format("is {} s but {} has a step of {} s{}", interval, time_path, tau,
+                                 time_unit == "s" ? "" : " (its times read in " + time_unit + ")"),
                      "the step of the time dataset");
   }
   m.start_time_s = std::abs(time[0] - fitted_start) <= resolution ? time[0] : fitted_start;
@@ -186,8 +195,10 @@ std::string H5Reader::ReadScenarioYaml() const {
 // The child makes exactly the calls this process makes next, from the same library state (the
 // fork's copy): a survey of the file can miss a path, and libhdf5 looped in-process on a
 // variable-length string the survey had read without harm.
-Measurement ReadMeasurementH5(const std::string& path) {
-  const auto read = [&] { return H5Reader(path, H5Reader::Probe::kNone).ReadMeasurement(); };
+Measurement ReadMeasurementH5(const std::string& path, const SecondsPerTimeUnit& seconds_per_unit) {
+  const auto read = [&] {
+    return H5Reader(path, H5Reader::Probe::kNone).ReadMeasurement(seconds_per_unit);
+  };
   internal::SurviveInChild(path, kExpectedH5, "the HDF5 library", read);
   return read();
 }

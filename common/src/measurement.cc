@@ -182,54 +182,56 @@ double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin
         std::max(max_deviation, std::abs(time_s[j] - (t0 + static_cast<double>(j) * tau)));
   }
   if (fitted_start_s != nullptr) *fitted_start_s = t0;
-  if (max_deviation >= kTimeUniformityTolerance * tau && printed_resolution_s > 0) {
-    // Least squares t_j = a + j b over j = 0..n-1 (centred, so the sums stay exact enough).
-    const double mean_j = 0.5 * static_cast<double>(n - 1);
-    const double mean_t = time_s.mean();
-    double sjt = 0, sjj = 0;
-    for (Eigen::Index j = 0; j < n; ++j) {
-      const double dj = static_cast<double>(j) - mean_j;
-      sjt += dj * (time_s[j] - mean_t);
-      sjj += dj * dj;
-    }
-    const double b = sjt / sjj;
-    const double a = mean_t - b * mean_j;
-    double worst = 0;
-    for (Eigen::Index j = 0; j < n; ++j) {
-      worst = std::max(worst, std::abs(time_s[j] - (a + static_cast<double>(j) * b)));
-    }
-    // Rounding to the printed digit moves a time by half its place value; allow the whole.
-    if (b > 0 && worst <= printed_resolution_s) {
-      CheckPrintedSteps(time_s, origin, field_of_sample, printed_resolution_s, b);
-      if (fitted_start_s != nullptr) *fitted_start_s = a;
-      return b;
+  if (max_deviation < kTimeUniformityTolerance * tau) return tau;
+  // Least squares t_j = a + j b over j = 0..n-1 (centred, so the sums stay exact enough).
+  const double mean_j = 0.5 * static_cast<double>(n - 1);
+  const double mean_t = time_s.mean();
+  double sjt = 0, sjj = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double dj = static_cast<double>(j) - mean_j;
+    sjt += dj * (time_s[j] - mean_t);
+    sjj += dj * dj;
+  }
+  const double b = sjt / sjj;
+  const double a = mean_t - b * mean_j;
+  double worst_from_line = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    worst_from_line =
+        std::max(worst_from_line, std::abs(time_s[j] - (a + static_cast<double>(j) * b)));
+  }
+  // Rounding to the printed digit moves a time by half its place value; allow the whole.
+  if (printed_resolution_s > 0 && b > 0 && worst_from_line <= printed_resolution_s) {
+    CheckPrintedSteps(time_s, origin, field_of_sample, printed_resolution_s, b);
+    if (fitted_start_s != nullptr) *fitted_start_s = a;
+    return b;
+  }
+  // The grid test decides; the step furthest from tau locates the gap or jump for the user.
+  Eigen::Index worst = 1;
+  double worst_step_deviation = -1;
+  for (Eigen::Index j = 1; j < n; ++j) {
+    const double d = std::abs((time_s[j] - time_s[j - 1]) - tau);
+    if (d > worst_step_deviation) {
+      worst_step_deviation = d;
+      worst = j;
     }
   }
-  if (max_deviation >= kTimeUniformityTolerance * tau) {
-    // The grid test decides; the step furthest from tau locates the gap or jump for the user.
-    Eigen::Index worst = 1;
-    double worst_step_deviation = -1;
-    for (Eigen::Index j = 1; j < n; ++j) {
-      const double d = std::abs((time_s[j] - time_s[j - 1]) - tau);
-      if (d > worst_step_deviation) {
-        worst_step_deviation = d;
-        worst = j;
-      }
-    }
-    throw InputError(
-        origin, field_of_sample(worst),
-        fmt::format("non-uniform time: step {:.9g} s from sample {} to {} differs from the mean "
-                    "step {:.9g} s (relative deviation {:.3g})",
-                    time_s[worst] - time_s[worst - 1], worst - 1, worst, tau,
-                    worst_step_deviation / tau),
-        printed_resolution_s > 0
-            ? fmt::format("uniform sampling (times within the printed resolution {:g} s of a "
-                          "uniform grid)",
-                          printed_resolution_s)
-            : fmt::format("uniform sampling (relative deviation under {:g})",
-                          kTimeUniformityTolerance));
-  }
-  return tau;
+  throw InputError(
+      origin, field_of_sample(worst),
+      fmt::format("non-uniform time: step {:.9g} s from sample {} to {} differs from the mean "
+                  "step {:.9g} s (relative deviation {:.3g})",
+                  time_s[worst] - time_s[worst - 1], worst - 1, worst, tau,
+                  worst_step_deviation / tau),
+      (printed_resolution_s > 0
+           ? fmt::format("uniform sampling (times within the printed resolution {:g} s of a "
+                         "uniform grid)",
+                         printed_resolution_s)
+           : fmt::format("uniform sampling (relative deviation under {:g})",
+                         kTimeUniformityTolerance)) +
+          // Scattered less than a quarter step about a straight line: stamps with jitter.
+          (b > 0 && worst_from_line < 0.25 * b
+               ? "; for a logger that samples at a fixed rate and stamps with jitter, its "
+                 "rate (sample_rate_hz in the record entry, --sample-rate-hz)"
+               : ""));
 }
 
 }  // namespace mbid

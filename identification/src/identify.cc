@@ -89,7 +89,8 @@ void AddTimeBaseUncertainty(double u, ModalResult* result) {
   }
   result->warnings.push_back(fmt::format(
       "the record's sample interval is known to +-{:.2g} % only (its file prints it to few "
-      "digits): every frequency and decay rate may be off by as much, which their standard "
+      "digits, or its time stamps' own rate is not quite the stated one): every frequency and "
+      "decay rate may be off by as much, which their standard "
       "deviations now include; the logger's exact rate (sample_rate_hz, --sample-rate-hz) "
       "removes it",
       100 * u));

@@ -16,16 +16,19 @@ namespace {
 
 struct Format {
   std::vector<std::string> extensions;  // lower case, with the dot
-  internal::RawTable (*read)(const std::string& path);
+  // The user's time unit goes to readers that must apply it before checking the time base.
+  internal::RawTable (*read)(const std::string& path, const std::string& time_unit);
 };
 
 const std::vector<Format>& Formats() {
   static const std::vector<Format> formats = {
-      {{".csv", ".txt"}, &internal::ReadCsv},
+      {{".csv", ".txt"},
+       [](const std::string& p, const std::string&) { return internal::ReadCsv(p); }},
       {{".h5", ".hdf5"}, &internal::ReadHdf5},
-      {{".uff", ".unv", ".uff58", ".uffb"}, &internal::ReadUff58},
-      {{".lvm"}, &internal::ReadLvm},
-      {{".mat"}, &internal::ReadMat},
+      {{".uff", ".unv", ".uff58", ".uffb"},
+       [](const std::string& p, const std::string&) { return internal::ReadUff58(p); }},
+      {{".lvm"}, [](const std::string& p, const std::string&) { return internal::ReadLvm(p); }},
+      {{".mat"}, [](const std::string& p, const std::string&) { return internal::ReadMat(p); }},
   };
   return formats;
 }
@@ -57,12 +60,12 @@ bool IsSupportedFile(const std::string& path) {
 
 namespace internal {
 
-RawTable ReadRawTable(const std::string& path) {
+RawTable ReadRawTable(const std::string& path, const std::string& time_unit) {
   const std::string extension = LowerExtension(path);
   for (const Format& format : Formats()) {
     const auto& extensions = format.extensions;
     if (std::find(extensions.begin(), extensions.end(), extension) != extensions.end()) {
-      return format.read(path);
+      return format.read(path, time_unit);
     }
   }
   throw InputError(

@@ -10,7 +10,7 @@
 namespace mbid::records::internal {
 
 // The file as its reader returns it; an unsupported extension is an InputError listing the
-// supported ones.
-RawTable ReadRawTable(const std::string& path);
+// supported ones. `time_unit` (--time-unit, "" for none) reaches readers that apply it themselves.
+RawTable ReadRawTable(const std::string& path, const std::string& time_unit);
 
 }  // namespace mbid::records::internal

@@ -177,6 +177,38 @@ std::string SampleField(const RawTable& table, const std::string& where, Eigen::
   return where.empty() ? fmt::format("sample {}", j) : fmt::format("{}, sample {}", where, j);
 }
 
+// Time stamps that jitter around the stated grid, offsets t_j - j tau: read at the stated rate.
+// Their own rate (the least-squares slope) differs from it by what the two clocks disagree,
+// which is the time base's uncertainty whichever clock is right.
+void JitteredStamps(const Eigen::ArrayXd& offset, double tau, double rate_hz, Measurement* m,
+                    ImportReport* report) {
+  const Eigen::Index n = offset.size();
+  const Eigen::ArrayXd j = Eigen::ArrayXd::LinSpaced(n, 0, static_cast<double>(n - 1));
+  const Eigen::ArrayXd dj = j - j.mean();
+  const double slope = (dj * (offset - offset.mean())).sum() / dj.square().sum();
+  const Eigen::ArrayXd residual = offset - offset.mean() - slope * dj;
+  const double scatter = std::sqrt(residual.square().sum() / static_cast<double>(n - 2));
+  const double slope_std = scatter / std::sqrt(dj.square().sum());
+  m->start_time_s = offset.mean();
+  m->sample_interval_s = tau;
+  const double jitter = residual.abs().maxCoeff();
+  std::string drift;
+  if (std::abs(slope) > 4 * slope_std) {
+    m->sample_interval_uncertainty =
+        std::max(m->sample_interval_uncertainty, (std::abs(slope) + slope_std) / tau);
+    drift = fmt::format(
+        "; their own rate is {:.9g} Hz, {:.2g} ppm off the stated one, which "
+        "every frequency's and decay's standard deviation carries",
+        1 / (tau + slope), 1e6 * std::abs(slope) / tau);
+  }
+  // Not a warning (which makes an identification unreliable): a jitter of the sampling itself
+  // would show in the identification's residual, which is judged there.
+  report->conversions.push_back(fmt::format(
+      "time: samples at j / {} Hz, the stamps scattered by up to {:.3g} s ({:.2g} % of the "
+      "interval) around that grid, as a logger that stamps its blocks with jitter writes them{}",
+      rate_hz, jitter, 100 * jitter / tau, drift));
+}
+
 // Sets the measurement's start time and interval from the file's time base (in seconds).
 // A time column printed to `resolution` with a rate the user states: every time must lie within
 // that resolution of one grid j / rate (the spread of t_j - j / rate is under one place value
@@ -226,6 +258,13 @@ void StatedRateGrid(const Eigen::VectorXd& time, const std::string& path, const 
   }
   const bool ties = high - low >= resolution - tolerance;
   const bool apart = last_low < first_high || last_high < first_low;
+  // Stamps that scatter by less than half an interval around the grid are a logger's stamping
+  // jitter (a PC clock read per block): a dropped or repeated sample moves the offsets by a whole
+  // interval, which this spread cannot hold.
+  if (beyond && high - low < 0.5 * tau && time.size() > 2) {
+    JitteredStamps(offset, tau, rate_hz, m, report);
+    return;
+  }
   if (beyond || (ties && apart)) {
     const Eigen::Index j = last_low < first_high   ? first_high
                            : last_high < first_low ? first_low
@@ -428,7 +467,7 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
   ImportReport local;
   ImportReport& r = report != nullptr ? *report : local;
   r = ImportReport();
-  const RawTable table = internal::ReadRawTable(path);
+  const RawTable table = internal::ReadRawTable(path, options.time_unit);
   r.format = table.format;
   r.dialect = table.dialect;
 

@@ -282,6 +282,59 @@ TEST(DateAndLayoutTest, AStatedRateSettlesACoarselyPrintedTimeColumn) {
   EXPECT_EQ(ImportMeasurement(repeats, options).sample_interval_s, 1.0 / 200);
 }
 
+// A logger that stamps its blocks from a PC clock: 1 kHz, the stamps scattered by up to 30 us
+// (a trial's logger file; it could not be read at all). The values are the grid's, j / 1000 Hz.
+std::string JitteredExport(int rows, double rate_error, int dropped_at = -1) {
+  const Decay psi;
+  return MakeExport("t [s],psi [deg]\n", rows, [&](int j) {
+    const int k = dropped_at >= 0 && j >= dropped_at ? j + 1 : j;
+    // A fixed scatter of +-30 us that no straight line follows (golden-ratio sequence).
+    const double jitter = 30e-6 * (2 * std::fmod(0.6180339887 * k, 1.0) - 1);
+    return fmt::format("{:.6f},{}", k * 1e-3 * (1 + rate_error) + jitter, Print(psi(k * 1e-3)));
+  });
+}
+
+TEST(DateAndLayoutTest, StampsWithJitterAreReadAtAStatedRate) {
+  TempDir dir;
+  const Decay psi;
+  const std::string path = dir.File("jitter.csv");
+  WriteText(path, JitteredExport(3000, 0));
+  // Alone, the column is not uniform; the message says what reads it.
+  const InputError e = CatchInputError([&] { ImportMeasurement(path); });
+  EXPECT_THAT(e.what(), HasSubstr("non-uniform time"));
+  EXPECT_THAT(e.what(), HasSubstr("stamps with jitter, its rate (sample_rate_hz"));
+  ImportOptions options;
+  options.sample_rate_hz = 1000;
+  ImportReport report;
+  const Measurement m = ImportMeasurement(path, options, &report);
+  EXPECT_EQ(m.sample_interval_s, 1e-3);
+  EXPECT_NEAR(m.start_time_s, 0.0, 2e-6);         // the mean of 3000 stamps' scatter, < 30 us / 15
+  EXPECT_EQ(m.sample_interval_uncertainty, 0.0);  // no drift: the stated rate is the stamps'
+  for (Eigen::Index j = 0; j < m.samples(); ++j) {  // 9 printed digits, as ExpectDecayRead
+    ASSERT_NEAR(m.values(j, 0), psi(1e-3 * j) * kDegree,
+                1e-8 * (psi.amplitude + psi.offset) * kDegree)
+        << j;
+  }
+  EXPECT_THAT(report.conversions[0],
+              HasSubstr("scattered by up to 3.0"));  // 30 us about their mean
+  EXPECT_THAT(report.conversions[0], HasSubstr("(3 % of the interval)"));
+  EXPECT_TRUE(report.warnings.empty());  // the identification judges its residual
+  // A dropped sample amid the jitter is still found: it moves the stamps by a whole interval.
+  const std::string dropped = dir.File("dropped.csv");
+  WriteText(dropped, JitteredExport(3000, 0, 1200));
+  const InputError d = CatchInputError([&] { ImportMeasurement(dropped, options); });
+  EXPECT_THAT(d.what(), HasSubstr("dropped or repeated sample"));
+  // Stamps from a clock 50 ppm off the stated rate: 0.15 ms over 3 s, read at the stated rate
+  // with the disagreement as the time base's uncertainty.
+  const std::string drifting = dir.File("drift.csv");
+  WriteText(drifting, JitteredExport(3000, 50e-6));
+  ImportReport drift_report;
+  const Measurement drift = ImportMeasurement(drifting, options, &drift_report);
+  EXPECT_EQ(drift.sample_interval_s, 1e-3);
+  EXPECT_NEAR(drift.sample_interval_uncertainty, 50e-6, 5e-6);  // + the slope's own std
+  EXPECT_THAT(drift_report.conversions[0], HasSubstr("ppm off the stated one"));
+}
+
 TEST(DateAndLayoutTest, AColumnOfTextIsNoChannel) {
   TempDir dir;
   const Decay psi;

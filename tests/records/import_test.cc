@@ -1,6 +1,7 @@
 // Logger exports in each dialect, written from a closed-form decay and read back in SI; mbid's
 // own files through the same door, bit for bit.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -325,6 +326,52 @@ TEST(ImportTest, MbidCsvAndHdf5RoundTripsStayBitExact) {
     EXPECT_TRUE(SameBits(read.values, written.values)) << path;
     EXPECT_TRUE(report.conversions.empty()) << path;  // SI in, nothing converted
   }
+}
+
+// A time dataset in ms (a lab's own writer of mbid's layout) is converted by its units attribute
+// like any channel; a user's time unit stands over the file's, and the step it gives must still
+// be sample_interval_s (a trial's file was refused, and --time-unit on a file in s divided its
+// rate by 1000 unnoticed).
+TEST(ImportTest, AnHdf5TimeIsReadInTheUnitItsAttributeOrTheUserStates) {
+  TempDir dir;
+  const Measurement written = mbid::testing::MakeMeasurement(300);
+  const std::string ms = dir.File("ms.h5");
+  {
+    H5Writer writer(ms);
+    writer.WriteMeasurement(written);
+    writer.WriteVector("/measurement", "time", 1e3 * written.CalcTime(), "ms");
+    writer.Commit();
+  }
+  ImportOptions user_ms;
+  user_ms.time_unit = "ms";
+  for (const ImportOptions& options : {ImportOptions(), user_ms}) {
+    ImportReport report;
+    const Measurement read = ImportMeasurement(ms, options, &report);
+    // The stated interval, through ms and back: within a few ulps of 0.01 s.
+    EXPECT_NEAR(read.sample_interval_s, written.sample_interval_s, 1e-16);
+    EXPECT_NEAR(read.start_time_s, written.start_time_s, 1e-15);
+    EXPECT_THAT(fmt::format("{}", fmt::join(report.conversions, "; ")),
+                HasSubstr("time: ms -> s (x 0.001)"));
+  }
+  const std::string s = dir.File("s.h5");
+  {
+    H5Writer writer(s);
+    writer.WriteMeasurement(written);
+    writer.Commit();
+  }
+  const InputError e = CatchInputError([&] { ImportMeasurement(s, user_ms); });
+  EXPECT_THAT(e.what(), HasSubstr("sample_interval_s': is 0.01 s but /measurement/time has a "
+                                  "step of 1e-05 s (its times read in ms)"));
+  // A unit that is no time is refused naming the attribute.
+  const std::string metres = dir.File("m.h5");
+  {
+    H5Writer writer(metres);
+    writer.WriteMeasurement(written);
+    writer.WriteVector("/measurement", "time", written.CalcTime(), "m");
+    writer.Commit();
+  }
+  const InputError m = CatchInputError([&] { ImportMeasurement(metres); });
+  EXPECT_THAT(m.what(), HasSubstr("/measurement/time attribute 'units'"));
 }
 
 TEST(ImportTest, MbidCsvUnitsCommentIsConverted) {

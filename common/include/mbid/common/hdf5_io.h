@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -54,6 +55,12 @@ class H5Writer {
   std::unique_ptr<Impl> impl_;
 };
 
+// The factor from the time unit a file states ("" when it states none) to seconds, for a
+// reader that converts units (the records library); it throws InputError naming `field` for a
+// unit it cannot convert, and sets `*unit` to the unit it read the times in.
+using SecondsPerTimeUnit =
+    std::function<double(const std::string& stated, const std::string& field, std::string* unit)>;
+
 // Read access to an HDF5 file written by H5Writer (or by h5py, MATLAB, ... in the same layout).
 // Every failure is an InputError naming the file and the dataset or attribute. Object paths
 // are absolute ("/truth/modes"); the root is "/". Float datasets of any precision are read as
@@ -90,7 +97,7 @@ class H5Reader {
   long long ReadIntAttribute(const std::string& object, const std::string& name) const;
 
   // See ReadMeasurementH5 and ReadScenarioYaml.
-  Measurement ReadMeasurement() const;
+  Measurement ReadMeasurement(const SecondsPerTimeUnit& seconds_per_unit = {}) const;
   std::string ReadScenarioYaml() const;
 
  private:
@@ -101,8 +108,10 @@ class H5Reader {
 // Reads /measurement; errors (not HDF5, wrong format attribute, missing channel, missing units,
 // non-uniform or decreasing time, NaN/Inf, empty) name the file and the dataset or attribute.
 // The sample interval is the sample_interval_s attribute, which must agree with the time
-// dataset to the uniformity tolerance; the start time is the first time sample.
-Measurement ReadMeasurementH5(const std::string& path);
+// dataset to the uniformity tolerance; the start time is the first time sample. The time is
+// in s, or in any unit `seconds_per_unit` converts.
+Measurement ReadMeasurementH5(const std::string& path,
+                              const SecondsPerTimeUnit& seconds_per_unit = {});
 
 // Reads the /scenario yaml attribute, or an empty string if the file has none.
 std::string ReadScenarioYaml(const std::string& path);
