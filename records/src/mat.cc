@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -176,6 +178,10 @@ void MatReader::ReadDirectory() {
     const std::string name = var->name != nullptr ? var->name : "";
     if (name.empty() || infos_.count(name)) continue;
     VarInfo info = InfoOf(*var, name);
+    if (info.class_type == MAT_C_EMPTY && info.elements > 0 &&
+        Mat_GetVersion(mat_.get()) == MAT_FT_MAT73) {
+      RecoverV73Class(&info);
+    }
     if (info.numeric() && info.dims.size() > 2) {
       throw VarError(name,
                      fmt::format("a {}-dimensional array ({})", info.dims.size(), info.Shape()),
@@ -189,8 +195,45 @@ void MatReader::ReadDirectory() {
   }
 }
 
+// matio reads a v7.3 variable's MATLAB_class only when the string is null-terminated; h5py
+// (hdf5storage) writes it null-padded, which matio takes for an empty array of the stated size.
+// Such a numeric variable is read through HDF5, as MATLAB would.
+void MatReader::RecoverV73Class(VarInfo* info) {
+  static const std::map<std::string, matio_classes> classes = {
+      {"double", MAT_C_DOUBLE}, {"single", MAT_C_SINGLE}, {"int8", MAT_C_INT8},
+      {"uint8", MAT_C_UINT8},   {"int16", MAT_C_INT16},   {"uint16", MAT_C_UINT16},
+      {"int32", MAT_C_INT32},   {"uint32", MAT_C_UINT32}, {"int64", MAT_C_INT64},
+      {"uint64", MAT_C_UINT64}};
+  if (!h5_) h5_ = std::make_unique<H5Reader>(path_);
+  const std::string object = "/" + info->name;
+  if (!h5_->Exists(object) || !h5_->HasAttribute(object, "MATLAB_class")) return;
+  std::string name = h5_->ReadStringAttribute(object, "MATLAB_class");
+  name.erase(std::find(name.begin(), name.end(), '\0'), name.end());
+  const auto known = classes.find(name);
+  if (known == classes.end()) return;
+  info->class_type = known->second;
+  info->through_hdf5 = true;
+}
+
 // A whole variable; its size is checked against the file before matio allocates it.
 MatVar MatReader::Load(const VarInfo& info) {
+  if (info.through_hdf5) {
+    // HDF5's row-major (columns, rows) is MATLAB's column-major (rows, columns).
+    const Eigen::MatrixXd stored = h5_->ReadMatrix("/", info.name);
+    const Eigen::MatrixXd column_major = stored.transpose();
+    if (static_cast<double>(column_major.size()) != info.elements || info.dims.size() != 2) {
+      throw VarError(
+          info.name,
+          fmt::format("{} numbers where its header says {}", column_major.size(), info.Shape()),
+          "a complete numeric array");
+    }
+    size_t dims[2] = {info.dims[0], info.dims[1]};
+    // Mat_VarCreate copies the data (no MAT_F_DONT_COPY_DATA).
+    MatVar var(Mat_VarCreate(info.name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims,
+                             const_cast<double*>(column_major.data()), 0));
+    if (!var) throw VarError(info.name, "its data cannot be read", "a complete variable");
+    return var;
+  }
   // Every element of an uncompressed v5 variable takes at least a byte of the file (a cell's
   // or struct's at least an 8-byte tag).
   const bool container = info.class_type == MAT_C_CELL || info.class_type == MAT_C_STRUCT;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "mbid/common/error.h"
+#include "mbid/common/hdf5_io.h"
 #include "raw_table.h"
 
 namespace mbid::records::internal {
@@ -50,6 +51,8 @@ struct VarInfo {
   bool complex = false;
   bool logical = false;
   bool compressed = false;
+  // A v7.3 numeric variable whose class matio could not read (read through HDF5 instead).
+  bool through_hdf5 = false;
   std::vector<size_t> dims;
   double elements = 0;  // product of dims (a double: no overflow on hostile dims)
 
@@ -85,6 +88,7 @@ class MatReader {
                       const std::string& expected) const;
   void ReadHead();
   void ReadDirectory();
+  void RecoverV73Class(VarInfo* info);
   MatVar Load(const VarInfo& info);
   std::vector<double> Doubles(const matvar_t& var, const std::string& name) const;
   double Scalar(const std::string& name);
@@ -117,6 +121,7 @@ class MatReader {
 
   const std::string& path_;
   MatFile mat_;
+  std::unique_ptr<H5Reader> h5_;  // a v7.3 file as HDF5, opened where matio fell short
   double file_size_ = 0;
   std::vector<std::string> order_;
   std::map<std::string, VarInfo> infos_;

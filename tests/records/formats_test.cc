@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <string>
@@ -500,6 +501,44 @@ TEST(Mat, ReadsV73MatrixWithTimeFirst) {
     EXPECT_EQ(table.columns[0].values[static_cast<size_t>(j)], 1.0 / (j + 1));  // exact
     EXPECT_EQ(table.columns[1].values[static_cast<size_t>(j)], -2.0 * j);
   }
+}
+
+// h5py (hdf5storage) writes a v7.3 variable's MATLAB_class null-padded, not null-terminated as
+// MATLAB does; matio then reads the variable as an empty array (a trial's file was refused:
+// "a 1901x1 empty"). Such numeric variables are read through HDF5.
+TEST(Mat, ReadsV73VariablesWhoseClassIsNullPadded) {
+  if (std::system("/usr/bin/python3 -c 'import h5py' >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "h5py is not installed for /usr/bin/python3";
+  }
+  TempDir dir;
+  const std::string path = dir.File("padded73.mat");
+  const std::vector<double> time = {0, 0.01, 0.02, 0.03};  // 100 Hz
+  const std::vector<float> a = {1.0f / 3, -2.5f, 7, 0};    // single precision, as loggers store
+  mat_t* mat = Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT73);
+  ASSERT_NE(mat, nullptr) << "matio without HDF5: no v7.3";
+  size_t column[2] = {4, 1}, row[2] = {1, 4};
+  WriteVar(mat, Mat_VarCreate("time", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, column,
+                              const_cast<double*>(time.data()), 0));
+  WriteVar(mat,
+           Mat_VarCreate("a", MAT_C_SINGLE, MAT_T_SINGLE, 2, row, const_cast<float*>(a.data()), 0));
+  Mat_Close(mat);
+  const std::string pad = dir.File("pad.py");
+  WriteText(pad,
+            "import sys, h5py, numpy as np\n"
+            "with h5py.File(sys.argv[1], 'r+') as f:\n"
+            "    for k in f:\n"
+            "        v = f[k].attrs['MATLAB_class']\n"
+            "        v = v if isinstance(v, bytes) else v.encode()\n"
+            "        del f[k].attrs['MATLAB_class']\n"
+            "        f[k].attrs.create('MATLAB_class', np.bytes_(v))\n"
+            "        t = h5py.h5a.open(f[k].id, b'MATLAB_class').get_type()\n"
+            "        assert t.get_strpad() == h5py.h5t.STR_NULLPAD\n");
+  ASSERT_EQ(std::system(("/usr/bin/python3 " + pad + " " + path).c_str()), 0);
+  const RawTable table = ReadMat(path);
+  EXPECT_EQ(table.time, time);
+  ASSERT_EQ(table.columns.size(), 1u);
+  EXPECT_EQ(table.columns[0].name, "a");
+  EXPECT_EQ(table.columns[0].values, std::vector<double>(a.begin(), a.end()));  // exact
 }
 
 TEST(Mat, ReadsVectorsWithSampleRate) {
