@@ -322,7 +322,10 @@ ReleaseDetection DetectReleaseInChannels(const Measurement& record) {
   return detection;
 }
 
-ReleaseDetection DetectRelease(const Measurement& record) {
+namespace {
+
+// DetectRelease's first change from rest, in the channels with a signal.
+ReleaseDetection DetectFirstRelease(const Measurement& record) {
   // A channel whose whole range is within a few times its noise (a sensor the test does not
   // excite: the out-of-plane accelerometer of a planar load drop) crosses any fraction of that
   // range at once, and no release was found: a knuckle-boom drop analysed from the record's
@@ -350,6 +353,92 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   ReleaseDetection detection = DetectReleaseInChannels(part);
   if (detection.detected) {  // every channel's, glitches bridged as for the detection's own
     detection.rest_level = RestLevels(BridgeGlitches(record.values), detection.rest_samples);
+  }
+  return detection;
+}
+
+// Samples a segment at rest must hold to end a change that no free decay followed.
+constexpr int kQuietSamples = 20;
+
+// The first sample from `from` on that opens kQuietSamples samples at rest at a new level:
+// every channel within 6 noise standard deviations (from its third differences) of the window's
+// median without a drift, and some channel's median that far from its level at rest before
+// (`before`; a slow start of the motion is still that rest). -1 if none.
+int FindNewRest(const Eigen::MatrixXd& y, const Eigen::VectorXd& noise,
+                const std::vector<double>& before, int from) {
+  const int n = static_cast<int>(y.rows());
+  for (int j = from; j + kQuietSamples <= n; ++j) {
+    bool quiet = true, moved = false;
+    for (Eigen::Index c = 0; c < y.cols() && quiet; ++c) {
+      std::vector<double> window(y.col(c).data() + j, y.col(c).data() + j + kQuietSamples);
+      std::nth_element(window.begin(), window.begin() + kQuietSamples / 2, window.end());
+      const double median = window[kQuietSamples / 2];
+      const auto segment = y.col(c).segment(j, kQuietSamples);
+      // No drift either: the halves' means agree within 2 noise standard deviations (their
+      // difference has 0.45 of one); a slow ramp stays within 6 of a median for 20 samples.
+      const double drift =
+          segment.tail(kQuietSamples / 2).mean() - segment.head(kQuietSamples / 2).mean();
+      quiet = (segment.array() - median).abs().maxCoeff() <= 6 * noise(c) &&
+              std::abs(drift) <= 2 * noise(c);
+      moved = moved || std::abs(median - before[static_cast<size_t>(c)]) > 6 * noise(c);
+    }
+    if (quiet && moved) return j;
+  }
+  return -1;
+}
+
+// The most reversals of direction, beyond 6 noise standard deviations (a hysteresis), that a
+// channel makes over samples [begin, end): a free decay makes two a period, a step or a ramp
+// none.
+int Reversals(const Eigen::MatrixXd& y, const Eigen::VectorXd& noise, int begin, int end) {
+  int most = 0;
+  for (Eigen::Index c = 0; c < y.cols(); ++c) {
+    const double h = 6 * noise(c);
+    if (!(h > 0) || end - begin < 2) continue;
+    int count = 0, direction = 0;
+    double extreme = y(begin, c);
+    for (int j = begin + 1; j < end; ++j) {
+      const double v = y(j, c);
+      if (direction >= 0 && v > extreme) {
+        extreme = v;
+      } else if (direction <= 0 && v < extreme) {
+        extreme = v;
+      } else if (std::abs(v - extreme) > h) {
+        if (direction != 0) ++count;
+        direction = v > extreme ? 1 : -1;
+        extreme = v;
+      }
+    }
+    most = std::max(most, count);
+  }
+  return most;
+}
+
+}  // namespace
+
+ReleaseDetection DetectRelease(const Measurement& record) {
+  ReleaseDetection detection = DetectFirstRelease(record);
+  // A change from rest that no oscillation follows before the structure is at rest again is not
+  // the release: a logger's leading zeros before the rest level, a winch's pull and hold before
+  // the load drop (a trial's records: the release taken 1.3 and 3.1 s early, and the real one
+  // for a glitch). The release is looked for again from that rest on.
+  const Eigen::MatrixXd y = BridgeGlitches(record.values);
+  Eigen::VectorXd noise(y.cols());
+  for (Eigen::Index c = 0; c < y.cols(); ++c) noise(c) = ThirdDifferenceNoise(y.col(c));
+  for (int round = 0; round < 4 && detection.detected; ++round) {
+    const int change = detection.rest_samples;
+    const int quiet = FindNewRest(y, noise, detection.rest_level, change);
+    if (quiet < 0 || Reversals(y, noise, change, quiet) > 1) break;
+    Measurement rest = record;
+    rest.start_time_s = record.start_time_s + quiet * record.sample_interval_s;
+    rest.values = record.values.bottomRows(record.values.rows() - quiet);
+    ReleaseDetection later = DetectFirstRelease(rest);
+    if (!later.detected || !(later.release_time_s > detection.release_time_s)) break;
+    later.description += fmt::format(
+        " (the change at {:.6g} s before it, which no oscillation followed, is no release)",
+        detection.release_time_s);
+    later.rest_samples += quiet;
+    detection = later;
   }
   return detection;
 }

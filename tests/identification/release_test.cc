@@ -242,6 +242,34 @@ TEST(ReleaseTest, AGlitchIsNoRelease) {
   EXPECT_NEAR(jump.release_time_s, test.release_s, 0.5 * test.interval_s);
 }
 
+// A change from rest that no oscillation follows before the next rest is no release: a logger's
+// zeros before the sensor's level, a winch's slow pull and hold before the drop (a trial's
+// records: the release placed 1.3 and 3.1 s early, the real one taken for a glitch).
+TEST(ReleaseTest, AChangeThatNoOscillationFollowsIsNoRelease) {
+  Release test;
+  test.release_s = 4.0045;  // after the pull; 6 s of decay follow
+  for (unsigned seed = 1; seed < 4; ++seed) {
+    Measurement zeros = test.Record("rad", seed);
+    zeros.values.col(0).head(40).setZero();  // 0.4 s of zeros before the deflection's level
+    Measurement pull = test.Record("rad", seed);
+    for (int j = 0; j * test.interval_s < 2.9; ++j) {
+      // At rest undeflected for 0.9 s, pulled over 2 s (a raised cosine), then held.
+      const double t = j * test.interval_s;
+      const double ramp = t < 0.9 ? 0 : 0.5 * (1 - std::cos(kPi * (t - 0.9) / 2));
+      pull.values(j, 0) += (ramp - 1) * test.deflected;
+    }
+    for (const Measurement& record : {zeros, pull}) {
+      const ReleaseDetection found = DetectRelease(record);
+      EXPECT_TRUE(found.detected);
+      // As a release from rest at the record's start (LoadReleaseFoundToAboutASample).
+      EXPECT_NEAR(found.release_time_s, test.release_s, 0.3 * test.interval_s) << seed;
+      EXPECT_NE(found.description.find("which no oscillation followed, is no release"),
+                std::string::npos)
+          << found.description;
+    }
+  }
+}
+
 // The benchmark: 0.5 s of zeros before the response of four modes (1.8, 2.5, 10 and
 // 16 Hz) gave three wrong modes and exit 0. With the release found, the four come back; with
 // the zeros analysed (--release none) the result is flagged unreliable.
