@@ -1,6 +1,7 @@
 // The mbid command: parses flags, calls the libraries, maps failures to the exit codes of
 // docs/interfaces.md (2 invalid input, 3 numerical failure, 1 anything else).
 #include <glog/logging.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -100,6 +101,9 @@ int Main(int argc, char** argv) {
   mbid::app::CommonOptions common;
   ImportFlags import_flags;
   app.add_flag("-q,--quiet", common.quiet, "No progress on standard error");
+  bool progress = false;
+  app.add_flag("--progress", progress,
+               "Progress on standard error also where it is no terminal (a log file)");
   app.add_flag("--overwrite", common.overwrite, "Replace output files that exist");
 
   std::string scenario_path;
@@ -226,7 +230,7 @@ int Main(int argc, char** argv) {
   plan->add_option("--json", common.json_path, "Write the JSON summary to FILE ('-' = stdout)");
 
   std::vector<std::string> structure_data;
-  int structure_max_rigid = 1;
+  std::optional<int> structure_max_rigid;
   int structure_threads = 0;
   CLI::App* structure = app.add_subcommand(
       "structure", "Rank structures (which joints really move) by BIC of their Route 2 fits");
@@ -236,10 +240,10 @@ int Main(int argc, char** argv) {
                    "Measurement files (.h5, .csv, .txt, .mat, .uff, .lvm), one per test")
       ->required();
   AddImportFlags(structure, &import_flags);
-  structure
-      ->add_option("--max-rigid", structure_max_rigid,
-                   "Candidates with up to K compliant coordinates made rigid")
-      ->capture_default_str();
+  structure->add_option(
+      "--max-rigid", structure_max_rigid,
+      "Candidates with up to K compliant coordinates made rigid (default 1; 0 for "
+      "a machine of one compliant coordinate)");
   structure->add_option("--threads", structure_threads,
                         "Fits side by side (default: one per core)");
   structure->add_option("-o,--output", output_path,
@@ -255,6 +259,8 @@ int Main(int argc, char** argv) {
               << "; expected see mbid --help\n";
     return static_cast<int>(mbid::app::ExitCode::kInvalidInput);
   }
+  // Progress goes to a terminal only: a script or log sees warnings and errors alone.
+  if (!progress && ::isatty(STDERR_FILENO) == 0) common.quiet = true;
   common.import = MakeOverrides(import_flags);
   // No output may replace an input or another output. Only one command's lists are filled.
   std::vector<mbid::NamedFile> inputs{{"SCENARIO", scenario_path}, {"DATA", data_path}};

@@ -59,6 +59,16 @@ int RunCampaignCommand(const std::string& campaign_path, const std::string& outp
   for (const std::string& damaged : summary.damaged_cases) {
     std::cerr << "mbid: warning: " << output_dir << ": case " << damaged << "; computed again\n";
   }
+  // The outcome on standard output (rank 0), as the other commands print their results: the
+  // progress on standard error is for a terminal only.
+  if (campaign::IsClusterRoot(*cluster) && !summary.stopped_before_running) {
+    std::cout << (summary.was_complete
+                      ? fmt::format("{}: already complete, nothing to do\n", output_dir)
+                      : fmt::format("{}: {} cases, {} run now in {:.2f} s, {} failed{}\n",
+                                    output_dir, summary.cases, summary.ran, summary.wall_s,
+                                    summary.failed,
+                                    summary.failed > 0 ? " (see summary.csv)" : ""));
+  }
   // Rank 0 throws the folder's error itself; the other ranks learn only that it stopped.
   return static_cast<int>(summary.stopped_before_running ? ExitCode::kInvalidInput
                                                          : ExitCode::kSuccess);

@@ -29,25 +29,11 @@ int RunIdentifyCommand(const std::string& data_path,
           ? ReadScenarioYaml(data_path)
           : std::string();
   // A record mbid simulated carries its test: after a forcing (an impulse, a burst) the free
-  // decay starts where the forcing ends, as `mbid run` analyses it. The release detection cannot
-  // see a pulse at the record's very start; the user's --release or window still win.
-  identification::IdentificationOptions options = given;
-  if (!scenario.empty() && options.release == identification::ReleaseMode::kDetect &&
-      !std::isfinite(options.window_start_s)) {
-    try {
-      const validation::Scenario test = validation::LoadScenarioFromText(scenario, data_path);
-      if (test.has_excitation && test.excitation.CalcForcingEndTime() > 0) {
-        options = validation::FreeDecayOptions(options, test.excitation);
-        if (!common.quiet) {
-          std::cerr << fmt::format(
-              "mbid: {}: free decay after the {} that ends at {:.6g} s (the record's scenario)\n",
-              data_path, test.excitation.type_name(), test.excitation.CalcForcingEndTime());
-        }
-      }
-    } catch (const InputError&) {
-      // A scenario this version cannot read: the record is analysed as any other.
-    }
-  }
+  // decay starts where the forcing ends, as `mbid run` analyses it.
+  std::string said;
+  const identification::IdentificationOptions options =
+      validation::RecordFileOptions(data_path, given, &said);
+  if (!said.empty() && !common.quiet) std::cerr << fmt::format("mbid: {}: {}\n", data_path, said);
   if (!common.quiet) {
     std::cerr << fmt::format("mbid: {}: {}\n", data_path, DescribeImport(import));
     std::cerr << fmt::format("mbid: identifying {} ({} samples x {} channels, {} Hz, {})\n",

@@ -69,7 +69,8 @@ StartedSettings StartFromRoute1(const model::MechanicalModel& model,
 }  // namespace
 
 int RunStructureCommand(const std::string& scenario_path,
-                        const std::vector<std::string>& data_paths, int max_rigid, int threads,
+                        const std::vector<std::string>& data_paths,
+                        std::optional<int> given_max_rigid, int threads,
                         const std::string& output_path, const CommonOptions& common) {
   const Scenario scenario = LoadScenario(scenario_path);
   const auto model = scenario.MakeModel();
@@ -82,6 +83,7 @@ int RunStructureCommand(const std::string& scenario_path,
   // A machine with every coordinate rigid cannot move: at least one stays.
   const int most = static_cast<int>(compliant.size()) -
                    (static_cast<int>(compliant.size()) == multibody->coordinate_count() ? 1 : 0);
+  const int max_rigid = given_max_rigid.value_or(std::min(1, most));
   if (max_rigid < 0 || max_rigid > most) {
     throw InputError("command line", "--max-rigid", std::to_string(max_rigid),
                      fmt::format("0 to {} (the compliant coordinates: {}; one must move)", most,
@@ -189,6 +191,10 @@ int RunStructureCommand(const std::string& scenario_path,
     WriteStructureGroup(*file, ranking);
     WriteStructureReport(ranking, scenario.name, data_paths, *report);
     file->Commit();
+  }
+  // The full model's fit says what `mbid update` would (also under --quiet).
+  for (const std::string& warning : reference.warnings) {
+    std::cerr << "mbid: warning: " << warning << "\n";
   }
   if (common.json_path != "-") {
     std::cout << StructureTable(ranking);

@@ -130,6 +130,13 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     release["file"] = test.path;
     summary["release"].push_back(release);
   }
+  // The contract's field: where the first DATA's free decay starts, in its own time (each
+  // file's cut is in `release`); a forced test's starts where its forcing ends.
+  const LoadedTest& first = tests.front();
+  const double free_decay_s =
+      first.release.release_time_s +
+      (first.release.how == "forced test" ? first.excitation.CalcForcingEndTime() : 0.0);
+  summary["release_time_s"] = free_decay_s;
   if (!note.empty()) summary["start_note"] = note;
   // A failed fit leaves no output file (interfaces.md); standard output still gets its JSON.
   if (common.json_path == "-" || (converged && !common.json_path.empty())) {
@@ -140,6 +147,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     file.WriteMeasurement(validation::AsFitted(tests.front().record, result.tests.front()));
     file.WriteScenarioYaml(scenario.yaml_text);
     updating::WriteUpdatingGroup(file, result, algebraic.get());
+    file.WriteScalar("/updating", "release_time_s", free_decay_s, "s");
     updating::WriteGlobalSearchGroup(file, search);
     // Where each DATA file was cut: its release in the file's own time (t = 0 of the test).
     Eigen::VectorXd release_s(static_cast<Eigen::Index>(tests.size()));

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
@@ -159,17 +160,18 @@ void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
     if (output.path.empty() || output.path == "-") continue;
     for (const NamedFile& input : inputs) {
       if (!input.path.empty() && SameFile(output.path, input.path)) {
-        throw InputError(
-            output.flag, output.path,
-            "is the input " + input.flag + " " + input.path + ", which writing it would destroy",
-            "an output name other than the command's input files");
+        throw InputError(output.path, "",
+                         "the " + output.flag + " output is the input " + input.flag + " " +
+                             input.path + ", which writing it would destroy",
+                         "an output name other than the command's input files");
       }
     }
     for (size_t p = 0; p < o; ++p) {
       if (!outputs[p].path.empty() && outputs[p].path != "-" &&
           SameFile(output.path, outputs[p].path)) {
-        throw InputError(output.flag, output.path,
-                         "is also the output of " + outputs[p].flag + ", and one would be lost",
+        throw InputError(output.path, "",
+                         "the " + output.flag + " output is also the output of " + outputs[p].flag +
+                             ", and one would be lost",
                          "a name of its own for each output");
       }
     }
@@ -197,13 +199,29 @@ void CheckOutputsReplaceable(const std::vector<NamedFile>& outputs, bool overwri
     std::error_code error;
     const fs::path folder = fs::absolute(output.path, error).parent_path();
     if (!fs::is_directory(folder, error)) {
-      throw InputError(output.flag, output.path,
-                       "its folder " + folder.string() + " does not exist",
-                       "an output in an existing folder");
+      throw InputError(
+          output.path, "",
+          "the folder of the " + output.flag + " output, " + folder.string() + ", does not exist",
+          "an output in an existing folder");
     }
     if (!overwrite && fs::exists(output.path, error)) {
-      throw InputError(output.flag, output.path, "exists",
+      throw InputError(output.path, "", "the " + output.flag + " output exists",
                        "a new file name, or --overwrite to replace it");
+    }
+    // The output is written under a temporary name in its folder: a folder that takes no new
+    // file (read-only, /proc) fails here, before the work, not after it.
+    const fs::path probe =
+        folder / (".mbid-probe-" + std::to_string(static_cast<long>(::getpid())));
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0 && errno != EEXIST) {  // a file of that name is left alone
+      throw InputError(output.path, "",
+                       "the " + output.flag + " output cannot be created in " + folder.string() +
+                           " (" + std::strerror(errno) + ")",
+                       "a writable folder");
+    }
+    if (fd >= 0) {
+      ::close(fd);
+      ::unlink(probe.c_str());
     }
   }
 }

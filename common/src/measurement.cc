@@ -63,9 +63,8 @@ void Measurement::Validate(const std::string& origin) const {
       throw InputError(origin, fmt::format("channel {}", i), "empty channel name",
                        "a non-empty name");
     }
-    if (name == "time" || name.find_first_of(",/\r\n") != std::string::npos) {
-      throw InputError(origin, name, fmt::format("invalid channel name '{}'", name),
-                       "a name other than 'time' without ',', '/' or line breaks");
+    if (const std::string problem = ProblemWithChannelName(name); !problem.empty()) {
+      throw InputError(origin, name, problem, kChannelNameRule);
     }
     if (!seen.insert(name).second) {
       throw InputError(origin, name, fmt::format("channel '{}' appears twice", name),
@@ -142,6 +141,16 @@ void CheckPrintedSteps(const Eigen::VectorXd& time_s, const std::string& origin,
 }
 
 }  // namespace
+
+std::string ProblemWithChannelName(const std::string& name) {
+  if (name.empty()) return "empty channel name";
+  // "." and ".." are no HDF5 dataset names (a path's own and its parent's).
+  if (name == "time" || name == "." || name == ".." ||
+      name.find_first_of(",/\r\n") != std::string::npos) {
+    return fmt::format("invalid channel name '{}'", name);
+  }
+  return "";
+}
 
 double CheckUniformTime(const Eigen::VectorXd& time_s, const std::string& origin,
                         const std::function<std::string(Eigen::Index)>& field_of_sample,

@@ -20,7 +20,8 @@ IdentificationOptions ApplyRelease(const Measurement& measurement,
       result->release = "none";
       return applied;
     case ReleaseMode::kGiven:
-      result->release = "given";
+    case ReleaseMode::kForcingEnd:
+      result->release = options.release == ReleaseMode::kGiven ? "given" : "forcing end";
       result->release_time_s = options.release_time_s;
       break;
     case ReleaseMode::kDetect: {

@@ -105,8 +105,9 @@ std::vector<Mode> CalcModes(const LinearModel& linear) {
             [](const Mode& a, const Mode& b) { return a.lambda.imag() < b.lambda.imag(); });
   std::sort(real.begin(), real.end(),
             [](const Mode& a, const Mode& b) { return a.lambda.real() > b.lambda.real(); });
-  oscillatory.insert(oscillatory.end(), real.begin(), real.end());
-  return oscillatory;
+  // Ascending frequency, as the contract lists modes: the real poles (frequency 0) first.
+  real.insert(real.end(), oscillatory.begin(), oscillatory.end());
+  return real;
 }
 
 }  // namespace mbid::model

@@ -11,6 +11,7 @@
 
 #include "degrees.h"
 #include "mbid/common/error.h"
+#include "mbid/common/measurement.h"
 
 namespace mbid::model {
 namespace {
@@ -284,6 +285,10 @@ void MachineDescription::Validate() const {
   for (const OutputDescription& output : outputs) {
     const std::string field = "outputs." + output.name;
     if (!output_names.insert(output.name).second) Fail(field, "output named twice", "each once");
+    // Its name is a channel of the measurement files: found here, not after a simulation.
+    if (const std::string problem = ProblemWithChannelName(output.name); !problem.empty()) {
+      Fail(field, problem + " for an output", kChannelNameRule);
+    }
     // A channel is an output or a coordinate by its name: one name, one quantity.
     const bool coordinate_name = std::find(all_coordinates.begin(), all_coordinates.end(),
                                            output.name) != all_coordinates.end();

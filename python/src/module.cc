@@ -15,6 +15,7 @@
 
 #include "mbid/mbid.h"
 #include "mbid/records/records.h"
+#include "mbid/validation/identification_settings.h"
 
 namespace py = pybind11;
 
@@ -250,9 +251,10 @@ PYBIND11_MODULE(_mbid, m) {
       .def_property(
           "release",
           [](const IdentificationOptions& o) {
-            return o.release == ReleaseMode::kDetect  ? "detect"
-                   : o.release == ReleaseMode::kGiven ? "given"
-                                                      : "none";
+            return o.release == ReleaseMode::kDetect       ? "detect"
+                   : o.release == ReleaseMode::kGiven      ? "given"
+                   : o.release == ReleaseMode::kForcingEnd ? "forcing end"
+                                                           : "none";
           },
           [](IdentificationOptions& o, const std::string& mode) {
             if (mode == "detect") {
@@ -336,6 +338,7 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readonly("method", &mbid::ModalResult::method)
       .def_readonly("channels", &mbid::ModalResult::channels)
       .def_readonly("release_time_s", &mbid::ModalResult::release_time_s)
+      .def_readonly("release", &mbid::ModalResult::release)
       .def_readonly("start_time_s", &mbid::ModalResult::start_time_s)
       .def_readonly("sample_interval_s", &mbid::ModalResult::sample_interval_s)
       .def_readonly("model_order", &mbid::ModalResult::model_order)
@@ -420,9 +423,16 @@ PYBIND11_MODULE(_mbid, m) {
         const mbid::Measurement record = AsRecord(record_object, "identify", "record");
         std::optional<mbid::Scenario> scenario;
         if (!scenario_object.is_none()) scenario = AsScenario(scenario_object, "identify");
+        // A record file mbid simulated carries its test, as `mbid identify` reads it.
+        IdentificationOptions applied = options;
+        const std::optional<std::string> path = AsPath(record_object);
+        if (!scenario && path) {
+          std::string said;
+          applied = mbid::validation::RecordFileOptions(*path, options, &said);
+        }
         py::gil_scoped_release release;
-        return scenario ? mbid::IdentifyTest(record, *scenario, options)
-                        : mbid::Identify(record, options);
+        return scenario ? mbid::IdentifyTest(record, *scenario, applied)
+                        : mbid::Identify(record, applied);
       },
       py::arg("record"), py::arg("options") = IdentificationOptions(),
       py::arg("scenario") = py::none(),

@@ -78,8 +78,7 @@ void CheckHdf5OutputName(const std::string& path) {
   if (path.empty() || path == "-") return;
   const std::string extension = LowerExtension(path);
   if (extension == ".h5" || extension == ".hdf5" || !IsSupportedFile(path)) return;
-  throw InputError("-o", path,
-                   "'" + extension + "' names another record format, and -o writes HDF5",
+  throw InputError(path, "", "'" + extension + "' names another record format, and -o writes HDF5",
                    "a .h5 file name (mbid simulate --export writes .csv, .uff, .uffb and .mat)");
 }
 

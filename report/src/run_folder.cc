@@ -24,10 +24,17 @@ namespace {
 namespace fs = std::filesystem;
 using validation::RunTest;
 
+// Where a test's free decay starts (the contract's `release_time_s`): a record's release in the
+// file's own time, or where the identification found it in a simulated test (after a forcing).
+double ReleaseTime(const RunTest& test) {
+  return test.release ? test.release->release_time_s : test.identified.release_time_s;
+}
+
 // A test's `updating` JSON: the best minimum's fit with the global search beside it.
 nlohmann::json TestUpdatingJson(const RunTest& test) {
   nlohmann::json json = updating::UpdateResultToJson(test.tuned, test.algebraic.get());
   updating::AddGlobalSearchToJson(test.search, json);
+  json["release_time_s"] = ReleaseTime(test);
   return json;
 }
 
@@ -55,6 +62,7 @@ void WriteTestGroups(H5Writer& run, const RunTest& test, const std::string& root
   }
   identification::WriteModalResult(run, test.identified, root + "/identification");
   updating::WriteUpdatingGroup(run, test.tuned, test.algebraic.get(), root + "/updating");
+  run.WriteScalar(root + "/updating", "release_time_s", ReleaseTime(test), "s");
   updating::WriteGlobalSearchGroup(run, test.search, root + "/updating/search");
   const updating::TestFit& fit = test.tuned.tests.front();
   const std::string validation = root + "/validation";
@@ -188,8 +196,7 @@ int WriteRunFolder(const validation::CycleResult& cycle, const validation::Scena
   summary["model"] = validation::LinearModelToJson(cycle.linear, cycle.exact_modes);
   summary["identification"] = identification::ModalResultToJson(first.identified);
   if (first.release) summary["release"] = first.release->ToJson();
-  summary["updating"] = updating::UpdateResultToJson(first.tuned, first.algebraic.get());
-  updating::AddGlobalSearchToJson(first.search, summary["updating"]);
+  summary["updating"] = TestUpdatingJson(first);
   if (!scenario.records.empty()) {
     nlohmann::json list = nlohmann::json::array();
     for (const RunTest& test : tests) {

@@ -2,6 +2,7 @@
 // no output left behind on failure, and files that other tools (h5py) read.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -133,6 +134,36 @@ TEST_F(CliTest, OutputIntoMissingFolderIsInvalidInput) {
   EXPECT_FALSE(fs::exists(dir_ / "no"));
 }
 
+// An output that its folder cannot take (/proc takes no new file, even from root) is invalid
+// input found before the work, not a failure (exit 1) after it.
+TEST_F(CliTest, OutputIntoAFolderThatTakesNoFileIsInvalidInput) {
+  const CommandResult result = Run("modes " + kReference + " --json /proc/mbid-modes.json");
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_EQ(result.err.rfind("mbid: error: /proc/mbid-modes.json: the --json output cannot be "
+                             "created in /proc (",
+                             0),
+            0u)
+      << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+}
+
+// Progress goes to a terminal only (the contract): a script's captured standard error holds
+// warnings and the one error line; --progress asks for the lines in a log.
+TEST_F(CliTest, ProgressGoesToATerminalOnly) {
+  const fs::path record = dir_ / "drop.h5";
+  ASSERT_EQ(Run("simulate " + kReference + " -o " + record.string()).exit_code, 0);
+  const CommandResult bad = Run("identify " + record.string() + " --channels nope");
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;  // it had 3
+  EXPECT_EQ(bad.err.rfind("mbid: error: ", 0), 0u) << bad.err;
+  const CommandResult quiet = Run("identify " + record.string());
+  EXPECT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err.find("mbid: identifying"), std::string::npos) << quiet.err;
+  const CommandResult told = Run("identify " + record.string() + " --progress");
+  EXPECT_EQ(told.exit_code, 0) << told.err;
+  EXPECT_NE(told.err.find("mbid: identifying"), std::string::npos) << told.err;
+}
+
 TEST_F(CliTest, HelpAndVersion) {
   const CommandResult help = Run("--help");
   EXPECT_EQ(help.exit_code, 0);
@@ -233,10 +264,9 @@ TEST_F(CliTest, AnExistingFileIsReplacedOnlyWithOverwrite) {
     const CommandResult refused = Run("simulate " + kReference + outputs);
     EXPECT_EQ(refused.exit_code, 2) << refused.err;
     EXPECT_EQ(refused.err,
-              "mbid: error: " +
-                  std::string(outputs.find("--json") == std::string::npos ? "-o" : "--json") + ":" +
-                  mine.string() +
-                  ": exists; expected a new file name, or --overwrite to replace it\n");
+              "mbid: error: " + mine.string() + ": the " +
+                  std::string(outputs.find("--json") == std::string::npos ? "-o" : "--json") +
+                  " output exists; expected a new file name, or --overwrite to replace it\n");
     EXPECT_EQ(ReadText(mine), "precious");
     EXPECT_FALSE(fs::exists(dir_ / "new.h5"));
   }
@@ -273,6 +303,8 @@ TEST_F(CliTest, RunClosesTheValidationCycle) {
   EXPECT_EQ(summary["identification"]["modes"].size(),
             4u);  // every mode visible (reference-crane.md)
   EXPECT_EQ(summary["updating"]["termination"], "converged");
+  // The contract's release_time_s in the run's updating too: a load drop's decay starts at 0.
+  EXPECT_EQ(summary["updating"]["release_time_s"], 0.0);
   EXPECT_TRUE(summary["validation"]["passed"].get<bool>());
   EXPECT_EQ(summary["validation"]["verdict"], "passed");
   EXPECT_TRUE(summary["validation"]["reasons"].empty());
@@ -310,7 +342,8 @@ TEST_F(CliTest, UnreliableIdentificationMakesTheRunInconclusive) {
   const fs::path scenario =
       WriteVariant("  seed: 1", "  seed: 1\nidentification:\n  max_frequency_hz: 3.2");
   const fs::path out = dir_ / "results";
-  const CommandResult result = Run("run " + scenario.string() + " -o " + out.string());
+  const CommandResult result =
+      Run("run " + scenario.string() + " -o " + out.string() + " --progress");
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));
   const nlohmann::json& validation = summary["validation"];

@@ -80,6 +80,11 @@ TEST_F(MachineCliTest, FreeCoordinateIsARigidBodyMotion) {
   for (const nlohmann::json& mode : modes) rigid += mode.value("rigid_body", false) ? 1 : 0;
   EXPECT_EQ(rigid, 2);
   EXPECT_EQ(modes.size(), 4u);  // boom and stick ring, the swing's double pole at 0
+  // By ascending frequency, as the contract lists modes: the poles at 0 first (they came last).
+  for (size_t k = 1; k < modes.size(); ++k) {
+    EXPECT_LE(modes[k - 1]["frequency_hz"].get<double>(), modes[k]["frequency_hz"].get<double>())
+        << k;
+  }
   // No rest to start from, and none asked for (the start-far-from-rest check once failed here).
   const CommandResult simulated =
       Run("simulate " + scenario.string() + " -o " + (dir_ / "free.h5").string());
@@ -87,7 +92,8 @@ TEST_F(MachineCliTest, FreeCoordinateIsARigidBodyMotion) {
   // One local fit (CI time): the global search's design would add 6 s and nothing this test
   // looks at.
   std::ofstream(scenario, std::ios::app) << "updating: {global_search: {enabled: false}}\n";
-  const CommandResult run = Run("run " + scenario.string() + " -o " + (dir_ / "run").string());
+  const CommandResult run =
+      Run("run " + scenario.string() + " -o " + (dir_ / "run").string() + " --progress");
   EXPECT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("Route 1 (eq. 7): skipped; coordinate 'swing' has no spring"),
             std::string::npos)
@@ -125,7 +131,8 @@ sensors: {sample_rate_hz: 200, channels: [a_roof], noise_std_mps2: 2.0e-3, seed:
                 modes.string() + " --export " + csv.string())
                 .exit_code,
             0);
-  const CommandResult identify = Run("identify " + record.string() + " --json " + found.string());
+  const CommandResult identify =
+      Run("identify " + record.string() + " --progress --json " + found.string());
   ASSERT_EQ(identify.exit_code, 0) << identify.err;
   EXPECT_NE(identify.err.find("free decay after the impulse that ends at 0.01 s"),
             std::string::npos)
@@ -133,6 +140,10 @@ sensors: {sample_rate_hz: 200, channels: [a_roof], noise_std_mps2: 2.0e-3, seed:
   const nlohmann::json exact = nlohmann::json::parse(ReadText(modes))["modes"];
   const nlohmann::json result = nlohmann::json::parse(ReadText(found));
   EXPECT_TRUE(result["reliable"].get<bool>()) << result["reasons"];
+  // The contract's release_time_s is where the free decay starts: the blow's end, not the
+  // record's start (0 before).
+  EXPECT_EQ(result["release"], "forcing end");
+  EXPECT_DOUBLE_EQ(result["release_time_s"].get<double>(), 0.01);
   ASSERT_EQ(result["modes"].size(), 3u);
   for (size_t k = 0; k < 3; ++k) {
     // 1e-4 relative: at this noise the identified frequencies' standard deviations are 1e-6 to
@@ -147,6 +158,7 @@ sensors: {sample_rate_hz: 200, channels: [a_roof], noise_std_mps2: 2.0e-3, seed:
   ASSERT_EQ(hammer_update.exit_code, 0) << hammer_update.err;
   const nlohmann::json credibility = nlohmann::json::parse(ReadText(tuned))["credibility"];
   EXPECT_TRUE(credibility["credible"].get<bool>()) << credibility;
+  EXPECT_DOUBLE_EQ(nlohmann::json::parse(ReadText(tuned))["release_time_s"].get<double>(), 0.01);
 
   // --release none still analyses from the record's start, as the user asks.
   const CommandResult none =

@@ -199,7 +199,8 @@ TEST_F(OutputSafetyTest, AnOutputThatNamesAnInputOrAnotherOutputIsRefused) {
   // The summary written over the record it summarises.
   CommandResult result = Run("identify " + csv + " --quiet --json " + csv);
   EXPECT_EQ(result.exit_code, 2) << result.err;
-  EXPECT_NE(result.err.find("--json:" + csv + ": is the input DATA " + csv), std::string::npos)
+  EXPECT_NE(result.err.find(csv + ": the --json output is the input DATA " + csv),
+            std::string::npos)
       << result.err;
   EXPECT_EQ(ReadText(csv), csv_text);
   // The HDF5 output over its input: by the same name, another spelling and a link.

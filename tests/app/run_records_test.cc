@@ -145,7 +145,7 @@ TEST_F(RunRecordsTest, EachRecordIsTunedWithItsOwnExcitation) {
                                      << "  - {name: heavy, file: heavy.h5}\n"
                                      << "updating: {global_search: {enabled: false}}\n";
   const fs::path out = dir_ / "both";
-  const CommandResult result = Run("run " + base.string() + " -o " + out.string());
+  const CommandResult result = Run("run " + base.string() + " -o " + out.string() + " --progress");
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.err.find("excitation load_drop from " + (dir_ / "heavy.h5").string()),
             std::string::npos)
@@ -351,7 +351,7 @@ TEST_F(RunRecordsTest, AClippedStartIsLeftOutOfTheTest) {
       << "  start: {c_alpha: 4.3e7, c_gamma: 1.25e6, c_eta: 6.2e6, c_theta: 8.3e6, d_alpha: 6.0e5, "
          "d_gamma: 1.5e5, d_eta: 5.0e4, d_theta: 1.0e5}\n";
   const fs::path out = dir_ / "run";
-  const CommandResult result = Run("run " + base.string() + " -o " + out.string());
+  const CommandResult result = Run("run " + base.string() + " -o " + out.string() + " --progress");
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.err.find("after its last clipped sample"), std::string::npos) << result.err;
   const nlohmann::json summary = nlohmann::json::parse(ReadText(out / "summary.json"));

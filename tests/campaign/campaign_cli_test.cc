@@ -64,9 +64,9 @@ TEST_F(CampaignCliTest, OneAndTwoWorkersGiveTheSameFileBitForBit) {
   ASSERT_GT(h5.size(), 10000u) << "6 cases with records and identification";
   EXPECT_TRUE(h5 == ReadText(dir_ / "two" / "campaign.h5")) << "campaign.h5 differs";
   EXPECT_EQ(ReadText(dir_ / "one" / "summary.csv"), ReadText(dir_ / "two" / "summary.csv"));
-  // Progress on standard error: cases and rate.
-  EXPECT_NE(one.err.find("ran 6 cases"), std::string::npos) << one.err;
-  EXPECT_NE(one.err.find("cases/s"), std::string::npos) << one.err;
+  // The outcome on standard output; no progress where standard error is no terminal.
+  EXPECT_NE(one.out.find("6 cases, 6 run now in "), std::string::npos) << one.out;
+  EXPECT_EQ(one.err.find("mbid: campaign"), std::string::npos) << one.err;
   // The per-case files are merged and gone; the summary has one row per case (+ header).
   EXPECT_FALSE(fs::exists(dir_ / "one" / "cases"));
   const std::string csv = ReadText(dir_ / "one" / "summary.csv");
@@ -101,7 +101,7 @@ sweep:
   EXPECT_NE(csv.find("case_0000,0,ok,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("case_0001,1,numerical_failure,simulate,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("CVODES"), std::string::npos) << csv;
-  EXPECT_NE(result.err.find("1 failed"), std::string::npos) << result.err;
+  EXPECT_NE(result.out.find(", 1 failed (see summary.csv)"), std::string::npos) << result.out;
 }
 
 // Starts mbid in the background and kills it with SIGKILL as soon as `ready` holds.
@@ -190,8 +190,8 @@ sweep:
 
   // Without --resume the folder is refused; with it the rest runs, the damaged case again.
   EXPECT_EQ(Run("campaign " + campaign.string() + " -o " + killed.string()).exit_code, 2);
-  const CommandResult resumed =
-      Run("campaign " + campaign.string() + " -o " + killed.string() + " --resume --workers 2");
+  const CommandResult resumed = Run("campaign " + campaign.string() + " -o " + killed.string() +
+                                    " --resume --workers 2 --progress");
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
   EXPECT_NE(resumed.err.find("resuming: "), std::string::npos) << resumed.err;
   EXPECT_NE(resumed.err.find("case " + damaged_id + ": damaged file (CRC-32"), std::string::npos)
@@ -207,7 +207,7 @@ sweep:
   const CommandResult again =
       Run("campaign " + campaign.string() + " -o " + killed.string() + " --resume");
   EXPECT_EQ(again.exit_code, 0);
-  EXPECT_NE(again.err.find("already complete"), std::string::npos) << again.err;
+  EXPECT_NE(again.out.find("already complete"), std::string::npos) << again.out;
 }
 
 // A folder as a crash can leave it: the manifest, a committed case file cut short by a lost
@@ -342,8 +342,9 @@ TEST_F(CampaignCliTest, TwoMpiRanksGiveTheSameFileAsOneProcess) {
   const CommandResult local =
       Run("campaign " + campaign.string() + " -o " + (dir_ / "local").string() + " -q");
   ASSERT_EQ(local.exit_code, 0) << local.err;
-  const CommandResult mpi = Run("campaign " + campaign.string() + " -o " + (dir_ / "mpi").string(),
-                                std::string(MBID_MPIEXEC) + " -n 2 ");
+  const CommandResult mpi =
+      Run("campaign " + campaign.string() + " -o " + (dir_ / "mpi").string() + " --progress",
+          std::string(MBID_MPIEXEC) + " -n 2 ");
   ASSERT_EQ(mpi.exit_code, 0) << mpi.err;
   EXPECT_NE(mpi.err.find("on 2 ranks"), std::string::npos) << mpi.err;
   EXPECT_TRUE(ReadText(dir_ / "local" / "campaign.h5") == ReadText(dir_ / "mpi" / "campaign.h5"))

@@ -593,6 +593,17 @@ INSTANTIATE_TEST_SUITE_P(
                 "model.bodies.mast.joint.coordinates", "expected 2 for this joint type"},
         BadCase{"spring on unknown coordinate", "  c: {stiffness_Nm_per_rad: 3.0e5",
                 "  d: {stiffness_Nm_per_rad: 3.0e5", "model.springs.d", "unknown coordinate"},
+        // An output's name is a channel of the measurement files: "." once failed in HDF5
+        // after the simulation (exit 1), "time" and "a/b" there too (exit 2 naming the file).
+        BadCase{"output named dot", "  tip_x: {type: displacement, point: tip",
+                "  \".\": {type: displacement, point: tip", "model.outputs..",
+                "invalid channel name '.' for an output"},
+        BadCase{"output named time", "  tip_x: {type: displacement, point: tip",
+                "  time: {type: displacement, point: tip", "model.outputs.time",
+                "invalid channel name 'time'"},
+        BadCase{"output name with a slash", "  tip_x: {type: displacement, point: tip",
+                "  a/b: {type: displacement, point: tip", "model.outputs.a/b",
+                "invalid channel name 'a/b'"},
         BadCase{"output unknown body", "body: jib, direction: [1, 0, 0]}\n  pitch",
                 "body: boom, direction: [1, 0, 0]}\n  pitch", "model.outputs.heading.body",
                 "unknown body"},

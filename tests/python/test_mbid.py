@@ -167,6 +167,15 @@ class IdentifyTest(unittest.TestCase):
             exact = json.loads(subprocess.run([MBID_BINARY, "modes", path, "--json", "-"],
                                               check=True, capture_output=True,
                                               text=True).stdout)["modes"]
+            # The record's file carries its scenario: identify(path) reads it as the command
+            # line does (it analysed the blow as a decay: 31 "modes" in a trial).
+            h5 = os.path.join(folder, "frame.h5")
+            subprocess.run([MBID_BINARY, "simulate", path, "-o", h5], check=True,
+                           capture_output=True)
+            from_file = mbid.identify(h5)
+            self.assertEqual(from_file.release, "forcing end")
+            self.assertEqual(from_file.release_time_s, 0.01)
+            self.assertEqual(len(from_file.modes), 3)
         record = mbid.simulate(scenario)
         # Without the scenario the decay starts at the blow, which no mode describes.
         plain = mbid.identify(record)

@@ -101,7 +101,7 @@ TEST_F(RecordsCliTest, BackboneAndDriftFlags) {
 TEST_F(RecordsCliTest, IdentifyFillsGapsAndReportsTheImport) {
   const fs::path data = WriteLogger("logger.csv", 100);
   const CommandResult result = Run("identify " + data.string() +
-                                   " --fill-gaps linear --json - --channel psi=\"Boom "
+                                   " --fill-gaps linear --json - --progress --channel psi=\"Boom "
                                    "angle\" --channel phi=2");
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.err.find("1 gap sample filled linearly"), std::string::npos) << result.err;
@@ -211,7 +211,7 @@ TEST_F(RecordsCliTest, RunReadsALoggerFileThroughTheRecordKeys) {
       << "record: {file: logger.csv, channels: {psi: Boom angle, phi: 2}, units: {Slew: deg}, "
          "fill_gaps: linear}\n";
   const fs::path out = dir_ / "run";
-  const CommandResult result = Run("run " + base.string() + " -o " + out.string());
+  const CommandResult result = Run("run " + base.string() + " -o " + out.string() + " --progress");
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.err.find("psi: deg -> rad"), std::string::npos) << result.err;
   EXPECT_NE(result.err.find("1 gap sample filled linearly"), std::string::npos) << result.err;

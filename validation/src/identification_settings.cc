@@ -1,9 +1,14 @@
 #include "mbid/validation/identification_settings.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <limits>
 
 #include "mbid/common/error.h"
+#include "mbid/common/hdf5_io.h"
+#include "mbid/records/records.h"
+#include "mbid/validation/scenario.h"
 
 namespace mbid::validation {
 
@@ -94,9 +99,38 @@ identification::IdentificationOptions FreeDecayOptions(
     identification::IdentificationOptions options, const simulation::Excitation& excitation) {
   const double forcing_end = excitation.CalcForcingEndTime();
   if (forcing_end > 0 && !std::isfinite(options.window_start_s)) {
-    options.window_start_s = forcing_end;
+    if (options.release == identification::ReleaseMode::kDetect) {
+      // The free decay starts where the forcing ends: that is the result's release_time_s.
+      options.release = identification::ReleaseMode::kForcingEnd;
+      options.release_time_s = forcing_end;
+    } else {
+      options.window_start_s = forcing_end;
+    }
   }
   return options;
+}
+
+identification::IdentificationOptions RecordFileOptions(
+    const std::string& path, const identification::IdentificationOptions& options,
+    std::string* said) {
+  said->clear();
+  const std::string lower = records::LowerExtension(path);
+  if ((lower != ".h5" && lower != ".hdf5") ||
+      options.release != identification::ReleaseMode::kDetect ||
+      std::isfinite(options.window_start_s)) {
+    return options;
+  }
+  const std::string yaml = ReadScenarioYaml(path);
+  if (yaml.empty()) return options;
+  try {
+    const Scenario test = LoadScenarioFromText(yaml, path);
+    if (!test.has_excitation || !(test.excitation.CalcForcingEndTime() > 0)) return options;
+    *said = fmt::format("free decay after the {} that ends at {:.6g} s (the record's scenario)",
+                        test.excitation.type_name(), test.excitation.CalcForcingEndTime());
+    return FreeDecayOptions(options, test.excitation);
+  } catch (const InputError&) {
+    return options;  // a scenario this version cannot read: the record as any other
+  }
 }
 
 }  // namespace mbid::validation

@@ -94,9 +94,14 @@ std::vector<LoadedTest> LoadTests(
     if (describe) {
       DescribeLoadedTest(tests.back());
     } else {
-      // Under --quiet the import's doubts are still said (the progress line carries them).
+      // Under --quiet the import's doubts are still said (the progress line carries them), and
+      // samples left out.
       for (const std::string& warning : tests.back().import.warnings) {
         std::cerr << fmt::format("mbid: warning: {}: {}\n", tests.back().path, warning);
+      }
+      if (tests.back().release.clipped_until_s) {
+        std::cerr << fmt::format("mbid: warning: {}: {}\n", tests.back().path,
+                                 tests.back().release.DescribeClipped());
       }
     }
   }

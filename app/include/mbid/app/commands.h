@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,7 +11,9 @@ namespace mbid::app {
 
 // Options every command shares.
 struct CommonOptions {
-  bool quiet = false;     // no progress on standard error
+  // No progress on standard error: --quiet, or standard error is no terminal (the contract)
+  // and --progress is not given.
+  bool quiet = false;
   std::string json_path;  // "" = none, "-" = standard output
   // Replace existing output files; `run`: an output folder an earlier run wrote.
   bool overwrite = false;
@@ -56,9 +59,10 @@ int RunPlanCommand(const std::string& scenario_path, const std::vector<std::stri
 // the candidate structures (the model, the model with up to `max_rigid` compliant coordinates
 // made rigid, the scenario's `structure.alternatives`) by BIC of their Route 2 fits
 // (docs/structure.md); `threads` fits side by side (0: one per core). -o also writes the report
-// beside the file (FILE.md, FILE-criteria.png).
+// beside the file (FILE.md, FILE-criteria.png). Unset `max_rigid`: 1, or 0 where the machine
+// has one compliant coordinate only.
 int RunStructureCommand(const std::string& scenario_path,
-                        const std::vector<std::string>& data_paths, int max_rigid, int threads,
-                        const std::string& output_path, const CommonOptions& common);
+                        const std::vector<std::string>& data_paths, std::optional<int> max_rigid,
+                        int threads, const std::string& output_path, const CommonOptions& common);
 
 }  // namespace mbid::app

@@ -33,9 +33,16 @@ struct Measurement {
   // Throws InputError naming `origin` (usually the file) unless: at least two samples, at least
   // one channel, names and units match the columns, names unique and non-empty, a positive
   // finite sample interval, and every value finite (the error names the channel and sample).
-  // Names must also be writable to both file formats: not "time", no ',', '/' or line breaks.
+  // Names must also be writable to both file formats (ProblemWithChannelName).
   void Validate(const std::string& origin) const;
 };
+
+// Why `name` cannot be a channel of mbid's HDF5 and CSV files ("" when it can): empty, "time",
+// "." or "..", or with ',', '/' or a line break. The expected part of an error is
+// kChannelNameRule.
+std::string ProblemWithChannelName(const std::string& name);
+inline constexpr char kChannelNameRule[] =
+    "a name other than 'time', '.' or '..', without ',', '/' or line breaks";
 
 // Largest deviation of a sample time from the uniform grid t0 + j * tau, relative to tau, that
 // a measurement file may have (docs/interfaces).

@@ -119,6 +119,9 @@ enum class ReleaseMode {
   kDetect,  // found in the record: the end of a segment at rest (default)
   kGiven,   // IdentificationOptions::release_time_s
   kNone,    // the record's start (the record is the free decay)
+  // IdentificationOptions::release_time_s, where the test's forcing (an impulse, a burst) ends
+  // and its free decay starts (reported as "forcing end").
+  kForcingEnd,
 };
 
 // Which modes carry a backbone, their frequency and damping ratio against amplitude (backbone.h).
@@ -140,7 +143,7 @@ struct IdentificationOptions {
 
   // The free decay starts at the release; the analysis window never starts before it.
   ReleaseMode release = ReleaseMode::kDetect;
-  double release_time_s = 0.0;  // kGiven: in the record's own time
+  double release_time_s = 0.0;  // kGiven, kForcingEnd: in the record's own time
 
   // The part of the record that is analysed, in the record's own time (s), inclusive.
   double window_start_s = -std::numeric_limits<double>::infinity();

@@ -49,8 +49,9 @@ struct Mode {
   double half_life_s() const;            // ln 2 / decay
 };
 
-// The exact modes: eigenvalues of [0 I; -M^-1 C  -M^-1 D], oscillatory ones (Im > 0) sorted by
-// ascending damped frequency, followed by real (overdamped) poles sorted by decay.
+// The exact modes: eigenvalues of [0 I; -M^-1 C  -M^-1 D] by ascending damped frequency: the
+// real (overdamped, free) poles, frequency 0, first by increasing decay, then the oscillatory
+// ones (Im > 0).
 std::vector<Mode> CalcModes(const LinearModel& linear);
 
 // One line per mode that grows (Re(lambda) > 0): the machine is unstable at rest, and a test

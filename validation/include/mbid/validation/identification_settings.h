@@ -24,4 +24,12 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
 identification::IdentificationOptions FreeDecayOptions(
     identification::IdentificationOptions options, const simulation::Excitation& excitation);
 
+// The options for the record file `path` as `mbid identify` and the Python module's identify()
+// take it: an HDF5 record mbid simulated carries its test, and after a forcing (an impulse, a
+// burst) its free decay starts where the forcing ends (FreeDecayOptions); the user's release or
+// window still win. `said` gets the line that tells the user so, else "".
+identification::IdentificationOptions RecordFileOptions(
+    const std::string& path, const identification::IdentificationOptions& options,
+    std::string* said);
+
 }  // namespace mbid::validation
