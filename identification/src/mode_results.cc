@@ -33,6 +33,26 @@ Eigen::MatrixXd KeepModes(const AnalysisRecord& record, const Estimate& estimate
              coefficients;
 }
 
+// A mode drifting with amplitude, split into two poles, has one shape: their modal assurance
+// criterion (channels weighed by their noise) is near 1; for two modes of their own shapes,
+// in other channels or out of phase, it is near 0.
+constexpr double kSameShape = 0.8;
+
+// |a^H W b|^2 / (a^H W a b^H W b) with W = diag(1 / noise^2): the MAC of two complex shapes with
+// each channel in units of its noise (a channel without noise counts as 1).
+double ShapeCorrelation(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b,
+                        const Eigen::VectorXd& noise) {
+  std::complex<double> ab = 0;
+  double aa = 0, bb = 0;
+  for (Eigen::Index c = 0; c < a.size(); ++c) {
+    const double w = c < noise.size() && noise[c] > 0 ? 1 / (noise[c] * noise[c]) : 1.0;
+    ab += std::conj(a[c]) * b[c] * w;
+    aa += std::norm(a[c]) * w;
+    bb += std::norm(b[c]) * w;
+  }
+  return aa > 0 && bb > 0 ? std::norm(ab) / (aa * bb) : 1.0;
+}
+
 // Poles within 3 % of each other are, in a free decay, one mode whose frequency drifts with
 // amplitude far more often than two modes the record resolves. Each such cluster is measured in
 // sliding windows (backbone.h) with the other modes subtracted; when the windows confirm a drift,
@@ -58,13 +78,27 @@ void MergeDriftingModes(const AnalysisRecord& record, const Estimate& estimate,
       ++j;
     }
     if (j - i >= 2) {
-      std::vector<size_t> cluster(order.begin() + static_cast<long>(i),
-                                  order.begin() + static_cast<long>(j));
-      size_t dominant = cluster.front();
-      for (size_t k : cluster) {
+      const std::vector<size_t> close(order.begin() + static_cast<long>(i),
+                                      order.begin() + static_cast<long>(j));
+      size_t dominant = close.front();
+      for (size_t k : close) {
         if (result->modes[k].amplitude.sum() > result->modes[dominant].amplitude.sum()) {
           dominant = k;
         }
+      }
+      // One mode drifting with amplitude keeps its shape; two modes of other shapes are two
+      // modes however close (a mast's two bending directions 2.6 % apart, each in a channel of
+      // its own, were merged and one dropped with all of its channel's signal).
+      std::vector<size_t> cluster;
+      for (size_t k : close) {
+        if (k == dominant ||
+            ShapeCorrelation((*shapes)[k], (*shapes)[dominant], estimate.noise_std) >= kSameShape) {
+          cluster.push_back(k);
+        }
+      }
+      if (cluster.size() < 2) {
+        i = j;
+        continue;
       }
       // The record with every mode outside the cluster (and the offset) taken away.
       const Eigen::MatrixXd alone = KeepModes(record, estimate, cluster);
