@@ -333,6 +333,21 @@ simulation: {duration_s: 1}
   const CommandResult bare = arm(0);
   ASSERT_EQ(bare.exit_code, 0) << bare.err;
   EXPECT_EQ(bare.err.find("warning"), std::string::npos) << bare.err;
+  // A load drop whose payload no spring holds: 2e5 kg at 1 m on 3000 N m/rad sags
+  // 2e5 * 9.81 / 3000 = 654 rad at rest (linearly), more than half a turn (an audit's 1e9 kg
+  // started at -9805 rad, unsaid).
+  const fs::path heavy = dir_ / "heavy.yaml";
+  std::string text = ReadText(dir_ / "arm.yaml");
+  text.replace(
+      text.find("excitation: {type: initial_deflection, deflection_rad: {q: 0.003}}"),
+      std::string("excitation: {type: initial_deflection, deflection_rad: {q: 0.003}}").size(),
+      "excitation: {type: load_drop, payload_mass_kg: 2.0e5}");
+  std::ofstream(heavy) << text;
+  const CommandResult dropped =
+      Run("simulate " + heavy.string() + " -o " + (dir_ / "heavy.h5").string());
+  ASSERT_EQ(dropped.exit_code, 0) << dropped.err;
+  EXPECT_NE(dropped.err.find("more than half a turn: no spring holds that"), std::string::npos)
+      << dropped.err;
 }
 
 struct BadMachine {

@@ -40,7 +40,8 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
 // One line when an initial_deflection starts the machine far from where it rests: its
 // coordinates count from q = 0, the unloaded machine's rest, and a payload attached in the
 // description rests it elsewhere (a 20 kg payload on a double pendulum: 80 mrad away, for a
-// deflection of 4 mrad). Empty otherwise.
+// deflection of 4 mrad). For a load drop, one line when the payload deflects a coordinate by
+// more than half a turn at rest. Empty otherwise.
 std::vector<std::string> FindStartFarFromRest(const model::MechanicalModel& model,
                                               const Excitation& excitation);
 
