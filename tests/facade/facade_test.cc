@@ -198,6 +198,56 @@ sensors: {sample_rate_hz: 100, channels: [a_rim, a_s_x, a_s_y], noise_std_mps2: 
   EXPECT_TRUE(modes.reliable) << ::testing::PrintToString(modes.reasons);
 }
 
+// An arm on a tilted revolute joint, released from 0.01 rad, with an angle, a displacement and
+// an acceleration at its tip: the outputs' geometry makes harmonics no linear mode has, so the
+// identification's modes leave 55 and 4.4 times the record's noise in two channels (unreliable,
+// rightly); the exact model, tuned, leaves the sensors' noise in every channel. An audit's
+// machines with such sensors were all inconclusive, the model right to 1e-6. A model whose
+// damping is 10 % off (not tuned) does not pass. One local fit each (test time).
+TEST(FacadeTest, AModelThatExplainsWhatItsModesDoNotPasses) {
+  const std::string arm = R"(name: arm
+model:
+  type: multibody
+  bodies:
+    arm:
+      parent: ground
+      joint: {type: revolute, coordinates: [q1], axis: [1, 2, 2], in_parent_m: [0.5, -0.2, 2.0], in_parent_rotation_deg: [{z: 30}], in_body_m: [0.1, 0, 0]}
+      mass_kg: 250.0
+      com_m: [0.5, 0.2, -0.3]
+      inertia_kgm2: [20.0, 30.0, 25.0, 2.0, -1.5, 3.0]
+  springs:
+    q1: {stiffness_Nm_per_rad: 4.0e5, damping_Nms_per_rad: DAMPING}
+  points: {tip: {body: arm, at_m: [1.1, 0.3, -0.5]}}
+  outputs:
+    q1: {type: coordinate, coordinate: q1}
+    dx: {type: displacement, point: tip, direction: [1, 0, 0], frame: ground}
+    ag: {type: acceleration, point: tip, direction: [0, 0, 1], frame: ground}
+excitation: {type: initial_deflection, deflection_rad: {q1: 0.01}}
+simulation: {duration_s: 2}
+sensors: {sample_rate_hz: 200, channels: [q1, dx, ag], noise_std_rad: 1.0e-6, noise_std_m: 1.0e-7, noise_std_mps2: 1.0e-5, seed: 3}
+updating: {parameters: PARAMETERS, algebraic_start: false, start: START, global_search: {enabled: false}}
+)";
+  const auto with = [&arm](const std::string& damping, const std::string& parameters,
+                           const std::string& start) {
+    std::string text = arm;
+    text.replace(text.find("DAMPING"), 7, damping);
+    text.replace(text.find("PARAMETERS"), 10, parameters);
+    text.replace(text.find("START"), 5, start);
+    return text;
+  };
+  const mbid::Scenario exact = mbid::LoadScenarioFromText(
+      with("300.0", "[c_q1, d_q1]", "{c_q1: 2.5e5, d_q1: 600.0}"), "arm.yaml");
+  const mbid::ValidationResult right = mbid::RunValidationCycle(exact);
+  EXPECT_FALSE(right.identified.reliable);
+  EXPECT_EQ(right.verdict, mbid::Verdict::kPassed) << ::testing::PrintToString(right.reasons);
+  // The same record, a model with d_q1 10 % high and only c_q1 tuned.
+  const mbid::Measurement record = mbid::Simulate(exact);
+  const mbid::Scenario off =
+      mbid::LoadScenarioFromText(with("330.0", "[c_q1]", "{c_q1: 2.5e5}"), "arm-off.yaml");
+  const mbid::UpdateResult wrong = mbid::Update(off, {record});
+  EXPECT_FALSE(wrong.credible) << ::testing::PrintToString(wrong.credibility);
+}
+
 TEST(FacadeTest, VerdictsReadAsTheContractWritesThem) {
   EXPECT_EQ(mbid::ToString(mbid::Verdict::kPassed), "passed");
   EXPECT_EQ(mbid::ToString(mbid::Verdict::kFailed), "failed");
