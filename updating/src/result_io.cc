@@ -150,9 +150,9 @@ void WriteProfileGroup(H5Writer& file, const std::string& group, const Parameter
   file.WriteScalar(group, "lower", profile.lower, units);
   file.WriteScalar(group, "upper", profile.upper, units);
   file.WriteScalar(group, "threshold", profile.threshold, "1");
-  file.WriteStringAttribute(group, "lower_open", profile.lower_open ? "1" : "0");
-  file.WriteStringAttribute(group, "upper_open", profile.upper_open ? "1" : "0");
-  file.WriteStringAttribute(group, "better_minimum", profile.better_minimum ? "1" : "0");
+  file.WriteStringAttribute(group, "lower_open", profile.lower_open ? "true" : "false");
+  file.WriteStringAttribute(group, "upper_open", profile.upper_open ? "true" : "false");
+  file.WriteStringAttribute(group, "better_minimum", profile.better_minimum ? "true" : "false");
   file.WriteVector(group, "values",
                    Eigen::Map<const Eigen::VectorXd>(
                        profile.values.data(), static_cast<Eigen::Index>(profile.values.size())),
@@ -341,10 +341,10 @@ void WriteUpdatingGroup(H5Writer& file, const UpdateResult& result,
     file.WriteScalar(group, "relative_std", p.relative_std, "1");
     file.WriteScalar(group, "interval_lower", p.interval_lower, p.units);
     file.WriteScalar(group, "interval_upper", p.interval_upper, p.units);
-    file.WriteStringAttribute(group, "determined", p.determined ? "1" : "0");
+    file.WriteStringAttribute(group, "determined", p.determined ? "true" : "false");
     if (p.profile.computed) WriteProfileGroup(file, group + "/profile", p.profile, p.units);
   }
-  file.WriteStringAttribute(root, "credible", result.credible ? "1" : "0");
+  file.WriteStringAttribute(root, "credible", result.credible ? "true" : "false");
   file.WriteScalar(root, "chi_square_per_dof", result.chi_square_per_dof, "1");
   file.WriteScalar(root, "std_inflation", result.std_inflation, "1");
   file.WriteStrings(root, "credibility", result.credibility);
@@ -449,7 +449,7 @@ void AddGlobalSearchToJson(const GlobalSearchResult& search, nlohmann::json& jso
 
 void WriteGlobalSearchGroup(H5Writer& file, const GlobalSearchResult& search,
                             const std::string& group) {
-  file.WriteStringAttribute(group, "non_unique", search.non_unique ? "1" : "0");
+  file.WriteStringAttribute(group, "non_unique", search.non_unique ? "true" : "false");
   file.WriteScalar(group, "starts", search.starts, "1");
   file.WriteScalar(group, "screened", search.screened, "1");
   file.WriteScalar(group, "full_fits", search.full_fits, "1");
