@@ -446,6 +446,13 @@ std::vector<std::vector<double>> TakeValues(const RawTable& table, const std::st
                      "a value in every cell, or gaps filled by `--fill-gaps linear` (record key "
                      "`fill_gaps: linear`)");
   }
+  std::vector<bool> filled(values.front().size(), false);
+  for (size_t c = 0; c < values.size(); ++c) {
+    for (size_t j = 0; j < values[c].size(); ++j) filled[j] = filled[j] || std::isnan(values[c][j]);
+  }
+  for (size_t j = 0; j < filled.size(); ++j) {
+    if (filled[j]) report->filled_rows.push_back(static_cast<int>(j));
+  }
   for (size_t c = 0; c < values.size(); ++c) {
     int unfillable = -1;
     report->filled_samples += internal::FillGapsLinear(&values[c], &unfillable);
@@ -476,6 +483,10 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
   Measurement m;
   ReadTimeBase(table, path, options, time_unit, &m, &r);
   std::vector<std::vector<double>> values = TakeValues(table, path, options, selected, &r);
+  for (const int j : r.filled_rows) {
+    r.filled_times_s.push_back(m.start_time_s + j * m.sample_interval_s);
+  }
+  r.samples = values.empty() ? 0 : static_cast<int>(values.front().size());
 
   const Eigen::Index samples =
       selected.empty() ? 0 : static_cast<Eigen::Index>(values.front().size());

@@ -83,8 +83,12 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
         double* const middle = magnitude.data() + magnitude.size() / 2;
         std::nth_element(magnitude.data(), middle, magnitude.data() + magnitude.size());
         const double spread = 1.4826 * *middle;
+        Eigen::VectorXd measured = r.cwiseAbs();
+        for (const Eigen::Index j : tests[t].unmeasured_samples) {
+          if (j >= 0 && j < measured.size()) measured[j] = 0;
+        }
         Eigen::Index largest = 0;
-        const double peak = r.cwiseAbs().maxCoeff(&largest);
+        const double peak = measured.maxCoeff(&largest);
         if (spread > 0 && peak / spread > spike) {
           spike = peak / spread;
           spike_at = fmt::format("{} at {:.6g} s", channel,

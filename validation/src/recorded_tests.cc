@@ -18,6 +18,7 @@ std::vector<updating::TestRecord> MakeWeightedRecords(const std::vector<LoadedTe
     updating::TestRecord record =
         updating::MakeTestRecord(test.path, test.record, test.excitation, settings);
     WeighByIdentifiedNoise(test.identified, record);
+    MarkUnmeasuredSamples(test.import, test.identified, record);
     record.release_detected = test.release.how == "detected";
     records.push_back(std::move(record));
   }

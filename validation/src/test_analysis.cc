@@ -124,6 +124,7 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
   updating::TestRecord record =
       updating::MakeTestRecord(test.name, test.measured, excitation, updating);
   WeighByIdentifiedNoise(test.identified, record);
+  if (test.import) MarkUnmeasuredSamples(*test.import, test.identified, record);
   record.release_detected = test.release && test.release->how == "detected";
   std::string start;
   std::string start_note;

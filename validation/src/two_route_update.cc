@@ -188,6 +188,37 @@ updating::GlobalSearchResult TuneModel(const model::MechanicalModel& model,
   return search;
 }
 
+void MarkUnmeasuredSamples(const records::ImportReport& import,
+                           const identification::ModalResult& identified,
+                           updating::TestRecord& record) {
+  // Only the record's start is ever cut (the release, a clipped start).
+  Measurement& measured = record.record;
+  const Eigen::Index kept = measured.samples();
+  const Eigen::Index cut = static_cast<Eigen::Index>(import.samples) - kept;
+  const double tau = measured.sample_interval_s;
+  const bool same_rate = std::abs(identified.sample_interval_s - tau) <= 1e-9 * tau;
+  for (const int row : import.filled_rows) {
+    const Eigen::Index j = row - cut;
+    if (cut < 0 || j < 0 || j >= kept) continue;
+    record.unmeasured_samples.push_back(j);
+    const double at =
+        (measured.start_time_s + static_cast<double>(j) * tau - identified.start_time_s) / tau;
+    const Eigen::Index k = std::llround(at);
+    if (!same_rate || std::abs(at - static_cast<double>(k)) > 1e-6 || k < 0 ||
+        k >= identified.reconstruction.rows()) {
+      continue;
+    }
+    for (Eigen::Index c = 0; c < measured.values.cols(); ++c) {
+      const auto found = std::find(identified.channels.begin(), identified.channels.end(),
+                                   measured.channels[static_cast<size_t>(c)]);
+      const Eigen::Index i = found - identified.channels.begin();
+      if (found != identified.channels.end() && i < identified.reconstruction.cols()) {
+        measured.values(j, c) = identified.reconstruction(k, i);
+      }
+    }
+  }
+}
+
 void WeighByIdentifiedNoise(const identification::ModalResult& identified,
                             updating::TestRecord& record) {
   for (size_t c = 0; c < identified.channels.size(); ++c) {

@@ -35,10 +35,15 @@ struct ImportOptions {
 
 // What the import did, for the user to check.
 struct ImportReport {
-  std::string format;                    // "mbid-csv", "csv", "uff58", "lvm", "mat", "hdf5"
-  std::string dialect;                   // text files: "';'-separated, decimal comma, ..."
-  std::vector<std::string> mapping;      // e.g. "psi <- column 3 (Boom angle)"
-  int filled_samples = 0;                // cells interpolated by GapFill::kLinear
+  std::string format;                // "mbid-csv", "csv", "uff58", "lvm", "mat", "hdf5"
+  std::string dialect;               // text files: "';'-separated, decimal comma, ..."
+  std::vector<std::string> mapping;  // e.g. "psi <- column 3 (Boom angle)"
+  int filled_samples = 0;            // cells interpolated by GapFill::kLinear
+  // The times (the record's own, s) of the samples with an interpolated cell: no measurement
+  // there, which the updating's credibility leaves out of its look for spikes.
+  std::vector<double> filled_times_s;
+  std::vector<int> filled_rows;          // their sample indices in the record as read
+  int samples = 0;                       // the samples read
   std::vector<std::string> conversions;  // e.g. "theta: deg -> rad (x 0.0174533)"
   // What the file does not say and may have been misread: a column named `time` without a unit
   // is in seconds by the contract, and a step of 0.1 s or more is then more likely ms.
