@@ -132,10 +132,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
   }
   // The contract's field: where the first DATA's free decay starts, in its own time (each
   // file's cut is in `release`); a forced test's starts where its forcing ends.
-  const LoadedTest& first = tests.front();
-  const double free_decay_s =
-      first.release.release_time_s +
-      (first.release.how == "forced test" ? first.excitation.CalcForcingEndTime() : 0.0);
+  const double free_decay_s = tests.front().release.free_decay_start_s();
   summary["release_time_s"] = free_decay_s;
   if (!note.empty()) summary["start_note"] = note;
   // A failed fit leaves no output file (interfaces.md); standard output still gets its JSON.
@@ -153,7 +150,7 @@ int RunUpdateCommand(const std::string& scenario_path, const std::vector<std::st
     Eigen::VectorXd release_s(static_cast<Eigen::Index>(tests.size()));
     std::vector<std::string> how, files;
     for (size_t i = 0; i < tests.size(); ++i) {
-      release_s(static_cast<Eigen::Index>(i)) = tests[i].release.release_time_s;
+      release_s(static_cast<Eigen::Index>(i)) = tests[i].release.free_decay_start_s();
       how.push_back(tests[i].release.how);
       files.push_back(tests[i].path);
     }

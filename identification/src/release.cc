@@ -395,17 +395,23 @@ int Reversals(const Eigen::MatrixXd& y, const Eigen::VectorXd& noise, int begin,
   for (Eigen::Index c = 0; c < y.cols(); ++c) {
     const double h = 6 * noise(c);
     if (!(h > 0) || end - begin < 2) continue;
+    // The first move beyond h sets the direction; each move back beyond h from the extreme
+    // since is a reversal.
     int count = 0, direction = 0;
-    double extreme = y(begin, c);
+    const double start = y(begin, c);
+    double extreme = start;
     for (int j = begin + 1; j < end; ++j) {
       const double v = y(j, c);
-      if (direction >= 0 && v > extreme) {
-        extreme = v;
-      } else if (direction <= 0 && v < extreme) {
+      if (direction == 0) {
+        if (std::abs(v - start) > h) {
+          direction = v > start ? 1 : -1;
+          extreme = v;
+        }
+      } else if ((v - extreme) * direction > 0) {
         extreme = v;
       } else if (std::abs(v - extreme) > h) {
-        if (direction != 0) ++count;
-        direction = v > extreme ? 1 : -1;
+        ++count;
+        direction = -direction;
         extreme = v;
       }
     }
@@ -421,24 +427,41 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   // A change from rest that no oscillation follows before the structure is at rest again is not
   // the release: a logger's leading zeros before the rest level, a winch's pull and hold before
   // the load drop (a trial's records: the release taken 1.3 and 3.1 s early, and the real one
-  // for a glitch). The release is looked for again from that rest on.
+  // for a glitch). The release is looked for again from that rest on. A slow pull from the
+  // record's start is no detected change at all (one cubic follows it): the record's start
+  // then stands for it.
   const Eigen::MatrixXd y = BridgeGlitches(record.values);
+  const int n = static_cast<int>(y.rows());
+  if (n < 2 * kQuietSamples) return detection;
   Eigen::VectorXd noise(y.cols());
   for (Eigen::Index c = 0; c < y.cols(); ++c) noise(c) = ThirdDifferenceNoise(y.col(c));
-  for (int round = 0; round < 4 && detection.detected; ++round) {
-    const int change = detection.rest_samples;
-    const int quiet = FindNewRest(y, noise, detection.rest_level, change);
+  int change = detection.detected ? detection.rest_samples : 0;
+  std::vector<double> before =
+      detection.detected ? detection.rest_level : RestLevels(y, std::min(5, n));
+  double passed_s = detection.detected ? detection.release_time_s : record.start_time_s;
+  for (int round = 0; round < 6; ++round) {
+    const int quiet = FindNewRest(y, noise, before, change);
     if (quiet < 0 || Reversals(y, noise, change, quiet) > 1) break;
     Measurement rest = record;
     rest.start_time_s = record.start_time_s + quiet * record.sample_interval_s;
-    rest.values = record.values.bottomRows(record.values.rows() - quiet);
+    rest.values = record.values.bottomRows(n - quiet);
     ReleaseDetection later = DetectFirstRelease(rest);
-    if (!later.detected || !(later.release_time_s > detection.release_time_s)) break;
-    later.description += fmt::format(
-        " (the change at {:.6g} s before it, which no oscillation followed, is no release)",
-        detection.release_time_s);
-    later.rest_samples += quiet;
-    detection = later;
+    if (later.detected && later.release_time_s > passed_s) {
+      later.description += fmt::format(
+          " (the change at {:.6g} s before it, which no oscillation followed, is no release)",
+          passed_s);
+      later.rest_samples += quiet;
+      detection = later;
+      change = detection.rest_samples;
+      before = detection.rest_level;
+      passed_s = detection.release_time_s;
+    } else {
+      // At rest from `quiet` on, and what follows sets off too slowly to be seen as a change
+      // (a pull): the next rest at a new level is looked for from there.
+      change = quiet;
+      before = RestLevels(y.bottomRows(n - quiet), std::min(5, n - quiet));
+      passed_s = rest.start_time_s;
+    }
   }
   return detection;
 }

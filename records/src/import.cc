@@ -270,11 +270,13 @@ void StatedRateGrid(const Eigen::VectorXd& time, const std::string& path, const 
                            : last_high < first_low ? first_low
                                                    : std::max(first_high, first_low);
     throw InputError(path, SampleField(table, "", j),
-                     fmt::format("the time column is off the grid of the stated {} Hz by {:.3g} s "
-                                 "from sample {} on (a dropped or repeated sample, or another "
-                                 "rate?)",
+                     fmt::format("the time column spreads over {1:.3g} s around the grid of the "
+                                 "stated {0} Hz from sample {2} on (a dropped or repeated sample, "
+                                 "or another rate?)",
                                  rate_hz, high - low, j),
-                     fmt::format("times within their printed resolution {:g} s of j / {} Hz",
+                     fmt::format("times within their printed resolution {:g} s of j / {} Hz, or "
+                                 "stamps that scatter within a band narrower than half an "
+                                 "interval around it",
                                  resolution, rate_hz));
   }
   m->start_time_s = offset.mean();

@@ -27,7 +27,7 @@ using validation::RunTest;
 // Where a test's free decay starts (the contract's `release_time_s`): a record's release in the
 // file's own time, or where the identification found it in a simulated test (after a forcing).
 double ReleaseTime(const RunTest& test) {
-  return test.release ? test.release->release_time_s : test.identified.release_time_s;
+  return test.release ? test.release->free_decay_start_s() : test.identified.release_time_s;
 }
 
 // A test's `updating` JSON: the best minimum's fit with the global search beside it.
@@ -52,7 +52,7 @@ void WriteTestGroups(H5Writer& run, const RunTest& test, const std::string& root
                        root + "/measurement");
   if (test.release) {
     // Where the record was cut: the release in the file's own time, t = 0 of the test.
-    run.WriteScalar(root + "/release", "release_time_s", test.release->release_time_s, "s");
+    run.WriteScalar(root + "/release", "release_time_s", test.release->free_decay_start_s(), "s");
     run.WriteStringAttribute(root + "/release", "release", test.release->how);
     if (test.release->detected_time_s) {
       run.WriteScalar(root + "/release", "detected_release_time_s", *test.release->detected_time_s,

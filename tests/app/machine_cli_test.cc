@@ -158,7 +158,11 @@ sensors: {sample_rate_hz: 200, channels: [a_roof], noise_std_mps2: 2.0e-3, seed:
   ASSERT_EQ(hammer_update.exit_code, 0) << hammer_update.err;
   const nlohmann::json credibility = nlohmann::json::parse(ReadText(tuned))["credibility"];
   EXPECT_TRUE(credibility["credible"].get<bool>()) << credibility;
-  EXPECT_DOUBLE_EQ(nlohmann::json::parse(ReadText(tuned))["release_time_s"].get<double>(), 0.01);
+  const nlohmann::json tuned_json = nlohmann::json::parse(ReadText(tuned));
+  EXPECT_DOUBLE_EQ(tuned_json["release_time_s"].get<double>(), 0.01);
+  // The file's own entry agrees (it said 0, the test's start, which is now test_start_s).
+  EXPECT_DOUBLE_EQ(tuned_json["release"][0]["release_time_s"].get<double>(), 0.01);
+  EXPECT_DOUBLE_EQ(tuned_json["release"][0]["test_start_s"].get<double>(), 0.0);
 
   // --release none still analyses from the record's start, as the user asks.
   const CommandResult none =

@@ -244,7 +244,8 @@ TEST(ReleaseTest, AGlitchIsNoRelease) {
 
 // A change from rest that no oscillation follows before the next rest is no release: a logger's
 // zeros before the sensor's level, a winch's slow pull and hold before the drop (a trial's
-// records: the release placed 1.3 and 3.1 s early, the real one taken for a glitch).
+// records: the release placed 1.3 and 3.1 s early, the real one taken for a glitch; an audit's
+// pull from the record's start: "record start" and wrong modes).
 TEST(ReleaseTest, AChangeThatNoOscillationFollowsIsNoRelease) {
   Release test;
   test.release_s = 4.0045;  // after the pull; 6 s of decay follow
@@ -258,7 +259,17 @@ TEST(ReleaseTest, AChangeThatNoOscillationFollowsIsNoRelease) {
       const double ramp = t < 0.9 ? 0 : 0.5 * (1 - std::cos(kPi * (t - 0.9) / 2));
       pull.values(j, 0) += (ramp - 1) * test.deflected;
     }
-    for (const Measurement& record : {zeros, pull}) {
+    // Pulled from the record's first sample (no rest before: one cubic follows the pull, which
+    // is no detected change at all), and zeros, rest, pull and hold before the drop.
+    Measurement from_start = test.Record("rad", seed);
+    Measurement zeros_pull = pull;
+    for (int j = 0; j * test.interval_s < 2.9; ++j) {
+      const double t = j * test.interval_s;
+      const double ramp = t < 0.9 ? 0.5 * (1 - std::cos(kPi * t / 0.9)) : 1;
+      from_start.values(j, 0) += (ramp - 1) * test.deflected;
+    }
+    zeros_pull.values.col(0).head(30).setZero();
+    for (const Measurement& record : {zeros, pull, from_start, zeros_pull}) {
       const ReleaseDetection found = DetectRelease(record);
       EXPECT_TRUE(found.detected);
       // As a release from rest at the record's start (LoadReleaseFoundToAboutASample).

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "mbid/common/clipping.h"
@@ -29,7 +30,9 @@ ReleaseChoice OverrideRelease(const ReleaseChoice& entry, const ImportOverrides&
 }
 
 nlohmann::json AppliedRelease::ToJson() const {
-  nlohmann::json json = {{"release_time_s", release_time_s}, {"release", how}};
+  nlohmann::json json = {{"release_time_s", free_decay_start_s()}, {"release", how}};
+  // A forced test starts before its free decay: where the record's t = 0 is.
+  if (forcing_end_s > 0) json["test_start_s"] = release_time_s;
   if (clipped_until_s) json["clipped_until_s"] = *clipped_until_s;
   if (detected_time_s) json["detected_release_time_s"] = *detected_time_s;
   if (std_s) json["release_std_s"] = *std_s;
@@ -59,11 +62,14 @@ AppliedRelease CutAtReleaseOnly(Measurement* record, const std::string& origin,
   if (choice.time_s) {
     applied.how = "given";
     applied.release_time_s = *choice.time_s;
+    // A forced test's given instant is its forcing's start (the test's t = 0).
+    applied.forcing_end_s = std::max(0.0, excitation.CalcForcingEndTime());
   } else if (choice.none) {
     applied.how = "none";
     return applied;
   } else if (excitation.CalcForcingEndTime() > 0) {
     applied.how = "forced test";
+    applied.forcing_end_s = excitation.CalcForcingEndTime();
     if (record->made_by_mbid()) return applied;  // starts at the excitation by construction
     // A logger's pre-trigger before the blow: the onset of a force that rises from zero is found
     // only to about a sample, and the pulse's timing must be known to a fraction of one (a

@@ -33,6 +33,11 @@ struct AppliedRelease {
   // simulated), "none" (--release none) or "forced test" (the excitation forces the structure
   // from t = 0, which is then the origin).
   std::string how;
+  // A forced test: where its forcing ends after t = 0, and so where its free decay starts.
+  double forcing_end_s = 0;
+  // The contract's release_time_s, where the free decay starts in the record's own time: the
+  // release, or a forced test's forcing end.
+  double free_decay_start_s() const { return release_time_s + forcing_end_s; }
   // A record clipped at its start (common/clipping.h) is used from the sample after its last
   // clipped one, this many seconds after the release; `clipped` says which channel and how.
   std::optional<double> clipped_until_s;
