@@ -265,6 +265,19 @@ void StatedRateGrid(const Eigen::VectorXd& time, const std::string& path, const 
     JitteredStamps(offset, tau, rate_hz, m, report);
     return;
   }
+  if (beyond && time.size() > 2) {
+    // A column whose mean step is not the stated one by far more than any jitter or dropped
+    // sample moves it (200 Hz stamps read at a stated 100 Hz were "off the grid by 10 s").
+    const double step = (time[time.size() - 1] - time[0]) / static_cast<double>(time.size() - 1);
+    if (std::abs(step - tau) > 0.01 * tau) {
+      throw InputError(path, table.time_where.empty() ? "sample_rate_hz" : table.time_where,
+                       fmt::format("the time column steps {:.6g} s ({:.6g} Hz) on average, not "
+                                   "the stated {} Hz",
+                                   step, 1 / step, rate_hz),
+                       "the rate the time column shows, or no stated rate (the time column "
+                       "gives it)");
+    }
+  }
   if (beyond || (ties && apart)) {
     const Eigen::Index j = last_low < first_high   ? first_high
                            : last_high < first_low ? first_low

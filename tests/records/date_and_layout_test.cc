@@ -324,6 +324,12 @@ TEST(DateAndLayoutTest, StampsWithJitterAreReadAtAStatedRate) {
   WriteText(dropped, JitteredExport(3000, 0, 1200));
   const InputError d = CatchInputError([&] { ImportMeasurement(dropped, options); });
   EXPECT_THAT(d.what(), HasSubstr("dropped or repeated sample"));
+  // A stated rate that is not the stamps' is said so (it was "off the grid by 3 s").
+  ImportOptions half;
+  half.sample_rate_hz = 500;
+  const InputError other = CatchInputError([&] { ImportMeasurement(path, half); });
+  // (the first and last stamps jitter too: the mean step is 1000 Hz to 1e-5)
+  EXPECT_THAT(other.what(), HasSubstr("Hz) on average, not the stated 500 Hz"));
   // Stamps from a clock 50 ppm off the stated rate: 0.15 ms over 3 s, read at the stated rate
   // with the disagreement as the time base's uncertainty.
   const std::string drifting = dir.File("drift.csv");
