@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cmath>
 #include <set>
 
@@ -144,9 +145,12 @@ void CheckPrintedSteps(const Eigen::VectorXd& time_s, const std::string& origin,
 
 std::string ProblemWithChannelName(const std::string& name) {
   if (name.empty()) return "empty channel name";
-  // "." and ".." are no HDF5 dataset names (a path's own and its parent's).
-  if (name == "time" || name == "." || name == ".." ||
-      name.find_first_of(",/\r\n") != std::string::npos) {
+  std::string lower = name;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  // "." and ".." are no HDF5 dataset names (a path's own and its parent's); "Time" is read back
+  // as the time column, and blanks at the ends are trimmed by every reader of a CSV header.
+  if (lower == "time" || name == "." || name == ".." || std::isspace(name.front()) ||
+      std::isspace(name.back()) || name.find_first_of(",/\r\n") != std::string::npos) {
     return fmt::format("invalid channel name '{}'", name);
   }
   return "";

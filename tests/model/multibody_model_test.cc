@@ -601,6 +601,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"output named time", "  tip_x: {type: displacement, point: tip",
                 "  time: {type: displacement, point: tip", "model.outputs.time",
                 "invalid channel name 'time'"},
+        // "Time" is read back as the time column of the CSV export; a CSV header trims blanks.
+        BadCase{"output named Time", "  tip_x: {type: displacement, point: tip",
+                "  Time: {type: displacement, point: tip", "model.outputs.Time",
+                "invalid channel name 'Time'"},
+        BadCase{"output name with a trailing blank", "  tip_x: {type: displacement, point: tip",
+                "  \"tip \": {type: displacement, point: tip", "model.outputs.tip ",
+                "invalid channel name 'tip '"},
         BadCase{"output name with a slash", "  tip_x: {type: displacement, point: tip",
                 "  a/b: {type: displacement, point: tip", "model.outputs.a/b",
                 "invalid channel name 'a/b'"},

@@ -37,12 +37,13 @@ struct Measurement {
   void Validate(const std::string& origin) const;
 };
 
-// Why `name` cannot be a channel of mbid's HDF5 and CSV files ("" when it can): empty, "time",
-// "." or "..", or with ',', '/' or a line break. The expected part of an error is
-// kChannelNameRule.
+// Why `name` cannot be a channel of mbid's HDF5 and CSV files ("" when it can): empty, "time"
+// in any case, "." or "..", blanks at either end, or with ',', '/' or a line break. The expected
+// part of an error is kChannelNameRule.
 std::string ProblemWithChannelName(const std::string& name);
 inline constexpr char kChannelNameRule[] =
-    "a name other than 'time', '.' or '..', without ',', '/' or line breaks";
+    "a name other than 'time' (in any case), '.' or '..', without blanks at its ends, ',', '/' "
+    "or line breaks";
 
 // Largest deviation of a sample time from the uniform grid t0 + j * tau, relative to tau, that
 // a measurement file may have (docs/interfaces).
