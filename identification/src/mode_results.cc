@@ -105,7 +105,14 @@ void MergeDriftingModes(const AnalysisRecord& record, const Estimate& estimate,
       Backbone backbone =
           CalcBackbone(alone, record.decimated_interval_s, record.decimated_start_time_s,
                        estimate.lambda[dominant], estimate.weights, options.refinement);
-      if (backbone.amplitude_dependent) {
+      // One mode's free decay never grows: windows whose amplitude rises again by more than
+      // 5 % are two modes beating (2.00 and 2.04 Hz of like shapes read as one mode drifting
+      // from 1.905 to 2.019 Hz), which stay two, doubted as too close to separate.
+      bool rises = false;
+      for (size_t w = 1; w < backbone.amplitude.size(); ++w) {
+        rises = rises || backbone.amplitude[w] > 1.05 * backbone.amplitude[w - 1];
+      }
+      if (backbone.amplitude_dependent && !rises) {
         const auto [low, high] =
             std::minmax_element(backbone.frequency_hz.begin(), backbone.frequency_hz.end());
         std::string merged;
