@@ -24,15 +24,12 @@ int RunIdentifyCommand(const std::string& data_path,
   records::ImportReport import;
   const Measurement measurement = records::ImportMeasurement(
       data_path, MergeImportOptions({}, common.import, nullptr), &import);
-  const std::string scenario =
-      data_path.size() > 3 && data_path.substr(data_path.size() - 3) == ".h5"
-          ? ReadScenarioYaml(data_path)
-          : std::string();
+  const std::string scenario = validation::ReadRecordScenario(data_path);
   // A record mbid simulated carries its test: after a forcing (an impulse, a burst) the free
   // decay starts where the forcing ends, as `mbid run` analyses it.
   std::string said;
   const identification::IdentificationOptions options =
-      validation::RecordFileOptions(data_path, given, &said);
+      validation::RecordFileOptions(scenario, data_path, given, &said);
   if (!said.empty() && !common.quiet) std::cerr << fmt::format("mbid: {}: {}\n", data_path, said);
   if (!common.quiet) {
     std::cerr << fmt::format("mbid: {}: {}\n", data_path, DescribeImport(import));

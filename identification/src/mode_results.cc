@@ -8,6 +8,7 @@
 #include <limits>
 #include <numeric>
 
+#include "internal.h"
 #include "mbid/identification/backbone.h"
 #include "mbid/identification/modal_fit.h"
 #include "mbid/identification/prony_svd.h"
@@ -34,24 +35,9 @@ Eigen::MatrixXd KeepModes(const AnalysisRecord& record, const Estimate& estimate
 }
 
 // A mode drifting with amplitude, split into two poles, has one shape: their modal assurance
-// criterion (channels weighed by their noise) is near 1; for two modes of their own shapes,
-// in other channels or out of phase, it is near 0.
+// criterion (ShapeCorrelation, channels weighed by their noise) is near 1; for two modes of
+// their own shapes, in other channels or out of phase, it is near 0.
 constexpr double kSameShape = 0.8;
-
-// |a^H W b|^2 / (a^H W a b^H W b) with W = diag(1 / noise^2): the MAC of two complex shapes with
-// each channel in units of its noise (a channel without noise counts as 1).
-double ShapeCorrelation(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b,
-                        const Eigen::VectorXd& noise) {
-  std::complex<double> ab = 0;
-  double aa = 0, bb = 0;
-  for (Eigen::Index c = 0; c < a.size(); ++c) {
-    const double w = c < noise.size() && noise[c] > 0 ? 1 / (noise[c] * noise[c]) : 1.0;
-    ab += std::conj(a[c]) * b[c] * w;
-    aa += std::norm(a[c]) * w;
-    bb += std::norm(b[c]) * w;
-  }
-  return aa > 0 && bb > 0 ? std::norm(ab) / (aa * bb) : 1.0;
-}
 
 // Poles within 3 % of each other are, in a free decay, one mode whose frequency drifts with
 // amplitude far more often than two modes the record resolves. Each such cluster is measured in

@@ -459,7 +459,8 @@ ReleaseDetection DetectRelease(const Measurement& record) {
       // At rest from `quiet` on, and what follows sets off too slowly to be seen as a change
       // (a pull): the next rest at a new level is looked for from there.
       change = quiet;
-      before = RestLevels(y.bottomRows(n - quiet), std::min(5, n - quiet));
+      const int head = std::min(5, n - quiet);
+      before = RestLevels(y.middleRows(quiet, head), head);
       passed_s = rest.start_time_s;
     }
   }

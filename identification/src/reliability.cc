@@ -8,6 +8,7 @@
 #include <complex>
 
 #include "coloured_noise.h"
+#include "internal.h"
 #include "mbid/common/channel_fault.h"
 #include "residual_windows.h"
 
@@ -278,16 +279,15 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
     if (a.amplitude.size() < 2 || a.amplitude.size() != b.amplitude.size()) return false;
     const double spread = std::hypot(a.std_frequency_hz, b.std_frequency_hz);
     if (!(std::abs(b.frequency_hz - a.frequency_hz) > 10 * spread)) return false;
-    std::complex<double> cross = 0;
-    double norm_a = 0, norm_b = 0;
-    for (Eigen::Index c = 0; c < a.amplitude.size(); ++c) {
-      const std::complex<double> x = std::polar(a.amplitude(c), a.phase_rad(c));
-      const std::complex<double> y = std::polar(b.amplitude(c), b.phase_rad(c));
-      cross += std::conj(x) * y;
-      norm_a += std::norm(x);
-      norm_b += std::norm(y);
-    }
-    return norm_a > 0 && norm_b > 0 && std::norm(cross) / (norm_a * norm_b) < 0.5;
+    const auto shape = [](const IdentifiedMode& mode) {
+      Eigen::VectorXcd z(mode.amplitude.size());
+      for (Eigen::Index c = 0; c < z.size(); ++c) {
+        z[c] = std::polar(mode.amplitude(c), mode.phase_rad(c));
+      }
+      return z;
+    };
+    // (A zero shape counts as alike: not told apart.)
+    return ShapeCorrelation(shape(a), shape(b)) < 0.5;
   };
   for (size_t k = 1; k < result->modes.size(); ++k) {
     const double low = result->modes[k - 1].frequency_hz;

@@ -428,7 +428,8 @@ PYBIND11_MODULE(_mbid, m) {
         const std::optional<std::string> path = AsPath(record_object);
         if (!scenario && path) {
           std::string said;
-          applied = mbid::validation::RecordFileOptions(*path, options, &said);
+          applied = mbid::validation::RecordFileOptions(mbid::validation::ReadRecordScenario(*path),
+                                                        *path, options, &said);
         }
         py::gil_scoped_release release;
         return scenario ? mbid::IdentifyTest(record, *scenario, applied)

@@ -498,9 +498,6 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
   Measurement m;
   ReadTimeBase(table, path, options, time_unit, &m, &r);
   std::vector<std::vector<double>> values = TakeValues(table, path, options, selected, &r);
-  for (const int j : r.filled_rows) {
-    r.filled_times_s.push_back(m.start_time_s + j * m.sample_interval_s);
-  }
   r.samples = values.empty() ? 0 : static_cast<int>(values.front().size());
 
   const Eigen::Index samples =

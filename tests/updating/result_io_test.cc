@@ -197,7 +197,8 @@ TEST(ResultIoTest, Hdf5GroupRoundTrips) {
   EXPECT_EQ(reader.ReadUnits("/updating/parameters/c_theta", "value"), "N*m/rad");
   EXPECT_TRUE(std::isnan(reader.ReadScalar("/updating/parameters/d_eta", "std")));
   EXPECT_EQ(reader.ReadScalar("/updating/parameters/c_theta/profile", "upper"), 9.6e6);
-  EXPECT_EQ(reader.ReadStringAttribute("/updating/parameters/c_theta/profile", "upper_open"), "true");
+  EXPECT_EQ(reader.ReadStringAttribute("/updating/parameters/c_theta/profile", "upper_open"),
+            "true");
   EXPECT_EQ(reader.ReadVector("/updating/parameters/c_theta/profile", "cost_rises")[0], 4.1);
   // '/' cannot be part of an HDF5 name: it becomes '_'.
   EXPECT_EQ(reader.ReadScalar("/updating/parameters/drop_1:payload_mass_kg", "value"), 650);

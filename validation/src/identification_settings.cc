@@ -110,20 +110,21 @@ identification::IdentificationOptions FreeDecayOptions(
   return options;
 }
 
-identification::IdentificationOptions RecordFileOptions(
-    const std::string& path, const identification::IdentificationOptions& options,
-    std::string* said) {
-  said->clear();
+std::string ReadRecordScenario(const std::string& path) {
   const std::string lower = records::LowerExtension(path);
-  if ((lower != ".h5" && lower != ".hdf5") ||
-      options.release != identification::ReleaseMode::kDetect ||
+  return lower == ".h5" || lower == ".hdf5" ? ReadScenarioYaml(path) : std::string();
+}
+
+identification::IdentificationOptions RecordFileOptions(
+    const std::string& scenario_yaml, const std::string& origin,
+    const identification::IdentificationOptions& options, std::string* said) {
+  said->clear();
+  if (scenario_yaml.empty() || options.release != identification::ReleaseMode::kDetect ||
       std::isfinite(options.window_start_s)) {
     return options;
   }
-  const std::string yaml = ReadScenarioYaml(path);
-  if (yaml.empty()) return options;
   try {
-    const Scenario test = LoadScenarioFromText(yaml, path);
+    const Scenario test = LoadScenarioFromText(scenario_yaml, origin);
     if (!test.has_excitation || !(test.excitation.CalcForcingEndTime() > 0)) return options;
     *said = fmt::format("free decay after the {} that ends at {:.6g} s (the record's scenario)",
                         test.excitation.type_name(), test.excitation.CalcForcingEndTime());

@@ -39,10 +39,9 @@ struct ImportReport {
   std::string dialect;               // text files: "';'-separated, decimal comma, ..."
   std::vector<std::string> mapping;  // e.g. "psi <- column 3 (Boom angle)"
   int filled_samples = 0;            // cells interpolated by GapFill::kLinear
-  // The times (the record's own, s) of the samples with an interpolated cell: no measurement
-  // there, which the updating's credibility leaves out of its look for spikes.
-  std::vector<double> filled_times_s;
-  std::vector<int> filled_rows;          // their sample indices in the record as read
+  // The samples with an interpolated cell, as indices of the record as read: no measurement
+  // there, which the updating leaves out of its look for spikes.
+  std::vector<int> filled_rows;
   int samples = 0;                       // the samples read
   std::vector<std::string> conversions;  // e.g. "theta: deg -> rad (x 0.0174533)"
   // What the file does not say and may have been misread: a column named `time` without a unit

@@ -24,12 +24,16 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
 identification::IdentificationOptions FreeDecayOptions(
     identification::IdentificationOptions options, const simulation::Excitation& excitation);
 
-// The options for the record file `path` as `mbid identify` and the Python module's identify()
-// take it: an HDF5 record mbid simulated carries its test, and after a forcing (an impulse, a
+// The scenario an HDF5 record file mbid wrote carries (/scenario), or "" (other files too).
+std::string ReadRecordScenario(const std::string& path);
+
+// The options for a record file whose scenario text is `scenario_yaml` (ReadRecordScenario) as
+// `mbid identify` and the Python module's identify() take it: after a forcing (an impulse, a
 // burst) its free decay starts where the forcing ends (FreeDecayOptions); the user's release or
-// window still win. `said` gets the line that tells the user so, else "".
+// window still win, and a scenario this version cannot read changes nothing. `origin` names the
+// file; `said` gets the line that tells the user so, else "".
 identification::IdentificationOptions RecordFileOptions(
-    const std::string& path, const identification::IdentificationOptions& options,
-    std::string* said);
+    const std::string& scenario_yaml, const std::string& origin,
+    const identification::IdentificationOptions& options, std::string* said);
 
 }  // namespace mbid::validation
