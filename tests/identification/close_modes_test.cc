@@ -85,27 +85,42 @@ TEST(CloseModesTest, APairAbsorbedByAStrongerModeIsWarnedOf) {
   EXPECT_GE(warned, 3);
 }
 
+// `modes` in channels psi and phi at 100 Hz for `samples` samples, 1e-4 noise from `seed`,
+// identified with the defaults: both modes kept, not merged as one mode drifting with
+// amplitude, each frequency within 3 of its standard deviations.
+ModalResult ExpectBothModesKept(const std::vector<testing::TrueMode>& modes, int samples,
+                                int seed) {
+  SignalSpec spec;
+  spec.channels = {"psi", "phi"};
+  spec.sample_interval_s = 0.01;
+  spec.samples = samples;
+  spec.modes = modes;
+  const ModalResult result = Identify(
+      MakeRecord(spec, testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(2, 1e-4), seed)),
+      {});
+  EXPECT_FALSE(testing::Mentions(result.warnings, "one mode drifting with amplitude"))
+      << ::testing::PrintToString(result.warnings);
+  EXPECT_EQ(result.modes.size(), modes.size());
+  for (size_t k = 0; k < std::min(modes.size(), result.modes.size()); ++k) {
+    const IdentifiedMode& mode = result.modes[k];
+    EXPECT_NEAR(mode.frequency_hz, modes[k].frequency_hz, 3 * mode.std_frequency_hz) << k;
+  }
+  return result;
+}
+
 // A mast's two bending directions, 2.0 and 2.06 Hz (3 % apart), each in a channel of its own at
 // 40 dB: one mode drifting with amplitude keeps its shape, these two do not. They were merged as
 // one drifting mode, the 2.06 Hz one dropped with all of its channel's signal (an audit's
 // record), and the result called unreliable; both are modes of the structure.
 TEST(CloseModesTest, CloseModesOfOtherShapesAreNoDriftingMode) {
-  SignalSpec spec;
-  spec.channels = {"psi", "phi"};
-  spec.sample_interval_s = 0.01;
-  spec.samples = 2000;
-  spec.modes = {{2.0, 0.30, {0.01, 1e-5}, {0.2, 1.0}}, {2.06, 0.35, {1e-5, 0.01}, {0.4, -0.7}}};
-  const ModalResult result = Identify(
-      MakeRecord(spec, testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(2, 1e-4), 3)), {});
-  EXPECT_FALSE(testing::Mentions(result.warnings, "one mode drifting with amplitude"))
-      << ::testing::PrintToString(result.warnings);
+  const std::vector<testing::TrueMode> modes = {{2.0, 0.30, {0.01, 1e-5}, {0.2, 1.0}},
+                                                {2.06, 0.35, {1e-5, 0.01}, {0.4, -0.7}}};
+  const ModalResult result = ExpectBothModesKept(modes, 2000, 3);
   ASSERT_EQ(result.modes.size(), 2u);
   for (size_t k = 0; k < 2; ++k) {
     // Each within 3 of its own standard deviations (2 modes x 2 quantities).
     const IdentifiedMode& mode = result.modes[k];
-    EXPECT_NEAR(mode.frequency_hz, spec.modes[k].frequency_hz, 3 * mode.std_frequency_hz) << k;
-    EXPECT_NEAR(mode.decay_rate_per_s, spec.modes[k].decay_per_s, 3 * mode.std_decay_rate_per_s)
-        << k;
+    EXPECT_NEAR(mode.decay_rate_per_s, modes[k].decay_per_s, 3 * mode.std_decay_rate_per_s) << k;
   }
   EXPECT_TRUE(result.reliable) << ::testing::PrintToString(result.reasons);
 }
@@ -115,20 +130,8 @@ TEST(CloseModesTest, CloseModesOfOtherShapesAreNoDriftingMode) {
 // record). One mode's free decay never grows again; these windows' amplitude does, so the two
 // stay, doubted as too close to separate.
 TEST(CloseModesTest, TwoModesOfLikeShapesThatBeatAreNoDriftingMode) {
-  SignalSpec spec;
-  spec.channels = {"psi", "phi"};
-  spec.sample_interval_s = 0.01;
-  spec.samples = 1500;
-  spec.modes = {{2.0, 0.15, {0.01, 0.009}, {0.0, 0.0}}, {2.04, 0.18, {0.01, 0.011}, {0.7, 0.7}}};
-  const ModalResult result = Identify(
-      MakeRecord(spec, testing::SynthesizeNoisy(spec, Eigen::VectorXd::Constant(2, 1e-4), 11)), {});
-  EXPECT_FALSE(testing::Mentions(result.warnings, "one mode drifting with amplitude"))
-      << ::testing::PrintToString(result.warnings);
-  ASSERT_EQ(result.modes.size(), 2u);
-  for (size_t k = 0; k < 2; ++k) {
-    const IdentifiedMode& mode = result.modes[k];
-    EXPECT_NEAR(mode.frequency_hz, spec.modes[k].frequency_hz, 3 * mode.std_frequency_hz) << k;
-  }
+  const ModalResult result = ExpectBothModesKept(
+      {{2.0, 0.15, {0.01, 0.009}, {0.0, 0.0}}, {2.04, 0.18, {0.01, 0.011}, {0.7, 0.7}}}, 1500, 11);
   EXPECT_TRUE(testing::Mentions(result.reasons, "two the record cannot separate"))
       << ::testing::PrintToString(result.reasons);
 }
