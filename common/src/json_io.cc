@@ -30,21 +30,24 @@ std::string EscapePointerToken(const std::string& key) {
 }
 
 // nlohmann::json would print NaN/Inf as null, silently losing the fact that a result is bad.
-void CheckFinite(const nlohmann::json& value, const std::string& pointer) {
+// A negative zero (the decay of a rigid-body pole, a phase of nothing) prints as "-0.0", which
+// reads as a sign the result does not have: it is written as 0.0.
+void CheckFiniteUnsignZeros(nlohmann::json& value, const std::string& pointer) {
   if (value.is_number_float()) {
     const double v = value.get<double>();
+    if (v == 0.0) value = 0.0;
     if (!std::isfinite(v)) {
       throw std::invalid_argument(fmt::format(
           "WriteJson: the value at '{}' is {}; JSON has no NaN or infinity",
           pointer.empty() ? "/" : pointer, std::isnan(v) ? "NaN" : (v > 0 ? "+Inf" : "-Inf")));
     }
   } else if (value.is_object()) {
-    for (const auto& item : value.items()) {
-      CheckFinite(item.value(), pointer + "/" + EscapePointerToken(item.key()));
+    for (auto& item : value.items()) {
+      CheckFiniteUnsignZeros(item.value(), pointer + "/" + EscapePointerToken(item.key()));
     }
   } else if (value.is_array()) {
     for (size_t i = 0; i < value.size(); ++i) {
-      CheckFinite(value[i], pointer + "/" + std::to_string(i));
+      CheckFiniteUnsignZeros(value[i], pointer + "/" + std::to_string(i));
     }
   }
 }
@@ -52,8 +55,9 @@ void CheckFinite(const nlohmann::json& value, const std::string& pointer) {
 }  // namespace
 
 void WriteJson(const nlohmann::json& value, const std::string& path) {
-  CheckFinite(value, "");
-  const std::string text = value.dump(2) + "\n";
+  nlohmann::json written = value;
+  CheckFiniteUnsignZeros(written, "");
+  const std::string text = written.dump(2) + "\n";
   if (path == "-") {
     std::cout << text << std::flush;
     if (!std::cout) throw std::runtime_error("cannot write JSON to standard output");

@@ -10,6 +10,7 @@
 #include "mbid/identification/release.h"
 #include "mbid/model/linear_model.h"
 #include "mbid/updating/settings.h"
+#include "mbid/validation/release_cut.h"
 #include "mbid/validation/release_profile.h"
 #include "mbid/validation/two_route_update.h"
 
@@ -203,6 +204,24 @@ TEST(UpdatingGlueTest, TwoDetectedReleasesArePlacedTogether) {
     // releases' uncertainty): the releases' leftover misplacement is no confident error.
     EXPECT_NEAR(best.Find(name).value, truth, 2 * best.Find(name).std) << name;
   }
+}
+
+// A release given before the record's first sample: the logger started late. The record is kept
+// whole and starts that long after the release, where the test's simulation starts (the reference
+// crane's CSV cut 0.5 s after its release, --release-time-s -0.5, updates to the truth within 2
+// std in `mbid update`).
+TEST(UpdatingGlueTest, AReleaseGivenBeforeTheRecordStartsItThatLongAfter) {
+  const updating::testing::Crane crane =
+      updating::testing::LoadCrane(updating::testing::kReferenceScenario);
+  Measurement record = updating::testing::SimulateExact(crane, 1.0, 50.0);
+  record.source = "import";  // a logger's file, not mbid's own
+  const Eigen::Index samples = record.values.rows();
+  const validation::AppliedRelease applied =
+      validation::CutRecordAtRelease(&record, "logger.csv", {false, -0.5}, crane.excitation);
+  EXPECT_EQ(applied.how, "given");
+  EXPECT_EQ(applied.release_time_s, -0.5);
+  EXPECT_EQ(record.values.rows(), samples);      // nothing cut
+  EXPECT_NEAR(record.start_time_s, 0.5, 1e-12);  // 0 - (-0.5)
 }
 
 // A record cut 6 samples late (a noisy onset at a high rate is detected so far off): the

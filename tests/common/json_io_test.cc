@@ -53,6 +53,14 @@ TEST(JsonIoTest, DashWritesToStandardOutput) {
   EXPECT_EQ(::testing::internal::GetCapturedStdout(), "{\n  \"a\": 1\n}\n");  // as written
 }
 
+// A rigid-body pole's decay rate is -Re(0) = -0.0: no sign the result has, so none is printed.
+TEST(JsonIoTest, NegativeZeroIsWrittenAsZero) {
+  ::testing::internal::CaptureStdout();
+  WriteJson({{"decay_rate_per_s", -0.0}, {"phase_rad", {-0.0, -1.5}}}, "-");
+  EXPECT_EQ(::testing::internal::GetCapturedStdout(),
+            "{\n  \"decay_rate_per_s\": 0.0,\n  \"phase_rad\": [\n    0.0,\n    -1.5\n  ]\n}\n");
+}
+
 TEST(JsonIoTest, NonFiniteNumberThrowsNamingTheKeyAndWritesNothing) {
   TempDir dir;
   nlohmann::json summary = Summary();
