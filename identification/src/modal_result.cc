@@ -98,6 +98,7 @@ nlohmann::json ModalResultToJson(const ModalResult& result) {
   }
   json["release_time_s"] = result.release_time_s;
   json["release"] = result.release;
+  if (result.next_excitation_s) json["next_excitation_s"] = *result.next_excitation_s;
   json["start_time_s"] = result.start_time_s;
   json["decimation"] = result.decimation;
   json["max_frequency_hz"] = NumberOrNull(result.max_frequency_hz);
@@ -164,6 +165,9 @@ void WriteModalResult(H5Writer& writer, const ModalResult& result, const std::st
   writer.WriteScalar(group, "max_frequency_hz", result.max_frequency_hz, "Hz");
   writer.WriteScalar(group, "release_time_s", result.release_time_s, "s");
   writer.WriteStringAttribute(group, "release", result.release);
+  if (result.next_excitation_s) {
+    writer.WriteScalar(group, "next_excitation_s", *result.next_excitation_s, "s");
+  }
   writer.WriteStringAttribute(group, "reliable", result.reliable ? "true" : "false");
   writer.WriteStrings(group, "reasons", result.reasons);
   writer.WriteScalar(group, "significance_threshold", result.significance_threshold, "1");

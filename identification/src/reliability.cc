@@ -94,7 +94,8 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
     const std::string what = fmt::format(
         "the residual from {:.4g} to {:.4g} s has {:.3g} times the power it has elsewhere: "
         "something there is not in the modes (a missed, heavily damped mode, a transient, a "
-        "start before the free decay)",
+        "start before the free decay, a second excitation before this decay came to rest: "
+        "end the analysis before it, --window-end-s)",
         from_s, from_s + windows.excess->samples * tau, windows.excess->power_ratio);
     (windows.excess->power_ratio >= 3 ? reasons : result->warnings).push_back(what);
   }

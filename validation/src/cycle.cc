@@ -69,6 +69,9 @@ std::vector<RunTest> AcquireTests(const Scenario& scenario, const model::Mechani
       if (test.release->clipped_until_s) {
         say(fmt::format("test {}: {}", test.name, test.release->DescribeClipped()));
       }
+      if (test.release->next_excitation_s) {
+        say(fmt::format("test {}: {}", test.name, test.release->next_excitation));
+      }
     }
     say(fmt::format("test {}: {} ({} samples x {} channels)", test.name, test.origin,
                     test.measured.samples(), test.measured.channel_count()));

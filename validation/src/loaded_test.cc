@@ -104,6 +104,10 @@ std::vector<LoadedTest> LoadTests(
                                  tests.back().release.DescribeClipped());
       }
     }
+    if (tests.back().release.next_excitation_s) {  // samples left out at the end
+      std::cerr << fmt::format("mbid: warning: {}: {}\n", tests.back().path,
+                               tests.back().release.next_excitation);
+    }
   }
   return tests;
 }

@@ -34,6 +34,7 @@ nlohmann::json AppliedRelease::ToJson() const {
   // A forced test starts before its free decay: where the record's t = 0 is.
   if (forcing_end_s > 0) json["test_start_s"] = release_time_s;
   if (clipped_until_s) json["clipped_until_s"] = *clipped_until_s;
+  if (next_excitation_s) json["next_excitation_s"] = *next_excitation_s;
   if (detected_time_s) json["detected_release_time_s"] = *detected_time_s;
   if (std_s) json["release_std_s"] = *std_s;
   return json;
@@ -118,6 +119,30 @@ AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin
                                   const ReleaseChoice& choice,
                                   const simulation::Excitation& excitation) {
   AppliedRelease applied = CutAtReleaseOnly(record, origin, choice, excitation);
+  if (applied.how != "none") {
+    // A second test in the same record (a reload and a second drop, a knock) after this decay
+    // came to rest is no part of it: the fit ends before it.
+    // In the record's time as it now is: a cut record's origin is its release (or a forced
+    // test's start), a forced test's uncut record keeps the file's.
+    const bool uncut = applied.how == "forced test";
+    const double decay_start_s = (uncut ? record->start_time_s : 0.0) + applied.forcing_end_s;
+    const std::optional<identification::NextExcitation> next =
+        identification::FindNextExcitation(*record, decay_start_s);
+    if (next) {
+      const double tau = record->sample_interval_s;
+      const auto kept =
+          static_cast<Eigen::Index>(std::ceil((next->time_s - record->start_time_s) / tau - 1e-6));
+      record->values = record->values.topRows(kept).eval();
+      // In the record's own time, as read from the file.
+      const double origin_s = uncut ? 0.0 : applied.release_time_s;
+      applied.next_excitation_s = next->time_s + origin_s;
+      applied.next_excitation = fmt::format(
+          "the structure is at rest again from {:.6g} s and set off again at {:.6g} s (in the "
+          "file's time): a second excitation (a reload and release, a knock) that is no part of "
+          "this test; the fit ends before it",
+          next->rest_s + origin_s, *applied.next_excitation_s);
+    }
+  }
   if (applied.how == "forced test") return applied;  // its forcing belongs to the fit
   // Clipped samples are no measured values: the fit and the identification both start after
   // the last one (the simulation still starts at the release).

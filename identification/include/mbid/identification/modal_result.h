@@ -66,6 +66,9 @@ struct ModalResult {
   // found: "detected", "record start" (nothing at rest before the decay), "given" or "none".
   double release_time_s = 0;
   std::string release = "record start";
+  // Where a second excitation sets the structure off again after this free decay came to rest
+  // (release.h: FindNextExcitation), in the record's time: the analysis ends before it.
+  std::optional<double> next_excitation_s;
   int decimation = 1;
   double max_frequency_hz = 0;  // top of the analysed band
   std::string method;           // "hankel-nls" | "prony-svd"

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,19 @@ struct ReleaseDetection {
 
 // Finds the release in `record`'s channels (all of them). Never throws on a valid record.
 ReleaseDetection DetectRelease(const Measurement& record);
+
+// A second excitation in the record after the free decay that starts at `release_time_s`: the
+// structure comes to rest (a window as long as a quarter of the time since the release, at least
+// 20 samples, within 12 noise standard deviations, no drift) and then leaves that rest by 8 of
+// them, swinging again or moving within the rest's length by a tenth of the decay's range (at
+// least 20 noise std): a reload and a second drop, a knock. A sensor's drift is none. Where the
+// decay never comes to rest within the record, none is looked for.
+struct NextExcitation {
+  double rest_s = 0;        // where the structure is at rest again, in the record's time
+  double time_s = 0;        // where it sets off again: the free decay's samples end before it
+  std::string description;  // one line for the user
+};
+std::optional<NextExcitation> FindNextExcitation(const Measurement& record, double release_time_s);
 
 // A release from rest is where the velocity of every channel vanishes: the reconstruction of
 // `modes` (identified on the decay after `coarse_time_s`) differentiated in time. Searched from

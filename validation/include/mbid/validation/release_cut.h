@@ -42,6 +42,10 @@ struct AppliedRelease {
   // clipped one, this many seconds after the release; `clipped` says which channel and how.
   std::optional<double> clipped_until_s;
   std::string clipped;
+  // A second excitation after the decay came to rest (identification/release.h:
+  // FindNextExcitation), in the record's own time: the record is cut before it; the line says so.
+  std::optional<double> next_excitation_s;
+  std::string next_excitation;
   // A detected release the fit placed (Place): the instant as detected, and the placed one's
   // standard deviation; release_time_s is then the placed instant.
   std::optional<double> detected_time_s;
