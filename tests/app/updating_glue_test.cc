@@ -2,6 +2,7 @@
 // paper chose its four "main" modes among all it found).
 #include <gtest/gtest.h>
 
+#include <random>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -222,6 +223,47 @@ TEST(UpdatingGlueTest, AReleaseGivenBeforeTheRecordStartsItThatLongAfter) {
   EXPECT_EQ(applied.release_time_s, -0.5);
   EXPECT_EQ(record.values.rows(), samples);      // nothing cut
   EXPECT_NEAR(record.start_time_s, 0.5, 1e-12);  // 0 - (-0.5)
+}
+
+// A logger left running through a second test: held, the crane's 14 s decay (at rest from about
+// 11 s), a 1 s reload, held, a second drop. The record is cut at the release and before the
+// reload, which the applied release names in the file's time (identification's
+// NextExcitationTest checks the search itself).
+TEST(UpdatingGlueTest, ASecondTestInTheRecordIsCutOff) {
+  const updating::testing::Crane crane =
+      updating::testing::LoadCrane(updating::testing::kReferenceScenario);
+  const Eigen::MatrixXd decay = updating::testing::SimulateExact(crane, 14.0, 100.0).values;
+  const Eigen::Index n = decay.rows();
+  Eigen::MatrixXd values(100 + n + 200 + n, decay.cols());
+  values.topRows(100) = decay.row(0).replicate(100, 1);
+  values.middleRows(100, n) = decay;
+  for (int j = 0; j < 100; ++j) {  // a raised cosine back to the held level
+    const double s = 0.5 * (1 - std::cos(M_PI * j / 100));
+    values.row(100 + n + j) = (1 - s) * decay.row(n - 1) + s * decay.row(0);
+  }
+  values.middleRows(200 + n, 100) = decay.row(0).replicate(100, 1);
+  values.bottomRows(n) = decay;
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> noise(0.0, 1e-5);  // the paper's sensors
+  for (Eigen::Index j = 0; j < values.size(); ++j) values.data()[j] += noise(rng);
+  Measurement record;
+  record.channels = {"psi", "phi"};
+  record.units = {"rad", "rad"};
+  record.sample_interval_s = 0.01;
+  record.values = values;
+  const validation::AppliedRelease applied =
+      validation::CutRecordAtRelease(&record, "two-tests.csv", {}, crane.excitation);
+  EXPECT_EQ(applied.how, "detected");
+  EXPECT_NEAR(applied.release_time_s, 1.0, 0.01);
+  ASSERT_TRUE(applied.next_excitation_s.has_value());
+  const double reload_s = 0.01 * static_cast<double>(100 + n);  // in the file's time
+  EXPECT_GE(*applied.next_excitation_s, reload_s);
+  EXPECT_LE(*applied.next_excitation_s, reload_s + 0.06);  // 3 noise std within 4 samples
+  // Nothing of the reload is left: the record ends before it, in the cut record's time.
+  EXPECT_LT(record.start_time_s + 0.01 * static_cast<double>(record.samples() - 1),
+            *applied.next_excitation_s - applied.release_time_s);
+  EXPECT_GT(record.samples(), 1300);  // the decay is kept
+  EXPECT_NE(applied.next_excitation.find("a second excitation"), std::string::npos);
 }
 
 // A record cut 6 samples late (a noisy onset at a high rate is detected so far off): the
