@@ -358,16 +358,19 @@ TEST(FacadeTest, AnOpenProfileMakesTheVerdictInconclusive) {
 
 // `passed` needs a credible fit. Weights that state the noise 30 % low (7e-6 rad against the
 // record's 1e-5) leave a white excess, chi^2/dof about 2, taken for a noise level stated too low:
-// the standard deviations are inflated by about 1.4 and every joint stays determined, but the fit
-// is not credible, and a trial's hammer blow 10 % off had passed the same way. Inconclusive, with
-// the credibility's reason.
+// the standard deviations are inflated by about 1.4, but the fit is not credible (a trial's hammer
+// blow 10 % off had passed the same way), so no joint is determined (interfaces.md: `determined`
+// needs a credible fit; a hanger's mass 30 % off was "determined" 3046 stds off so). Inconclusive,
+// with the credibility's reason.
 TEST(FacadeTest, AFitThatIsNotCredibleDoesNotPass) {
   const mbid::ValidationResult result = mbid::RunValidationCycle(mbid::LoadScenarioFromText(
       ReferenceText(4, "updating: {noise_std_rad: 7.0e-6, global_search: {enabled: false}}\n"),
       "understated.yaml"));
   EXPECT_FALSE(result.updated.credible);
-  EXPECT_TRUE(result.updated.undetermined.empty())
+  EXPECT_EQ(result.updated.undetermined.size(), 8u)
       << ::testing::PrintToString(result.updated.undetermined);
+  EXPECT_NE(result.updated.parameters.at("c_alpha").why_undetermined.find("not credible"),
+            std::string::npos);
   EXPECT_EQ(result.verdict, mbid::Verdict::kInconclusive);
   bool named = false;
   for (const std::string& reason : result.reasons) {

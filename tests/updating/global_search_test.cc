@@ -352,7 +352,10 @@ TEST(CredibilityTest, ColouredResidualInflatesTheStandardDeviations) {
   EXPECT_NEAR(result.tests[0].correlation_time[0], 8.9, 1.0);
   EXPECT_NEAR(result.std_inflation, std::sqrt(8.9), 0.3);
   EXPECT_FALSE(result.credible);
-  EXPECT_TRUE(result.parameters[0].determined);  // 3% inflated, still below 30%
+  // 3 % inflated, below 30 %, but a fit that is not credible determines nothing: a model that
+  // lacks something leaves such a residual too.
+  EXPECT_FALSE(result.parameters[0].determined);
+  EXPECT_NE(result.parameters[0].why_undetermined.find("not credible"), std::string::npos);
 }
 
 TEST(CredibilityTest, WhiteExcessOverTheNoiseOnlyInflates) {

@@ -252,6 +252,15 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
       p.why_undetermined =
           spiked ? "the fit does not explain the records (a residual sample far beyond the noise)"
                  : "the fit does not explain the records (a residual above the noise, not white)";
+    } else if (!result.credible && p.test.empty()) {
+      // Not white or above the noise, though within what chi^2 lets pass: a model that lacks
+      // something leaves such a residual too (a hanger's mass 30 % off: chi^2/dof 0.94 under an
+      // identification's noise 20 % high, correlation time 5 samples, c_q1 3046 stds off).
+      p.determined = false;
+      p.why_undetermined = fmt::format(
+          "the fit is not credible: its residual is above the noise or not white (standard "
+          "deviations scaled up by {:.3g}), as a model that lacks something leaves it",
+          result.std_inflation);
     } else if (!MarkIfSpreadUndetermined(p, result.std_inflation,
                                          options.undetermined_relative_std) &&
                !p.determined && p.why_undetermined.empty()) {
