@@ -35,6 +35,12 @@ const std::map<std::string, std::string>& Aliases() {
       {"gn", "standard_free_fall"},
       {"g0", "standard_free_fall"},
       {"g_n", "standard_free_fall"},
+      // Upper-case spellings of loggers' exports that udunits2 does not know.
+      {"DEG", "degree"},
+      {"Deg", "degree"},
+      {"RAD", "rad"},
+      {"MM", "mm"},
+      {"Nm", "N.m"},
   };
   return aliases;
 }
@@ -137,14 +143,33 @@ std::string UnknownUnitHint(const std::string& text) {
                      text);
 }
 
-// udunits2 reads a bare `g` as the gram; on a vibration logger it almost always means standard
-// gravity. Neither is guessed: the user writes gn or gram.
-void RefuseBareG(const std::string& text, const std::string& source, const std::string& field) {
-  if (text == "g" || text == "G") {
-    throw InputError(source, field,
-                     fmt::format("unit '{}' is ambiguous (udunits2 reads the gram)", text),
-                     "gn for standard gravity (9.80665 m/s^2), or gram for a mass");
-  }
+// Spellings loggers write that udunits2 reads as another unit: never guessed, the user writes
+// what is meant. A bare `g` is the gram to udunits2 and almost always standard gravity on a
+// vibration logger; `mg` the milligram, not milli-g; `Grad` the giga-radian, not the German
+// "Grad" (degree, a trial's inclinometer read 1e9 times too large); `ms-2` per millisecond
+// squared, not the British m s-2 (1e6 times too large); `Mrad` the mega-radian, not mrad.
+void RefuseAmbiguous(const std::string& text, const std::string& source, const std::string& field) {
+  struct Reading {
+    const char* udunits;
+    const char* expected;
+  };
+  static const std::map<std::string, Reading> readings = {
+      {"g", {"the gram", "gn for standard gravity (9.80665 m/s^2), or gram for a mass"}},
+      {"G", {"the gram", "gn for standard gravity (9.80665 m/s^2), or gram for a mass"}},
+      {"mg", {"the milligram", "'0.001 gn' for milli-g, or milligram for a mass"}},
+      {"Grad", {"the giga-radian", "deg for degrees (German Grad)"}},
+      {"Mrad", {"the mega-radian", "mrad for milliradians"}},
+      {"ms-1", {"per millisecond", "m/s (or m s-1, with a space)"}},
+      {"ms^-1", {"per millisecond", "m/s (or m s-1, with a space)"}},
+      {"ms-2", {"per millisecond squared", "m/s^2 (or m s-2, with a space)"}},
+      {"ms^-2", {"per millisecond squared", "m/s^2 (or m s-2, with a space)"}},
+  };
+  const auto found = readings.find(text);
+  if (found == readings.end()) return;
+  throw InputError(
+      source, field,
+      fmt::format("unit '{}' is ambiguous (udunits2 reads {})", text, found->second.udunits),
+      found->second.expected);
 }
 
 }  // namespace
@@ -169,7 +194,7 @@ std::string SiUnitFor(const std::string& unit, const std::string& source,
 
 std::string SiUnitByUdunits(const std::string& unit, const std::string& source,
                             const std::string& field) {
-  RefuseBareG(unit, source, field);
+  RefuseAmbiguous(unit, source, field);
   const std::lock_guard<std::mutex> lock(UnitsMutex());
   const UnitPtr parsed = Parse(unit);
   if (!parsed) {
@@ -184,7 +209,7 @@ std::string SiUnitByUdunits(const std::string& unit, const std::string& source,
 UnitConversion FindConversion(const std::string& from, const std::string& to,
                               const std::string& source, const std::string& field) {
   if (from == to) return {};
-  RefuseBareG(from, source, field);
+  RefuseAmbiguous(from, source, field);
   const std::lock_guard<std::mutex> lock(UnitsMutex());
   const UnitPtr a = Parse(from);
   if (!a) {

@@ -82,6 +82,19 @@ TEST(UnitsTest, RefusesUnknownAndIncompatibleUnits) {
   const InputError milli = CatchInputError([] { FindConversion("mg", "m/s^2", "f", "c"); });
   EXPECT_THAT(milli.expected(), HasSubstr("'0.001 gn'"));
   EXPECT_NEAR(FindConversion("0.001 gn", "m/s^2", "f", "c").scale, 9.80665e-3, 1e-15);
+  // Without a model the target is the column's own SI unit: mg was read as a mass, Grad (German
+  // for degree) as 1e9 rad, ms-2 (British m s-2) as 1e6 s-2, each without a word.
+  for (const char* unit : {"mg", "Grad", "ms-2", "ms^-2", "ms-1", "Mrad", "G"}) {
+    const InputError ambiguous = CatchInputError([unit] { SiUnitFor(unit, "f", "c"); });
+    EXPECT_THAT(ambiguous.problem(), HasSubstr("ambiguous")) << unit;
+  }
+  EXPECT_THAT(CatchInputError([] { SiUnitFor("Grad", "f", "c"); }).expected(), HasSubstr("deg"));
+  // Upper-case spellings of loggers' exports.
+  EXPECT_DOUBLE_EQ(FindConversion("DEG", "rad", "f", "c").scale, M_PI / 180);
+  EXPECT_DOUBLE_EQ(FindConversion("Deg", "rad", "f", "c").scale, M_PI / 180);
+  EXPECT_TRUE(FindConversion("RAD", "rad", "f", "c").scale == 1.0);
+  EXPECT_DOUBLE_EQ(FindConversion("MM", "m", "f", "c").scale, 1e-3);
+  EXPECT_EQ(SiUnitFor("Nm", "f", "c"), "N*m");
 }
 
 TEST(UnitsTest, ConcurrentUseIsSafe) {
