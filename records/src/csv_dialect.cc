@@ -119,14 +119,30 @@ bool IsCommentOrBlank(const std::string& line) {
   return trimmed.empty() || trimmed.front() == '#';
 }
 
+// Whether the content lines from `first` on (up to kRowsChecked of them) are all rows of
+// `columns` fields that are data: a header candidate's rows must go on as it says. Two data lines
+// of a ';' file with decimal commas ("1,49;34,999;-12" then "1,5;35;-11,998") split on ',' as a
+// 3-field "header" and a row; the line after had 4 fields, and the file was refused.
+bool RowsFollow(const std::vector<TextLine>& lines, const std::vector<int>& content, size_t first,
+                size_t columns, char separator) {
+  constexpr size_t kRowsChecked = 20;
+  for (size_t k = first; k < content.size() && k < first + kRowsChecked; ++k) {
+    auto row = SplitFields(lines[static_cast<size_t>(content[k])].text, separator);
+    if (!FitRow(&row, columns) || !IsDataRow(row, separator)) return false;
+  }
+  return true;
+}
+
 bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
   std::vector<int> content;  // indices of lines that are neither comments nor blank
   for (size_t i = 0; i < lines.size(); ++i) {
     if (!IsCommentOrBlank(lines[i].text)) content.push_back(static_cast<int>(i));
   }
-  bool found = false;
+  // A header stands among the first lines, after a preamble of at most this many.
+  constexpr size_t kMaxPreamble = 1000;
+  bool found = false, found_follows = false;
   for (const char separator : {',', ';', '\t'}) {
-    for (size_t k = 0; k + 1 < content.size(); ++k) {
+    for (size_t k = 0; k + 1 < content.size() && k <= kMaxPreamble; ++k) {
       const auto header = SplitFields(lines[content[k]].text, separator);
       if (header.size() < 2 || IsDataRow(header, separator)) continue;
       auto next = SplitFields(lines[content[k + 1]].text, separator);
@@ -138,9 +154,15 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
         if (!FitRow(&data, header.size()) || !IsDataRow(data, separator)) continue;
         units_row = content[k + 1];
       }
-      // The most fields wins ("a,b;c" is not a ';' file); ties go to the earlier separator.
-      if (!found || static_cast<int>(header.size()) > dialect->field_count) {
+      // A header whose rows go on as it says wins; then the most fields ("a,b;c" is not a ';'
+      // file); ties go to the earlier separator. A header whose rows break off soon still
+      // stands where it is the only one (the bad row's error then names its cell).
+      const bool follows =
+          RowsFollow(lines, content, units_row < 0 ? k + 1 : k + 2, header.size(), separator);
+      if (!found || (follows && !found_follows) ||
+          (follows == found_follows && static_cast<int>(header.size()) > dialect->field_count)) {
         found = true;
+        found_follows = follows;
         dialect->separator = separator;
         dialect->header = content[k];
         dialect->units_row = units_row;

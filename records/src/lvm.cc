@@ -393,7 +393,10 @@ class LvmReader {
       RawColumn column;
       column.name = first.names.empty() ? fmt::format("channel {}", c + 1) : first.names[c];
       column.unit = KeyValue(first, "Y_Unit_Label", c);
-      column.where = fmt::format("channel {} ({})", c + 1, column.name);
+      // LabVIEW and DAQmx label an accelerometer's channel "g": standard gravity, as in UFF58,
+      // not the gram the unit library reads (the format's own example was refused).
+      if (column.unit == "g") column.unit = "gn";
+      column.where = fmt::format("channel {}", c + 1);  // import.cc adds the name
       table.columns.push_back(std::move(column));
     }
     if (x_columns_ == XColumns::kNone) {

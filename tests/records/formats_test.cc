@@ -277,7 +277,9 @@ TEST(Lvm, ReadsTabSeparatedDecimalCommaFixture) {
   EXPECT_DOUBLE_EQ(table.printed_resolution, 1e-6);  // X values print six decimals
   ASSERT_EQ(table.columns.size(), 2u);               // Channels 2
   EXPECT_EQ(table.columns[0].name, "accel");
-  EXPECT_EQ(table.columns[0].unit, "g");
+  // LabVIEW's "g" of an accelerometer is standard gravity (the gram to udunits2: refused before,
+  // the format's own example among such files).
+  EXPECT_EQ(table.columns[0].unit, "gn");
   EXPECT_EQ(table.columns[1].name, "angle");
   EXPECT_EQ(table.columns[1].unit, "deg");
   ASSERT_EQ(table.sample_lines.size(), 8u);
@@ -288,6 +290,9 @@ TEST(Lvm, ReadsTabSeparatedDecimalCommaFixture) {
     EXPECT_DOUBLE_EQ(table.columns[0].values[static_cast<size_t>(j)], 0.0125 * (j - 3));
     EXPECT_DOUBLE_EQ(table.columns[1].values[static_cast<size_t>(j)], 0.25 * j - 1.5);
   }
+  const Measurement imported = ImportMeasurement(DataFile("two_channels_comma.lvm"));
+  EXPECT_EQ(imported.units[0], "m/s^2");
+  EXPECT_DOUBLE_EQ(imported.values(4, 0), 0.0125 * 9.80665);  // j = 4: 0.0125 g
 }
 
 // An .lvm without X columns in two segments; `second_x0` is where the second starts.

@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "logger_export.h"
@@ -79,6 +80,39 @@ TEST(ImportTest, DecimalCommaFlaggedWhenUsed) {
   EXPECT_THAT(report.dialect, HasSubstr("decimal comma"));
   EXPECT_DOUBLE_EQ(m.values(1, 0), 2.5e-3);  // 2,5 mm
   EXPECT_EQ(m.sample_interval_s, 0.5);
+}
+
+// An inclinometer's ';' export with decimal commas and trailing zeros trimmed: two data lines
+// ("1,49;34,999;-12" then "1,5;35;-11,998") split on ',' as a 3-field header and a row, which
+// tied with the real header's 3 fields and won; the next line's 4 fields refused the file (8 of
+// 8 such exports, ';' and tab, a trial's). A header's rows must go on as it says.
+TEST(ImportTest, DataLinesThatSplitLikeAHeaderOnCommasAreNoHeader) {
+  TempDir dir;
+  for (const char* separator : {";", "\t"}) {
+    std::string text = fmt::format("time [s]{0}a [deg]{0}b [deg]\n", separator);
+    const char* rows[] = {"1,48;35,017;-12,014", "1,49;34,999;-12", "1,5;35;-11,998",
+                          "1,51;35,011;-12,017", "1,52;35,009;-12,018"};
+    for (int j = 0; j < 148; ++j) {  // 1.47 s of rest before them, one sample per 10 ms
+      std::string time = fmt::format("{:g}", j * 0.01);
+      std::replace(time.begin(), time.end(), '.', ',');
+      text += fmt::format("{}{}35,02{}-12,01\n", time, separator, separator);
+    }
+    for (const char* row : rows) {
+      std::string line = row;
+      for (char& c : line) {
+        if (c == ';') c = separator[0];
+      }
+      text += line + "\n";
+    }
+    const std::string path = dir.File(separator[0] == ';' ? "semicolon.csv" : "tab.txt");
+    WriteText(path, text);
+    ImportReport report;
+    const Measurement m = ImportMeasurement(path, {}, &report);
+    EXPECT_EQ(m.samples(), 153) << separator;
+    EXPECT_EQ(m.channels, (std::vector<std::string>{"a", "b"}));
+    EXPECT_NEAR(m.values(149, 0), 34.999 * kDeg, 1e-12);  // "1,49;34,999;-12"
+    EXPECT_NEAR(m.values(149, 1), -12 * kDeg, 1e-12);
+  }
 }
 
 // Two inclinometers both headed "Incl" (a logger's default names): by name they are ambiguous,
