@@ -1,9 +1,12 @@
 // The model's dynamics: the state derivative without the Dynamics stage, the rest matrices, static
 // equilibrium and the linearization.
+#include <fmt/format.h>
+
 #include <Eigen/Dense>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -15,49 +18,108 @@
 namespace mbid::model {
 namespace {
 
-// Newton's chord method on f(q) = 0 from q = 0: the tangent starts as `rest_tangent` (-C at
-// rest: no evaluations), kept while the steps shrink fast and refreshed by central differences
-// when they do not. The root's accuracy depends only on f, so the iteration reaches machine
-// precision.
-Eigen::VectorXd SolveEquilibrium(
-    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& force,
-    const Eigen::MatrixXd& rest_tangent) {
-  const Eigen::Index n = rest_tangent.rows();
-  auto tangent = [&](const Eigen::VectorXd& q) {
-    Eigen::MatrixXd jacobian(n, n);
-    const double h = 1e-7;  // rad or m; smooth forces, curvature scale ~1
-    for (Eigen::Index j = 0; j < n; ++j) {
-      Eigen::VectorXd dq = Eigen::VectorXd::Zero(n);
-      dq[j] = h;
-      jacobian.col(j) = (force(q + dq) - force(q - dq)) / (2 * h);
-    }
-    return Eigen::FullPivLU<Eigen::MatrixXd>(jacobian);
-  };
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
-  Eigen::VectorXd f = force(q);
-  if (f.lpNorm<Eigen::Infinity>() == 0) return q;
-  Eigen::FullPivLU<Eigen::MatrixXd> lu(rest_tangent);
-  if (!lu.isInvertible()) {
-    throw NumericalError("static equilibrium",
-                         "the machine has no stiffness against a load on a free coordinate");
+using Force = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;
+// The generalized force at q under the fraction s in [0, 1] of the load.
+using LoadedForce = std::function<Eigen::VectorXd(const Eigen::VectorXd&, double)>;
+
+// The tangent df/dq at q by central differences.
+Eigen::MatrixXd Tangent(const Force& force, const Eigen::VectorXd& q) {
+  const Eigen::Index n = q.size();
+  Eigen::MatrixXd jacobian(n, n);
+  const double h = 1e-7;  // rad or m; smooth forces, curvature scale ~1
+  for (Eigen::Index j = 0; j < n; ++j) {
+    Eigen::VectorXd dq = Eigen::VectorXd::Zero(n);
+    dq[j] = h;
+    jacobian.col(j) = (force(q + dq) - force(q - dq)) / (2 * h);
   }
+  return jacobian;
+}
+
+// Converged when the step is at roundoff of q, or stops shrinking after being tiny.
+bool StepConverged(double step_norm, double last_step, const Eigen::VectorXd& q) {
+  return step_norm <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, q.norm()) ||
+         (step_norm < 1e-12 && step_norm >= last_step);
+}
+
+// Newton's chord method on f(q) = 0 from q = 0 with the tangent at rest (-C: no evaluations).
+// Taken only where it contracts fast from the first step on (each step at most half the one
+// before, the tangent never refreshed): then the root is the one nearest the unloaded rest. A
+// payload that deflects the machine far (a luffed arm sagging 1.3 rad) made the chord overshoot
+// into another root: flipped over the top, at an unstable one, or at none (50 iterations).
+std::optional<Eigen::VectorXd> SolveByChord(const Force& force, const Eigen::MatrixXd& rest_tangent,
+                                            const Eigen::VectorXd& f0) {
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(rest_tangent);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(rest_tangent.rows());
+  Eigen::VectorXd f = f0;
   double last_step = std::numeric_limits<double>::infinity();
   for (int iteration = 0; iteration < 50; ++iteration) {
     const Eigen::VectorXd step = lu.solve(-f);
+    const double step_norm = step.lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(step_norm) || step_norm > 0.5 * last_step + 1e-12) return std::nullopt;
     q += step;
     f = force(q);
-    const double step_norm = step.lpNorm<Eigen::Infinity>();
-    if (!std::isfinite(step_norm)) break;
-    // Converged when the step is at roundoff of q, or stops shrinking after being tiny.
-    if (step_norm <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, q.norm()) ||
-        (step_norm < 1e-12 && step_norm >= last_step)) {
-      return q;
-    }
-    if (step_norm > 0.1 * last_step) lu = tangent(q);  // slow contraction: refresh the tangent
+    if (StepConverged(step_norm, last_step, q)) return q;
     last_step = step_norm;
   }
-  throw NumericalError("static equilibrium", "Newton did not converge in 50 iterations; residual " +
-                                                 std::to_string(f.norm()));
+  return std::nullopt;
+}
+
+// The rest reached by applying the load gradually: the roots of loaded(q, s), the machine under
+// the fraction s of its load (the rest of the payload's weight held by a hook, point loads
+// scaled), followed from q = 0 at s = 0 to s = 1 by Newton with fresh tangents, each step of s
+// halved until Newton converges without q moving more than 0.2 (rad or m) from the last root.
+// Where the step must shrink below 1e-6, the load has no rest on this path (a fold: the machine
+// snaps through).
+Eigen::VectorXd SolveByContinuation(const LoadedForce& loaded, Eigen::Index n) {
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+  double s = 0, ds = 0.125;
+  while (s < 1) {
+    const double next = std::min(1.0, s + ds);
+    const Force force = [&](const Eigen::VectorXd& x) { return loaded(x, next); };
+    const double scale = 1 + force(q).norm();
+    Eigen::VectorXd x = q;
+    bool converged = false;
+    double last_step = std::numeric_limits<double>::infinity();
+    for (int iteration = 0; iteration < 30 && !converged; ++iteration) {
+      const Eigen::FullPivLU<Eigen::MatrixXd> lu(Tangent(force, x));
+      if (!lu.isInvertible()) break;
+      const Eigen::VectorXd step = lu.solve(-force(x));
+      const double step_norm = step.lpNorm<Eigen::Infinity>();
+      if (!std::isfinite(step_norm) || step_norm > 0.2) break;
+      x += step;
+      converged = StepConverged(step_norm, last_step, x) ||
+                  (step_norm < 1e-10 && force(x).norm() <= 1e-9 * scale);
+      last_step = step_norm;
+    }
+    if (converged && (x - q).lpNorm<Eigen::Infinity>() <= 0.2) {
+      q = x;
+      s = next;
+      ds = std::min(0.25, 2 * ds);
+    } else if ((ds *= 0.5) < 1e-6) {
+      throw NumericalError(
+          "static equilibrium",
+          fmt::format("the load has no rest reached by applying it gradually: at {:.4g} % of it "
+                      "the machine snaps through (a spring too weak for the load's overturning "
+                      "moment)",
+                      100 * s));
+    }
+  }
+  return q;
+}
+
+// The static equilibrium loaded(q, 1) = 0 that loading the machine gradually from its unloaded
+// rest q = 0 reaches; `rest_tangent` is d loaded / dq at q = 0 under the whole load.
+Eigen::VectorXd SolveEquilibrium(const LoadedForce& loaded, const Eigen::MatrixXd& rest_tangent) {
+  const Eigen::Index n = rest_tangent.rows();
+  const Force force = [&](const Eigen::VectorXd& q) { return loaded(q, 1.0); };
+  const Eigen::VectorXd f0 = force(Eigen::VectorXd::Zero(n));
+  if (f0.lpNorm<Eigen::Infinity>() == 0) return Eigen::VectorXd::Zero(n);
+  if (!Eigen::FullPivLU<Eigen::MatrixXd>(rest_tangent).isInvertible()) {
+    throw NumericalError("static equilibrium",
+                         "the machine has no stiffness against a load on a free coordinate");
+  }
+  if (std::optional<Eigen::VectorXd> q = SolveByChord(force, rest_tangent, f0)) return *q;
+  return SolveByContinuation(loaded, n);
 }
 
 }  // namespace
@@ -79,8 +141,13 @@ void MultibodyModel::Impl::CalcRestMatrices(RestMatrices& result) const {
   // The springs carry the unloaded machine at q = 0; an attached payload's weight deflects it to
   // a rest of its own, where it vibrates: the matrices belong there.
   SimTK::State s = MakeSpringState();  // the preload carries the unloaded machine
-  result.q = SolveEquilibrium([&](const Eigen::VectorXd& q) { return CalcStaticForceAt(s, q, {}); },
-                              CalcRestTangent(result.K_g));
+  // Under a fraction of the payload, a hook holds the rest of its weight at its point.
+  const Eigen::Vector3d weight(0, 0, -machine.attached_payload_kg * machine.gravity_mps2);
+  result.q = SolveEquilibrium(
+      [&](const Eigen::VectorXd& q, double fraction) {
+        return CalcStaticForceAt(s, q, {{machine.payload_point, -(1 - fraction) * weight}});
+      },
+      CalcRestTangent(result.K_g));
   if (result.q.lpNorm<Eigen::Infinity>() > 0) CalcMatricesAt(result);
 }
 
@@ -267,7 +334,17 @@ Eigen::VectorXd MultibodyModel::SolveStaticEquilibrium(const std::vector<PointLo
   const Eigen::Index n = static_cast<Eigen::Index>(impl_->coordinates.size());
   SimTK::State s = MakeState(Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n));
   return SolveEquilibrium(
-      [&](const Eigen::VectorXd& q) { return impl_->CalcStaticForceAt(s, q, loads); },
+      [&](const Eigen::VectorXd& q, double fraction) {
+        std::vector<PointLoad> part = loads;
+        for (PointLoad& load : part) load.force_G *= fraction;
+        if (impl_->machine.attached_payload_kg > 0) {  // a hook holds the rest of its weight
+          part.push_back({impl_->machine.payload_point,
+                          Eigen::Vector3d(0, 0,
+                                          (1 - fraction) * impl_->machine.attached_payload_kg *
+                                              impl_->machine.gravity_mps2)});
+        }
+        return impl_->CalcStaticForceAt(s, q, part);
+      },
       impl_->CalcRestTangent(impl_->rest_matrices().K_g));
 }
 

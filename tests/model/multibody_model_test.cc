@@ -11,6 +11,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -146,6 +147,31 @@ TEST(MultibodyModelTest, AnAttachedPayloadIsLinearizedAtTheRestItDeflectsTo) {
   ASSERT_EQ(modes.size(), 1u);
   EXPECT_NEAR(modes[0].undamped_frequency_hz(),
               std::sqrt(stiffness / (m * L * L + 1 + payload * 16)) / (2 * M_PI), 1e-9);
+}
+
+// The same arm on weak springs sags far under its payload (1-1.4 rad): the rest is where loading
+// it gradually leads, the root of the balance in (0, pi/2) (unique there: the balance falls
+// monotonically, from 19620 N m to -c pi/2 - m g L), stable. The chord method from q = 0 had
+// overshot into other roots: over the top (a trial's luffed arm at 200 deg, its mode 9 % low), an
+// unstable one ("the machine is unstable at rest"), or none (exit 3).
+TEST(MultibodyModelTest, APayloadThatSagsTheArmFarIsLinearizedWhereLoadingLeads) {
+  const double m = 50.0, L = 2.0, g = 9.81, payload = 500.0;
+  for (const double c : {1000.0, 2000.0, 3000.0, 5000.0}) {
+    const std::string text = std::string(kHorizontalArm) + "payload_mass_kg: 500.0\n";
+    const auto arm = FromYaml(std::regex_replace(text, std::regex("4\\.0e4"), std::to_string(c)));
+    const auto balance = [&](double q) {
+      return -c * q + m * g * L * (std::cos(q) - 1) + payload * g * 4 * std::cos(q);
+    };
+    double low = 0, high = M_PI / 2;  // bisection: independent of the model's solver
+    for (int i = 0; i < 100; ++i)
+      (balance(0.5 * (low + high)) > 0 ? low : high) = 0.5 * (low + high);
+    const double rest = 0.5 * (low + high);
+    const double stiffness = c + (m * g * L + payload * g * 4) * std::sin(rest);
+    const LinearModel linear = arm->Linearize();
+    EXPECT_NEAR(linear.C(0, 0), stiffness, 1e-7 * stiffness) << c;
+    EXPECT_NEAR(linear.H(0, 0), -4 * std::cos(rest), 1e-9) << c;
+    EXPECT_TRUE(FindGrowingModes(CalcModes(linear)).empty()) << c;
+  }
 }
 
 // An azimuth needs a direction off the vertical at q = 0.
