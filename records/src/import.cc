@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <set>
 
@@ -300,6 +301,57 @@ void StatedRateGrid(const Eigen::VectorXd& time, const std::string& path, const 
                   rate_hz, resolution));
 }
 
+// A time without a unit read in s whose step is under 0.1 s (10 Hz; slower steps are said in
+// ReadTimeBase) may still count ms of a logger above 10 kHz: every frequency then comes out
+// 1000 times too low, reliable (a trial's 12.8-20 kHz records: 1.2 and 6.5 Hz as 0.0012 and
+// 0.0065 Hz). Such a record swings over thousands of samples: where every channel that swings
+// (four reversals beyond a tenth of its range) takes over 500 samples per reversal, periods of
+// over 50 s at 20 Hz, which no machine's structure has, it is said (the median spacing of the
+// reversals: a long record's rest around a short decay does not count).
+void SayIfOversampled(const Measurement& m, ImportReport* report) {
+  constexpr double kSamplesPerReversal = 500;
+  if (!report->time_unit_assumed || m.samples() < 4 * kSamplesPerReversal ||
+      m.sample_interval_s * (1 + kTimeUniformityTolerance) >= 0.1) {
+    return;
+  }
+  double fastest = std::numeric_limits<double>::infinity();  // fewest samples per reversal
+  for (Eigen::Index c = 0; c < m.values.cols(); ++c) {
+    const auto column = m.values.col(c);
+    const double h = 0.1 * (column.maxCoeff() - column.minCoeff());
+    if (!(h > 0)) continue;
+    // Where each reversal happens (at its extreme): the median spacing is the swing's half
+    // period, whatever the record holds besides (a long rest, a decay into the noise).
+    std::vector<double> spacing;
+    int direction = 0;
+    Eigen::Index at = 0, last = -1;
+    for (Eigen::Index j = 1; j < column.size(); ++j) {
+      const double v = column(j);
+      if (direction == 0) {
+        if (std::abs(v - column(at)) > h) direction = v > column(at) ? 1 : -1;
+        if (direction != 0) at = j;
+      } else if ((v - column(at)) * direction > 0) {
+        at = j;
+      } else if (std::abs(v - column(at)) > h) {
+        if (last >= 0) spacing.push_back(static_cast<double>(at - last));
+        last = at;
+        direction = -direction;
+        at = j;
+      }
+    }
+    if (spacing.size() < 3) continue;  // four reversals: two periods
+    std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
+    fastest = std::min(fastest, spacing[spacing.size() / 2]);
+  }
+  if (!(fastest > kSamplesPerReversal) || std::isinf(fastest)) return;
+  const double seconds = 2 * fastest * m.sample_interval_s;
+  report->warnings.push_back(fmt::format(
+      "the time states no unit and is read in s (a step of {:g} s, {:.3g} Hz), and the record "
+      "swings over {:.0f} samples per period, {:.3g} s: if the time counts ms (a logger at {:.3g} "
+      "kHz), every frequency is 1000 times too low; give `time_unit: ms` in the scenario's "
+      "record entry (or --time-unit ms), or `time_unit: s` if the periods are right",
+      m.sample_interval_s, 1 / m.sample_interval_s, 2 * fastest, seconds, 1 / m.sample_interval_s));
+}
+
 void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOptions& options,
                   const std::string& user_time_unit, Measurement* m, ImportReport* report) {
   if (table.time.empty() && table.interval <= 0) {
@@ -324,6 +376,7 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
   // 0.1 s or more (10 Hz or slower, where a ms clock of 10 kHz or slower lands) is said.
   // A format whose time has no unit in the file (MAT, LVM without X_Unit_Label) is read in s.
   const bool format_default = user_time_unit.empty() && table.time_unit_assumed;
+  report->time_unit_assumed = seconds_by_contract || format_default;
   const auto say_if_slow = [&] {
     // (0.1 itself: a fitted step of 0.09999999999999999 s is 0.1 s.)
     if (!(seconds_by_contract || format_default) ||
@@ -532,6 +585,7 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
   }
   if (!table.source.empty()) m.source = table.source;
   m.Validate(path);
+  SayIfOversampled(m, &r);
   return m;
 }
 

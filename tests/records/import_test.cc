@@ -115,6 +115,34 @@ TEST(ImportTest, DataLinesThatSplitLikeAHeaderOnCommasAreNoHeader) {
   }
 }
 
+// A unitless `time` in ms of a 20 kHz logger reads as 20 Hz: its 1.2 Hz decay then swings over
+// 16,667 samples per period (periods of 833 s), and the reading is doubted; a true 20 Hz record
+// of the same decay (17 samples per period, then 1950 s at rest), or the same file with its unit
+// stated, is not.
+TEST(ImportTest, AUnitlessTimeOfThousandsOfSamplesPerPeriodIsDoubted) {
+  TempDir dir;
+  const auto write = [&](const std::string& name, double step, double rate_hz) {
+    std::string text = "time,x [mm]\n";
+    for (int j = 0; j < 40000; ++j) {  // 2 s at 20 kHz, or 2000 s at 20 Hz
+      const double t = j / rate_hz;
+      text += fmt::format("{:.6g},{:.9g}\n", j * step,
+                          std::exp(-0.2 * t) * std::cos(2 * M_PI * 1.2 * t));
+    }
+    WriteText(dir.File(name), text);
+    return dir.File(name);
+  };
+  ImportReport report;
+  ImportMeasurement(write("ms.csv", 0.05, 20000.0), {}, &report);  // 0.05 ms steps
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_THAT(report.warnings[0], HasSubstr("every frequency is 1000 times too low"));
+  ImportOptions stated;
+  stated.time_unit = "s";
+  ImportMeasurement(dir.File("ms.csv"), stated, &report);
+  EXPECT_TRUE(report.warnings.empty());
+  ImportMeasurement(write("slow.csv", 0.05, 20.0), {}, &report);  // a true 20 Hz logger
+  EXPECT_TRUE(report.warnings.empty()) << report.warnings.front();
+}
+
 // Two inclinometers both headed "Incl" (a logger's default names): by name they are ambiguous,
 // by number each is its own. The file was refused whatever the mapping.
 TEST(ImportTest, TwoColumnsOfOneNameAreReadByNumber) {

@@ -47,6 +47,8 @@ struct ImportReport {
   // What the file does not say and may have been misread: a column named `time` without a unit
   // is in seconds by the contract, and a step of 0.1 s or more is then more likely ms.
   std::vector<std::string> warnings;
+  // The time was read in s without a unit in the file (a column named `time`, a MAT or LVM time).
+  bool time_unit_assumed = false;
 };
 
 // Reads any supported file (chosen by its extension and contents), converts it to SI and
