@@ -235,11 +235,22 @@ updating: {parameters: PARAMETERS, algebraic_start: false, start: START, global_
     text.replace(text.find("START"), 5, start);
     return text;
   };
-  const mbid::Scenario exact = mbid::LoadScenarioFromText(
-      with("300.0", "[c_q1, d_q1]", "{c_q1: 2.5e5, d_q1: 600.0}"), "arm.yaml");
+  // Route 1 on: its joint set is the other start the verdict's uniqueness needs with the search
+  // off (one local fit alone leaves other minima unasked).
+  std::string exact_text = with("300.0", "[c_q1, d_q1]", "{c_q1: 2.5e5, d_q1: 600.0}");
+  exact_text.replace(exact_text.find("algebraic_start: false"), 22, "algebraic_start: true");
+  const mbid::Scenario exact = mbid::LoadScenarioFromText(exact_text, "arm.yaml");
   const mbid::ValidationResult right = mbid::RunValidationCycle(exact);
   EXPECT_FALSE(right.identified.reliable);
   EXPECT_EQ(right.verdict, mbid::Verdict::kPassed) << ::testing::PrintToString(right.reasons);
+  // Route 1 off too: one local fit from one start, the minimum's uniqueness unasked (an audit's
+  // symmetric machine passed so with its joints swapped): inconclusive, saying so.
+  const mbid::ValidationResult alone = mbid::RunValidationCycle(mbid::LoadScenarioFromText(
+      with("300.0", "[c_q1, d_q1]", "{c_q1: 2.5e5, d_q1: 600.0}"), "arm-alone.yaml"));
+  EXPECT_EQ(alone.verdict, mbid::Verdict::kInconclusive);
+  EXPECT_NE(::testing::PrintToString(alone.reasons).find("uniqueness was not checked"),
+            std::string::npos)
+      << ::testing::PrintToString(alone.reasons);
   // The same record, a model with d_q1 10 % high and only c_q1 tuned.
   const mbid::Measurement record = mbid::Simulate(exact);
   const mbid::Scenario off =
