@@ -302,7 +302,7 @@ void StatedRateGrid(const Eigen::VectorXd& time, const std::string& path, const 
 }
 
 // A time without a unit read in s whose step is under 0.1 s (10 Hz; slower steps are said in
-// ReadTimeBase) may still count ms of a logger above 10 kHz: every frequency then comes out
+// ReadTimeBase) may still count ms of a logger of 10-50 kHz: every frequency then comes out
 // 1000 times too low, reliable (a trial's 12.8-20 kHz records: 1.2 and 6.5 Hz as 0.0012 and
 // 0.0065 Hz). Such a record swings over thousands of samples: where every channel that swings
 // (four reversals beyond a tenth of its range) takes over 500 samples per reversal, periods of
@@ -310,8 +310,11 @@ void StatedRateGrid(const Eigen::VectorXd& time, const std::string& path, const 
 // reversals: a long record's rest around a short decay does not count).
 void SayIfOversampled(const Measurement& m, ImportReport* report) {
   constexpr double kSamplesPerReversal = 500;
+  // Steps of 0.02-0.1 "s": a ms clock of 10-50 kHz. A finer step read in s is a fast logger in
+  // s (2 kHz: the crane's 1.5 Hz mode swings over 1333 samples) or a ms clock faster than any.
   if (!report->time_unit_assumed || m.samples() < 4 * kSamplesPerReversal ||
-      m.sample_interval_s * (1 + kTimeUniformityTolerance) >= 0.1) {
+      m.sample_interval_s * (1 + kTimeUniformityTolerance) >= 0.1 ||
+      m.sample_interval_s * (1 + kTimeUniformityTolerance) < 0.02) {
     return;
   }
   double fastest = std::numeric_limits<double>::infinity();  // fewest samples per reversal

@@ -117,8 +117,8 @@ TEST(ImportTest, DataLinesThatSplitLikeAHeaderOnCommasAreNoHeader) {
 
 // A unitless `time` in ms of a 20 kHz logger reads as 20 Hz: its 1.2 Hz decay then swings over
 // 16,667 samples per period (periods of 833 s), and the reading is doubted; a true 20 Hz record
-// of the same decay (17 samples per period, then 1950 s at rest), or the same file with its unit
-// stated, is not.
+// of the same decay (17 samples per period, then 1950 s at rest), a true 2 kHz one, or the same
+// file with its unit stated, is not.
 TEST(ImportTest, AUnitlessTimeOfThousandsOfSamplesPerPeriodIsDoubted) {
   TempDir dir;
   const auto write = [&](const std::string& name, double step, double rate_hz) {
@@ -140,6 +140,10 @@ TEST(ImportTest, AUnitlessTimeOfThousandsOfSamplesPerPeriodIsDoubted) {
   ImportMeasurement(dir.File("ms.csv"), stated, &report);
   EXPECT_TRUE(report.warnings.empty());
   ImportMeasurement(write("slow.csv", 0.05, 20.0), {}, &report);  // a true 20 Hz logger
+  EXPECT_TRUE(report.warnings.empty()) << report.warnings.front();
+  // A true 2 kHz logger in s: 1667 samples per period, but no ms clock ticks 0.5 us (the release
+  // corpus's crane records at 2-10 kHz were doubted so).
+  ImportMeasurement(write("fast.csv", 0.0005, 2000.0), {}, &report);
   EXPECT_TRUE(report.warnings.empty()) << report.warnings.front();
 }
 
