@@ -454,10 +454,21 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
     say_if_slow();
     return;
   }
+  // Counted from the first stamp before the unit's factor: epoch stamps in ms (1.77e12) scaled
+  // to s first keep steps only to 2.4e-7 s, and a logger's exact 1 ms read as 1.00017 ms (refused
+  // as a dropped sample). The origin is added back to the start.
+  const double origin = table.time.empty() ? 0.0 : table.time.front();
+  const double origin_s = to_s.identity() ? origin : to_s.scale * origin + to_s.offset;
+  // Epoch seconds printed to 0.01 s (1.77e9) parse to doubles 2.4e-7 s apart: counted from the
+  // first, they are put back on the printed digit's grid, which they were printed on.
+  const double printed = table.printed_resolution;
+  const bool snap =
+      printed > 0 && std::abs(origin) * std::numeric_limits<double>::epsilon() > 1e-6 * printed;
   Eigen::VectorXd time(static_cast<Eigen::Index>(table.time.size()));
   for (size_t j = 0; j < table.time.size(); ++j) {
-    time[static_cast<Eigen::Index>(j)] =
-        to_s.identity() ? table.time[j] : to_s.scale * table.time[j] + to_s.offset;
+    double since = table.time[j] - origin;
+    if (snap) since = std::round(since / printed) * printed;
+    time[static_cast<Eigen::Index>(j)] = to_s.identity() ? since : to_s.scale * since;
   }
   if (options.sample_rate_hz > 0 && table.printed_resolution > 0 &&
       (time.array().isFinite().all()) && time.size() > 1 &&
@@ -465,13 +476,14 @@ void ReadTimeBase(const RawTable& table, const std::string& path, const ImportOp
       ((time.tail(time.size() - 1) - time.head(time.size() - 1)).array() >= 0).all()) {
     StatedRateGrid(time, path, table, options.sample_rate_hz, table.printed_resolution * to_s.scale,
                    m, report);
+    m->start_time_s += origin_s;
     return;
   }
   double start = 0;
   const double tau = CheckUniformTime(
       time, path, [&](Eigen::Index j) { return SampleField(table, "", j); },
       table.printed_resolution * to_s.scale, &start);
-  m->start_time_s = start;
+  m->start_time_s = origin_s + start;
   m->sample_interval_s = tau;
   if (table.stated_interval_s > 0) {
     // The exact interval, when it agrees with the time column, makes mbid's round trip exact.

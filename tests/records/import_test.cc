@@ -147,6 +147,27 @@ TEST(ImportTest, AUnitlessTimeOfThousandsOfSamplesPerPeriodIsDoubted) {
   EXPECT_TRUE(report.warnings.empty()) << report.warnings.front();
 }
 
+// Epoch stamps (a logger's PC clock): in ms, scaled to s before the first was subtracted, exact
+// 1 ms steps read as 1.00017 ms and the file was refused as a dropped sample; in s printed to
+// 0.01 s, each stamp parses 2.4e-7 s off its printed value, with the same result. Both are read
+// on their grid, the start at the first stamp.
+TEST(ImportTest, EpochStampsAreReadToTheirPrintedDigit) {
+  TempDir dir;
+  std::string ms = "timestamp [ms],x [mm]\n", s = "timestamp [s],x [mm]\n";
+  for (int j = 0; j < 2000; ++j) {
+    ms += fmt::format("{},{:.6f}\n", 1772366400000LL + j, std::sin(0.01 * j));
+    s += fmt::format("{}.{:02d},{:.6f}\n", 1772366400 + j / 100, j % 100, std::sin(0.01 * j));
+  }
+  WriteText(dir.File("ms.csv"), ms);
+  WriteText(dir.File("s.csv"), s);
+  const Measurement in_ms = ImportMeasurement(dir.File("ms.csv"));
+  EXPECT_EQ(in_ms.sample_interval_s, 1e-3);
+  EXPECT_EQ(in_ms.start_time_s, 1772366400.0);
+  const Measurement in_s = ImportMeasurement(dir.File("s.csv"));
+  EXPECT_NEAR(in_s.sample_interval_s, 0.01, 1e-15);
+  EXPECT_EQ(in_s.start_time_s, 1772366400.0);
+}
+
 // Two inclinometers both headed "Incl" (a logger's default names): by name they are ambiguous,
 // by number each is its own. The file was refused whatever the mapping.
 TEST(ImportTest, TwoColumnsOfOneNameAreReadByNumber) {
