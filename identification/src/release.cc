@@ -359,27 +359,27 @@ ReleaseDetection DetectFirstRelease(const Measurement& record) {
   return detection;
 }
 
-// Samples a segment at rest must hold to end a change that no free decay followed.
+// Samples a segment at rest must hold to end a change that no free decay followed (and 0.1 s).
 constexpr int kQuietSamples = 20;
 
-// The first sample from `from` on that opens kQuietSamples samples at rest at a new level:
+// The first sample from `from` on that opens `quiet_samples` samples at rest at a new level:
 // every channel within 6 noise standard deviations (from its third differences) of the window's
 // median without a drift, and some channel's median that far from its level at rest before
 // (`before`; a slow start of the motion is still that rest). -1 if none.
 int FindNewRest(const Eigen::MatrixXd& y, const Eigen::VectorXd& noise,
-                const std::vector<double>& before, int from) {
+                const std::vector<double>& before, int from, int quiet_samples) {
   const int n = static_cast<int>(y.rows());
-  for (int j = from; j + kQuietSamples <= n; ++j) {
+  for (int j = from; j + quiet_samples <= n; ++j) {
     bool quiet = true, moved = false;
     for (Eigen::Index c = 0; c < y.cols() && quiet; ++c) {
-      std::vector<double> window(y.col(c).data() + j, y.col(c).data() + j + kQuietSamples);
-      std::nth_element(window.begin(), window.begin() + kQuietSamples / 2, window.end());
-      const double median = window[kQuietSamples / 2];
-      const auto segment = y.col(c).segment(j, kQuietSamples);
+      std::vector<double> window(y.col(c).data() + j, y.col(c).data() + j + quiet_samples);
+      std::nth_element(window.begin(), window.begin() + quiet_samples / 2, window.end());
+      const double median = window[static_cast<size_t>(quiet_samples / 2)];
+      const auto segment = y.col(c).segment(j, quiet_samples);
       // No drift either: the halves' means agree within 2 noise standard deviations (their
       // difference has 0.45 of one); a slow ramp stays within 6 of a median for 20 samples.
       const double drift =
-          segment.tail(kQuietSamples / 2).mean() - segment.head(kQuietSamples / 2).mean();
+          segment.tail(quiet_samples / 2).mean() - segment.head(quiet_samples / 2).mean();
       quiet = (segment.array() - median).abs().maxCoeff() <= 6 * noise(c) &&
               std::abs(drift) <= 2 * noise(c);
       moved = moved || std::abs(median - before[static_cast<size_t>(c)]) > 6 * noise(c);
@@ -389,13 +389,15 @@ int FindNewRest(const Eigen::MatrixXd& y, const Eigen::VectorXd& noise,
   return -1;
 }
 
-// The most reversals of direction, beyond 6 noise standard deviations (a hysteresis), that a
+// The most reversals of direction, beyond 10 noise standard deviations (a hysteresis), that a
 // channel makes over samples [begin, end): a free decay makes two a period, a step or a ramp
-// none.
+// none. Noise alone over a flat stretch reaches about 4 of its standard deviations either way
+// in 10^4 samples (5 in 10^6): a hysteresis of 6 counted a winch's 3 s pull at 2 kHz as swinging
+// twice, and its start was taken for the release, 5 s early.
 int Reversals(const Eigen::MatrixXd& y, const Eigen::VectorXd& noise, int begin, int end) {
   int most = 0;
   for (Eigen::Index c = 0; c < y.cols(); ++c) {
-    const double h = 6 * noise(c);
+    const double h = 10 * noise(c);
     if (!(h > 0) || end - begin < 2) continue;
     // The first move beyond h sets the direction; each move back beyond h from the extreme
     // since is a reversal.
@@ -434,7 +436,11 @@ ReleaseDetection DetectRelease(const Measurement& record) {
   // then stands for it.
   const Eigen::MatrixXd y = BridgeGlitches(record.values);
   const int n = static_cast<int>(y.rows());
-  if (n < 2 * kQuietSamples) return detection;
+  // A rest lasts 0.1 s at least: 20 samples at 2 kHz are 10 ms, which a winch's slow pull
+  // passes within its noise, and the pull's start was taken for the release, 5 s early.
+  const int quiet_samples =
+      std::max(kQuietSamples, static_cast<int>(std::ceil(0.1 / record.sample_interval_s - 1e-9)));
+  if (n < 2 * quiet_samples) return detection;
   Eigen::VectorXd noise(y.cols());
   for (Eigen::Index c = 0; c < y.cols(); ++c) noise(c) = ThirdDifferenceNoise(y.col(c));
   int change = detection.detected ? detection.rest_samples : 0;
@@ -442,7 +448,7 @@ ReleaseDetection DetectRelease(const Measurement& record) {
       detection.detected ? detection.rest_level : RestLevels(y, std::min(5, n));
   double passed_s = detection.detected ? detection.release_time_s : record.start_time_s;
   for (int round = 0; round < 6; ++round) {
-    const int quiet = FindNewRest(y, noise, before, change);
+    const int quiet = FindNewRest(y, noise, before, change, quiet_samples);
     if (quiet < 0 || Reversals(y, noise, change, quiet) > 1) break;
     Measurement rest = record;
     rest.start_time_s = record.start_time_s + quiet * record.sample_interval_s;

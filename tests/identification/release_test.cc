@@ -281,6 +281,26 @@ TEST(ReleaseTest, AChangeThatNoOscillationFollowsIsNoRelease) {
   }
 }
 
+// A winch's pull over 3 s and a 2 s hold at 2 kHz (a trial's, also at 1 kHz): 20 samples are
+// 10 ms, which the slow pull passes within its noise, and its flat stretches' noise swung past a
+// hysteresis of 6 noise std: the pull's start at 1 s was taken for the release, 5 s early, and
+// the 2.3 Hz mode lost. A rest now lasts 0.1 s, and a swing passes 10 noise std.
+TEST(ReleaseTest, ASlowPullAtAHighRateIsNoRelease) {
+  Release test;
+  test.interval_s = 0.0005;  // 2 kHz
+  test.samples = 20000;      // 10 s
+  test.release_s = 6.00012;
+  Measurement pull = test.Record("rad", 1);
+  for (int j = 0; j * test.interval_s < test.release_s; ++j) {
+    const double t = j * test.interval_s;
+    const double ramp = t < 1 ? 0 : t < 4 ? 0.5 * (1 - std::cos(kPi * (t - 1) / 3)) : 1;
+    pull.values(j, 0) += (ramp - 1) * test.deflected;
+  }
+  const ReleaseDetection found = DetectRelease(pull);
+  EXPECT_TRUE(found.detected);
+  EXPECT_NEAR(found.release_time_s, test.release_s, 2 * test.interval_s);
+}
+
 // The benchmark: 0.5 s of zeros before the response of four modes (1.8, 2.5, 10 and
 // 16 Hz) gave three wrong modes and exit 0. With the release found, the four come back; with
 // the zeros analysed (--release none) the result is flagged unreliable.
