@@ -43,6 +43,12 @@ double ExpressionContext::Evaluate(const std::string& text) const {
     const mu::EErrorCodes code = error.GetCode();
     if ((code == mu::ecUNASSIGNABLE_TOKEN || code == mu::ecUNEXPECTED_VAR) && !token.empty() &&
         std::isalpha(static_cast<unsigned char>(token[0]))) {
+      // YAML's true/false/yes/no: a value that is no number at all, not a parameter misspelt.
+      static const char* const kBooleans[] = {"true",  "false", "True", "False", "TRUE",
+                                              "FALSE", "yes",   "no",   "on",    "off"};
+      for (const char* word : kBooleans) {
+        if (text == word) throw std::invalid_argument("'" + text + "' is no number");
+      }
       throw std::invalid_argument("unknown parameter '" + token + "' in '" + text + "'");
     }
     std::string why = error.GetMsg();  // muparser's sentence ends with a full stop

@@ -44,7 +44,8 @@ void CheckInertia(const BodyDescription& body, const std::string& field) {
     Fail(field,
          "inertia not positive definite (principal moments " + std::to_string(moments[0]) + ", " +
              std::to_string(moments[1]) + ", " + std::to_string(moments[2]) + ")",
-         "positive principal moments in kg*m^2");
+         "positive principal moments in kg*m^2 (a point mass or a slender rod has a zero one: "
+         "give each a small positive value, e.g. 1e-6 m L^2)");
   }
   // A rigid body's principal moments obey I_max <= I_a + I_b (a tolerance for rounded data).
   if (moments[2] > (moments[0] + moments[1]) * (1 + 1e-9)) {

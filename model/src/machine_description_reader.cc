@@ -252,8 +252,12 @@ MachineDescription ReadMachineDescription(const YamlReader& model) {
     if (result.parent != "ground" &&
         std::none_of(machine.bodies.begin(), machine.bodies.end(),
                      [&](const BodyDescription& b) { return b.name == result.parent; })) {
-      body.FailAt("parent", "parent '" + result.parent + "' is not defined above",
-                  "ground or a body listed before '" + name + "'");
+      // Its own parent, or a parent listed later (a loop of bodies is always one of these).
+      const std::string problem = result.parent == name
+                                      ? "'" + name + "' is its own parent"
+                                      : "parent '" + result.parent + "' is not defined above";
+      body.FailAt("parent", problem,
+                  "ground or a body listed before '" + name + "' (bodies form a tree: no loops)");
     }
     result.joint = ReadJoint(body.Child("joint"), context);
     result.mass_kg = Number(body, "mass_kg", context);

@@ -609,6 +609,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"unknown key", "mass_kg: 60", "mas_kg: 60", "model.bodies.jib", "mas_kg"},
         BadCase{"parent not above", "parent: carriage", "parent: jib", "model.bodies.mast.parent",
                 "not defined above"},
+        // Said as what it is (an audit's self-parent read "not defined above").
+        BadCase{"its own parent", "parent: carriage", "parent: mast", "model.bodies.mast.parent",
+                "'mast' is its own parent"},
+        // YAML's true is no parameter (it read "unknown parameter 'true'").
+        BadCase{"boolean mass", "mass_kg: 60", "mass_kg: true", "model.bodies.jib.mass_kg",
+                "'true' is no number"},
+        BadCase{"point mass", "inertia_kgm2: [0.5, 45, 45]", "inertia_kgm2: [0, 0, 0]",
+                "model.bodies.jib.inertia_kgm2", "a point mass or a slender rod"},
         BadCase{"coordinate twice", "coordinates: [c]", "coordinates: [a]",
                 "model.bodies.jib.joint.coordinates", "twice"},
         // Not reported as the spring's unknown coordinate offering the bad name as the fix.
