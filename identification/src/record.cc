@@ -213,7 +213,8 @@ AnalysisRecord PrepareRecord(const Measurement& measurement, const Identificatio
       throw InputError(origin, record.channels[c],
                        column(0) == 0
                            ? std::string("every sample in the window is zero")
-                           : fmt::format("constant: every sample in the window is {}", column(0)),
+                           : fmt::format("constant: every sample in the window is {} {}", column(0),
+                                         c < record.units.size() ? record.units[c] : ""),
                        "a record that varies (a free decay)");
     }
   }
