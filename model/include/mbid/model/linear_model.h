@@ -59,4 +59,9 @@ std::vector<Mode> CalcModes(const LinearModel& linear);
 // (a spring weaker than gravity's overturning stiffness?)").
 std::vector<std::string> FindGrowingModes(const std::vector<Mode>& modes);
 
+// One line when the modes span so many orders of magnitude that double precision leaves the
+// slowest with fewer than 6 digits (about eps omega_max^2 / omega_min^2 of itself): a joint
+// given a stiffness 1e12 times the others' to make it rigid.
+std::vector<std::string> FindImpreciseModes(const std::vector<Mode>& modes);
+
 }  // namespace mbid::model
