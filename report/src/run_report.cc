@@ -55,6 +55,8 @@ std::string DrawRecordFigure(const std::string& folder, const Measurement& measu
 
 std::string DrawSpectrumFigure(const std::string& folder,
                                const identification::ModalResult& result) {
+  // No spectrum (an overdamped machine's identification found nothing to show one with).
+  if (!result.has_spectrum || result.spectrum.frequency_hz.size() < 2) return "";
   Figure figure;
   figure.title = "Amplitude spectra (step 1), identified frequencies marked";
   figure.x_label = "frequency, Hz";

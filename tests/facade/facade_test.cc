@@ -367,6 +367,41 @@ TEST(FacadeTest, AnOpenProfileMakesTheVerdictInconclusive) {
   EXPECT_TRUE(result.updated.parameters.at("c_alpha").determined);
 }
 
+// An overdamped machine (what damper sizing designs): a pendulum on a joint at 1.5 times critical
+// damping, sqrt((c + m g L) J) = sqrt((100 + 10 * 9.81 * 0.5) * 3.05) = 20.06, d = 3 * 20.06 =
+// 60.18, rings at no frequency, and `update` and `run` stopped at "no modes found" (exit 3). The
+// time-domain fit needs no modes: both joint parameters come back within 3 standard deviations;
+// the run is inconclusive (no identification), not a failure to run.
+TEST(FacadeTest, AnOverdampedMachineIsTunedWithoutModes) {
+  const std::string text = R"(name: pendulum
+model:
+  type: multibody
+  bodies:
+    bob: {parent: ground, joint: {type: revolute, coordinates: [swing], axis: [0, 1, 0]},
+          mass_kg: 10.0, com_m: [0, 0, -0.5], inertia_kgm2: [0.2, 0.2, 0.05]}
+  springs:
+    swing: {stiffness_Nm_per_rad: 100.0, damping_Nms_per_rad: 60.18}
+  outputs:
+    angle: {type: coordinate, coordinate: swing}
+excitation: {type: initial_deflection, deflection_rad: {swing: 0.01}}
+simulation: {duration_s: 4}
+sensors: {sample_rate_hz: 100, channels: [angle], noise_std_rad: 1.0e-5, seed: 3}
+updating: {noise_std_rad: 1.0e-5, global_search: {enabled: false},
+           start: {c_swing: 80.0, d_swing: 50.0}}
+)";
+  const mbid::Scenario scenario = mbid::LoadScenarioFromText(text, "overdamped.yaml");
+  const mbid::UpdateResult tuned = mbid::Update(scenario, {mbid::Simulate(scenario)});
+  const mbid::ParameterValue& c = tuned.parameters.at("c_swing");
+  const mbid::ParameterValue& d = tuned.parameters.at("d_swing");
+  EXPECT_NEAR(c.value, 100.0, 3 * c.std);
+  EXPECT_NEAR(d.value, 60.18, 3 * d.std);
+  EXPECT_TRUE(c.determined && d.determined);
+  const mbid::ValidationResult run = mbid::RunValidationCycle(scenario);
+  EXPECT_EQ(run.verdict, mbid::Verdict::kInconclusive);
+  EXPECT_NE(::testing::PrintToString(run.reasons).find("an overdamped machine"), std::string::npos)
+      << ::testing::PrintToString(run.reasons);
+}
+
 // `passed` needs a credible fit. Weights that state the noise 30 % low (7e-6 rad against the
 // record's 1e-5) leave a white excess, chi^2/dof about 2, taken for a noise level stated too low:
 // the standard deviations are inflated by about 1.4, but the fit is not credible (a trial's hammer

@@ -7,6 +7,7 @@
 
 #include "mbid/common/error.h"
 #include "mbid/common/hdf5_io.h"
+#include "mbid/identification/identify.h"
 #include "mbid/records/records.h"
 #include "mbid/validation/scenario.h"
 
@@ -108,6 +109,37 @@ identification::IdentificationOptions FreeDecayOptions(
     }
   }
   return options;
+}
+
+identification::ModalResult IdentifyForTheFit(const Measurement& record,
+                                              const identification::IdentificationOptions& options,
+                                              const std::string& origin) {
+  try {
+    return identification::Identify(record, options, origin);
+  } catch (const NumericalError& error) {
+    if (error.reason().rfind("no modes found", 0) != 0) throw;
+    // An overdamped machine (every joint past critical: what damper sizing designs) rings at no
+    // frequency; the time-domain fit needs no modes and tunes its joints from the decay alone.
+    identification::ModalResult nothing;
+    nothing.channels = record.channels;
+    nothing.units = record.units;
+    nothing.sample_interval_s = record.sample_interval_s;
+    nothing.samples = record.samples();
+    nothing.start_time_s = record.start_time_s;
+    nothing.release_time_s = record.start_time_s;
+    const Eigen::Index m = record.channel_count();
+    nothing.noise_std = Eigen::VectorXd::Zero(m);  // no weights from it
+    // No mode reconstructs nothing of the record: K 0 in every channel.
+    nothing.correlation = Eigen::VectorXd::Zero(m);
+    nothing.offset = Eigen::VectorXd::Zero(m);
+    nothing.reconstruction = Eigen::MatrixXd::Zero(record.samples(), m);
+    nothing.reliable = false;
+    nothing.reasons.push_back(
+        error.reason() +
+        " (an overdamped machine rings at no frequency; its joints are tuned to the record by "
+        "the time-domain fit alone, without Route 1)");
+    return nothing;
+  }
 }
 
 std::string ReadRecordScenario(const std::string& path) {

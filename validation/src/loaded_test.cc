@@ -59,7 +59,7 @@ LoadedTest PrepareTest(Measurement record, const std::string& origin,
   test.excitation_source = "scenario";
   // The simulation of the test starts at the release: the record is cut there.
   test.release = CutRecordAtRelease(&test.record, origin, release, test.excitation);
-  test.identified = identification::Identify(
+  test.identified = IdentifyForTheFit(
       test.record, FreeDecayOptions(identification_options, test.excitation), origin);
   return test;
 }

@@ -84,20 +84,16 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
                  const simulation::Excitation& excitation, const RunSettings& settings,
                  const std::function<void(const std::string&)>& say,
                  const std::function<void(const RunTest&)>& identified) {
-  try {
-    test.identified = identification::Identify(
-        test.measured, FreeDecayOptions(settings.identification, excitation), test.origin);
-  } catch (const NumericalError& error) {
-    // A simulated test that does not move the machine above its sensors' noise has nothing
-    // to identify: say why.
-    if (BarelyMoves(test)) {
-      throw NumericalError(error.stage(),
-                           error.reason() +
-                               " (the simulated test barely moves the machine: in every channel "
-                               "the noise-free signal stays below the sensor noise; does the "
-                               "excitation load a compliant coordinate?)");
-    }
-    throw;
+  const identification::IdentificationOptions options =
+      FreeDecayOptions(settings.identification, excitation);
+  test.identified = IdentifyForTheFit(test.measured, options, test.origin);
+  // A simulated test that does not move the machine above its sensors' noise has nothing to
+  // identify nor to fit: say why (no modes from a machine that moves is an overdamped one).
+  if (test.identified.modes.empty() && BarelyMoves(test)) {
+    throw NumericalError("identification",
+                         "no modes found (the simulated test barely moves the machine: in every "
+                         "channel the noise-free signal stays below the sensor noise; does the "
+                         "excitation load a compliant coordinate?)");
   }
   if (test.simulation) {
     // The test as simulated cannot show a mode above its Nyquist frequency but as an alias.

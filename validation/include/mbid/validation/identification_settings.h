@@ -1,6 +1,8 @@
 #pragma once
 
+#include "mbid/common/measurement.h"
 #include "mbid/common/yaml_reader.h"
+#include "mbid/identification/modal_result.h"
 #include "mbid/identification/options.h"
 #include "mbid/simulation/excitation.h"
 
@@ -23,6 +25,13 @@ identification::IdentificationOptions ReadIdentificationSettings(const YamlReade
 // excitation's forcing end (impulse, burst).
 identification::IdentificationOptions FreeDecayOptions(
     identification::IdentificationOptions options, const simulation::Excitation& excitation);
+
+// The record's modes for `update` and `run`: Identify, except that where it finds no modes (an
+// overdamped machine) the result has none, no noise levels, and is unreliable saying why: the
+// time-domain fit tunes the joints without them. Other failures throw as Identify's.
+identification::ModalResult IdentifyForTheFit(const Measurement& record,
+                                              const identification::IdentificationOptions& options,
+                                              const std::string& origin);
 
 // The scenario an HDF5 record file mbid wrote carries (/scenario), or "" (other files too).
 std::string ReadRecordScenario(const std::string& path);
