@@ -339,6 +339,7 @@ PYBIND11_MODULE(_mbid, m) {
       .def_readonly("channels", &mbid::ModalResult::channels)
       .def_readonly("release_time_s", &mbid::ModalResult::release_time_s)
       .def_readonly("release", &mbid::ModalResult::release)
+      .def_readonly("next_excitation_s", &mbid::ModalResult::next_excitation_s)
       .def_readonly("start_time_s", &mbid::ModalResult::start_time_s)
       .def_readonly("sample_interval_s", &mbid::ModalResult::sample_interval_s)
       .def_readonly("model_order", &mbid::ModalResult::model_order)

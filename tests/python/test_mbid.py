@@ -69,6 +69,25 @@ class IdentifyTest(unittest.TestCase):
         self.assertAlmostEqual(mode.damping_ratio,
                                0.3 / math.hypot(0.3, 2 * math.pi * 2.0), delta=1e-7)
 
+    def test_a_knock_after_the_decay_came_to_rest_ends_the_analysis(self):
+        # 1 s at rest at the deflection, a 2 Hz decay at 2 1/s (at rest within the 1e-4 noise
+        # from about 6 s), then at 12 s a knock: the analysis ends before it (C++:
+        # NextExcitationTest), and the mode is the first decay's.
+        rng = np.random.default_rng(1)
+        t = np.arange(3000) * 0.005
+        s = t - 1.0
+        y = np.where(t < 1.0, 1.0, np.exp(-2.0 * s) * np.cos(2 * np.pi * 2.0 * s))
+        k = t - 12.0
+        y = y + np.where(t >= 12.0, np.exp(-2.0 * k) * np.sin(2 * np.pi * 2.0 * k), 0.0)
+        y = y + 1e-4 * rng.standard_normal(t.size)
+        result = mbid.identify_arrays(t, {"x": y}, {"x": "m"})
+        self.assertIsNotNone(result.next_excitation_s)
+        self.assertAlmostEqual(result.next_excitation_s, 12.0, delta=0.011)
+        self.assertEqual(len(result.modes), 1)
+        self.assertAlmostEqual(result.modes[0].frequency_hz, 2.0, delta=1e-3)
+        quiet = mbid.identify_arrays(t[t < 12.0], {"x": y[t < 12.0]}, {"x": "m"})
+        self.assertIsNone(quiet.next_excitation_s)
+
     def test_options_reach_the_identification(self):
         # The two-mode decay above. A band up to 4 Hz keeps the 2 Hz mode alone (within two of
         # its standard deviations), and since one mode cannot explain the record the result says
