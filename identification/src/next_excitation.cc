@@ -116,7 +116,8 @@ std::optional<NextExcitation> FindNextExcitation(const Measurement& record, doub
   next.time_s = record.start_time_s + start * tau;
   next.description = fmt::format(
       "the structure is at rest again from {:.6g} s and set off again at {:.6g} s: a second "
-      "excitation (a reload and release, a knock) that is no part of this free decay",
+      "excitation (a reload and release, a knock) or a change of a sensor (a re-zero, hum "
+      "switching on) that is no part of this free decay",
       next.rest_s, next.time_s);
   return next;
 }

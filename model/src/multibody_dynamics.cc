@@ -118,7 +118,18 @@ Eigen::VectorXd SolveEquilibrium(const LoadedForce& loaded, const Eigen::MatrixX
     throw NumericalError("static equilibrium",
                          "the machine has no stiffness against a load on a free coordinate");
   }
-  if (std::optional<Eigen::VectorXd> q = SolveByChord(force, rest_tangent, f0)) return *q;
+  // The chord's root stands where the machine is stable there (-K negative definite) and was at
+  // q = 0: from a tangent that is not (a link raised 70 degrees under its payload) its first step
+  // went the wrong way, to an unstable balance with the link tipped back (a re-audit's arm).
+  const auto stable = [&](const Eigen::MatrixXd& tangent) {
+    const Eigen::MatrixXd symmetric = 0.5 * (tangent + tangent.transpose());
+    return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(symmetric).eigenvalues().maxCoeff() < 0;
+  };
+  if (stable(rest_tangent)) {
+    if (std::optional<Eigen::VectorXd> q = SolveByChord(force, rest_tangent, f0)) {
+      if (stable(Tangent(force, *q))) return *q;
+    }
+  }
   return SolveByContinuation(loaded, n);
 }
 

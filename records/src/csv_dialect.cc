@@ -142,9 +142,17 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
   constexpr size_t kMaxPreamble = 1000;
   bool found = false, found_follows = false;
   for (const char separator : {',', ';', '\t'}) {
+    bool passed_one = false;  // a candidate whose rows did not follow
     for (size_t k = 0; k + 1 < content.size() && k <= kMaxPreamble; ++k) {
       const auto header = SplitFields(lines[content[k]].text, separator);
       if (header.size() < 2 || IsDataRow(header, separator)) continue;
+      // Below a candidate whose rows broke off, only names make a header: a data row with a
+      // text cell ("0.01,zero") is the bad row the first candidate's error should name.
+      if (passed_one && std::any_of(header.begin(), header.end(), [&](const std::string& cell) {
+            return ClassifyCell(cell, separator) != CellKind::kText && !cell.empty();
+          })) {
+        continue;
+      }
       auto next = SplitFields(lines[content[k + 1]].text, separator);
       if (!FitRow(&next, header.size())) continue;
       int units_row = -1;
@@ -169,7 +177,11 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
         dialect->field_count = static_cast<int>(header.size());
         dialect->preamble_lines = static_cast<int>(k);
       }
-      break;
+      // A logger's preamble line of a name and numbers ("Messbereich;-10;10") reads as a row
+      // under the one above it ("Abtastrate;100;Hz"): the header whose rows follow is looked
+      // for further down (a trial's such file was refused).
+      if (follows) break;
+      passed_one = true;
     }
   }
   if (found) return true;

@@ -180,12 +180,14 @@ void StatedRateGrid(const Eigen::VectorXd& time, const std::string& path, const 
 // A time without a unit read in s whose step is under 0.1 s (10 Hz; slower steps are said in
 // ReadTimeBase) may still count ms of a logger of 10-50 kHz: every frequency then comes out
 // 1000 times too low, reliable (a trial's 12.8-20 kHz records: 1.2 and 6.5 Hz as 0.0012 and
-// 0.0065 Hz). Such a record swings over thousands of samples: where every channel that swings
-// (four reversals beyond a tenth of its range) takes over 500 samples per reversal, periods of
-// over 50 s at 20 Hz, which no machine's structure has, it is said (the median spacing of the
-// reversals: a long record's rest around a short decay does not count).
+// 0.0065 Hz). Such a record swings slowly for the time it states: where every channel that
+// swings (four reversals beyond a tenth of its range) has periods over 22 s (0.045 Hz, below any
+// machine's structure; a 100 m rope's pendulum is 0.05 Hz), it is said (the median spacing of
+// the reversals: a long record's rest around a short decay does not count). A 40 Hz mode of a
+// 25.6 kHz ms clock reads as 0.04 Hz, 640 samples per period (a first rule of 1000 missed it).
 void SayIfOversampled(const Measurement& m, ImportReport* report) {
-  constexpr double kSamplesPerReversal = 500;
+  constexpr double kLongestPeriodS = 22;
+  constexpr double kSamplesPerReversal = 100;  // the fewest to judge a period by
   // Steps of 0.02-0.1 "s": a ms clock of 10-50 kHz. A finer step read in s is a fast logger in
   // s (2 kHz: the crane's 1.5 Hz mode swings over 1333 samples) or a ms clock faster than any.
   if (!report->time_unit_assumed || m.samples() < 4 * kSamplesPerReversal ||
@@ -221,7 +223,7 @@ void SayIfOversampled(const Measurement& m, ImportReport* report) {
     std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
     fastest = std::min(fastest, spacing[spacing.size() / 2]);
   }
-  if (!(fastest > kSamplesPerReversal) || std::isinf(fastest)) return;
+  if (std::isinf(fastest) || !(2 * fastest * m.sample_interval_s > kLongestPeriodS)) return;
   const double seconds = 2 * fastest * m.sample_interval_s;
   report->warnings.push_back(fmt::format(
       "the time states no unit and is read in s (a step of {:g} s, {:.3g} Hz), and the record "

@@ -41,6 +41,10 @@ const std::map<std::string, std::string>& Aliases() {
       {"RAD", "rad"},
       {"MM", "mm"},
       {"Nm", "N.m"},
+      {"kNm", "kN.m"},
+      // Upper-case exports' S of seconds (MM/S, DEG/S): udunits2 reads the siemens, which no
+      // vibration sensor measures.
+      {"S", "s"},
   };
   return aliases;
 }
@@ -165,11 +169,37 @@ void RefuseAmbiguous(const std::string& text, const std::string& source, const s
       {"ms^-2", {"per millisecond squared", "m/s^2 (or m s-2, with a space)"}},
   };
   const auto found = readings.find(text);
-  if (found == readings.end()) return;
-  throw InputError(
-      source, field,
-      fmt::format("unit '{}' is ambiguous (udunits2 reads {})", text, found->second.udunits),
-      found->second.expected);
+  if (found != readings.end()) {
+    throw InputError(
+        source, field,
+        fmt::format("unit '{}' is ambiguous (udunits2 reads {})", text, found->second.udunits),
+        found->second.expected);
+  }
+  // Inside a compound unit too: a gyro's `Grad/s` was read as giga-radians per second, `ms**-2`
+  // as per millisecond squared.
+  for (size_t i = 0; i < text.size();) {
+    if (!IsNameByte(text[i])) {
+      ++i;
+      continue;
+    }
+    size_t end = i;
+    while (end < text.size() && IsNameByte(text[end])) ++end;
+    const std::string name = text.substr(i, end - i);
+    const std::string after = text.substr(end, 3);
+    const bool negative_power =
+        after.rfind("-", 0) == 0 || after.rfind("^-", 0) == 0 || after.rfind("**-", 0) == 0;
+    if (name == "Grad" || name == "Mrad" || (name == "ms" && negative_power)) {
+      throw InputError(source, field,
+                       fmt::format("unit '{}' is ambiguous: udunits2 reads '{}' as {}", text, name,
+                                   name == "Grad"   ? "the giga-radian"
+                                   : name == "Mrad" ? "the mega-radian"
+                                                    : "the millisecond"),
+                       name == "Grad"   ? "deg for degrees (German Grad), e.g. deg/s"
+                       : name == "Mrad" ? "mrad for milliradians"
+                                        : "m/s^2 or m/s (or m s-2, with a space)");
+    }
+    i = end;
+  }
 }
 
 }  // namespace

@@ -174,6 +174,38 @@ TEST(MultibodyModelTest, APayloadThatSagsTheArmFarIsLinearizedWhereLoadingLeads)
   }
 }
 
+// A re-audit's two-link arm: link 1 luffed 10 degrees (2 m, 80 kg, 9000 N m/rad), link 2 raised
+// 70 degrees more (1.5 m, 40 kg, 900 N m/rad), 100 kg at its tip. Under the payload link 2 is
+// unstable at q = 0, and the chord's first step went the wrong way, to an unstable balance with
+// link 2 tipped back ("the machine is unstable at rest", modes 0 and 0.61 Hz). Loaded gradually
+// (the re-audit's own path tracking, 20,000 steps) it sags forward to q = (-0.372, -1.594), with
+// modes of 0.3335 and 1.3710 Hz (its printed digits).
+TEST(MultibodyModelTest, APayloadThatTipsALinkAtRestIsFollowedToWhereLoadingLeads) {
+  const auto arm = FromYaml(R"(
+type: multibody
+bodies:
+  l1: {parent: ground, joint: {type: revolute, coordinates: [q1], axis: [0, -1, 0], in_parent_m: [0, 0, 1],
+       in_parent_rotation_deg: [{y: -10}]}, mass_kg: 80, com_m: [1.0, 0, 0], inertia_kgm2: [0.5, 26.666666666666668, 27.166666666666668]}
+  l2: {parent: l1, joint: {type: revolute, coordinates: [q2], axis: [0, -1, 0], in_parent_m: [2.0, 0, 0],
+       in_parent_rotation_deg: [{y: -70}]}, mass_kg: 40, com_m: [0.75, 0, 0], inertia_kgm2: [0.3, 7.5, 7.8]}
+springs:
+  q1: {stiffness_Nm_per_rad: 9000, damping_Nms_per_rad: 50.0}
+  q2: {stiffness_Nm_per_rad: 900, damping_Nms_per_rad: 30.0}
+points:
+  tip: {body: l2, at_m: [1.5, 0, 0]}
+payload_point: tip
+payload_mass_kg: 100
+gravity_mps2: 9.81
+outputs:
+  a1: {type: coordinate, coordinate: q1}
+)");
+  const std::vector<Mode> modes = CalcModes(arm->Linearize());
+  ASSERT_EQ(modes.size(), 2u);
+  EXPECT_TRUE(FindGrowingModes(modes).empty());
+  EXPECT_NEAR(modes[0].frequency_hz(), 0.3335, 1e-4);  // damped, as the re-audit printed them
+  EXPECT_NEAR(modes[1].frequency_hz(), 1.3710, 1e-4);
+}
+
 // A joint made "rigid" by a stiffness 1e12 times the other's: its slow mode is the machine's with
 // that joint welded, to the order of the stiffness ratio (2e-12), an independent model. Solved in
 // the plain first-order form (|A| ~ omega_max^2) the slow mode's decay rate was 1.7 % off and the

@@ -89,6 +89,15 @@ TEST(UnitsTest, RefusesUnknownAndIncompatibleUnits) {
     EXPECT_THAT(ambiguous.problem(), HasSubstr("ambiguous")) << unit;
   }
   EXPECT_THAT(CatchInputError([] { SiUnitFor("Grad", "f", "c"); }).expected(), HasSubstr("deg"));
+  // Inside compound units too: a gyro's Grad/s read 1e9 too large, ms**-2 1e6.
+  for (const char* unit : {"Grad/s", "Grad/s^2", "ms**-2", "m*ms-2"}) {
+    const InputError ambiguous = CatchInputError([unit] { SiUnitFor(unit, "f", "c"); });
+    EXPECT_THAT(ambiguous.problem(), HasSubstr("ambiguous")) << unit;
+  }
+  EXPECT_DOUBLE_EQ(FindConversion("ms", "s", "f", "c").scale, 1e-3);  // a time unit stays
+  EXPECT_DOUBLE_EQ(FindConversion("MM/S", "m/s", "f", "c").scale, 1e-3);
+  EXPECT_DOUBLE_EQ(FindConversion("DEG/S", "rad/s", "f", "c").scale, M_PI / 180);
+  EXPECT_DOUBLE_EQ(FindConversion("kNm", "N*m", "f", "c").scale, 1e3);
   // Upper-case spellings of loggers' exports.
   EXPECT_DOUBLE_EQ(FindConversion("DEG", "rad", "f", "c").scale, M_PI / 180);
   EXPECT_DOUBLE_EQ(FindConversion("Deg", "rad", "f", "c").scale, M_PI / 180);

@@ -138,8 +138,9 @@ AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin
       applied.next_excitation_s = next->time_s + origin_s;
       applied.next_excitation = fmt::format(
           "the structure is at rest again from {:.6g} s and set off again at {:.6g} s (in the "
-          "file's time): a second excitation (a reload and release, a knock) that is no part of "
-          "this test; the fit ends before it",
+          "file's time): a second excitation (a reload and release, a knock) or a change of a "
+          "sensor (a re-zero, hum switching on) that is no part of this test; the fit ends "
+          "before it",
           next->rest_s + origin_s, *applied.next_excitation_s);
     }
   }
