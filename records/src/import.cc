@@ -74,6 +74,29 @@ std::vector<Selected> SelectColumns(const RawTable& table, const std::string& pa
                          "unique column names, or channels mapped to column numbers "
                          "(`channels: {NAME: 2}`, --channel NAME=2)");
       }
+      if (!ProblemWithChannelName(column.name).empty()) {
+        // A logger's "Weg, links [mm]": its name cannot be a channel's (mbid's CSV header), but
+        // the column can be read under one the user gives.
+        std::string suggestion;
+        for (const char c : column.name) {
+          if (std::isalnum(static_cast<unsigned char>(c)) != 0) {
+            suggestion += c;
+          } else if (!suggestion.empty() && suggestion.back() != '_') {
+            suggestion += '_';
+          }
+        }
+        while (!suggestion.empty() && suggestion.back() == '_') suggestion.pop_back();
+        if (suggestion.empty() || ProblemWithChannelName(suggestion) != "") suggestion = "x";
+        const size_t number = static_cast<size_t>(&column - table.columns.data()) + 1;
+        throw InputError(path, DescribeColumn(column),
+                         fmt::format("the column name '{}' cannot name a channel (no ',', '/', "
+                                     "line break or blank at its ends, not 'time')",
+                                     column.name),
+                         fmt::format("the column read under a name of yours: --channel {0}={1} "
+                                     "(`channels: {{{0}: {1}}}` in the record entry), one per "
+                                     "channel to read",
+                                     suggestion, number));
+      }
       selected.push_back({column.name, &column, column.unit});
     }
     return selected;

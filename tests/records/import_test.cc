@@ -174,6 +174,20 @@ TEST(ImportTest, APreambleLineOfNumbersIsNoRowOfTheLineAbove) {
   EXPECT_THAT(report.dialect, HasSubstr("4 preamble lines"));
 }
 
+// A logger's "Weg, links [mm]" cannot name a channel (mbid's CSV header): refused saying how to
+// read it under a name of the user's, which then reads it (the refusal gave no way out before).
+TEST(ImportTest, AColumnNameThatCannotNameAChannelSaysHowToReadIt) {
+  TempDir dir;
+  WriteText(dir.File("weg.csv"), "Zeit [s];Weg, links [mm]\n0,00;1,5\n0,01;2,5\n0,02;3,5\n");
+  const InputError refused = CatchInputError([&] { ImportMeasurement(dir.File("weg.csv")); });
+  EXPECT_THAT(refused.expected(), HasSubstr("--channel Weg_links=1"));
+  ImportOptions named;
+  named.channel_columns = {{"Weg_links", "1"}};
+  const Measurement m = ImportMeasurement(dir.File("weg.csv"), named);
+  EXPECT_EQ(m.channels, std::vector<std::string>{"Weg_links"});
+  EXPECT_DOUBLE_EQ(m.values(1, 0), 2.5e-3);
+}
+
 // Epoch stamps (a logger's PC clock): in ms, scaled to s before the first was subtracted, exact
 // 1 ms steps read as 1.00017 ms and the file was refused as a dropped sample; in s printed to
 // 0.01 s, each stamp parses 2.4e-7 s off its printed value, with the same result. Both are read
