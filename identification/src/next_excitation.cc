@@ -24,7 +24,7 @@ using internal::kQuietSamples;
 // that long to die out, so no crest of a slow swing and no node of two beating modes (each far
 // shorter than half their beat) passes for a rest. -1 if none; *length is the window's.
 int FindRestAfterMotion(const Eigen::MatrixXd& y, const Eigen::VectorXd& noise, int begin,
-                        int* length) {
+                        int* length, int cap) {
   const int n = static_cast<int>(y.rows());
   const Eigen::Index m = y.cols();
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n + 1, m);
@@ -35,7 +35,7 @@ int FindRestAfterMotion(const Eigen::MatrixXd& y, const Eigen::VectorXd& noise, 
   bool moved = false;
   int end = begin;
   for (int a = begin; a < n; ++a) {
-    *length = std::max(kQuietSamples, (a - begin) / 4);
+    *length = std::max(kQuietSamples, std::min((a - begin) / 4, cap));
     if (a + *length > n) return -1;
     for (; end < a + *length; ++end) {
       for (Eigen::Index c = 0; c < m; ++c) {
@@ -88,7 +88,11 @@ std::optional<NextExcitation> FindNextExcitation(const Measurement& record, doub
     noise(c) = internal::ThirdDifferenceNoise(y.col(c).segment(begin, n - begin));
   }
   int length = 0;
-  const int rest = FindRestAfterMotion(y, noise, begin, &length);
+  // At most 10 s: over a minute's decay a quarter of it outlasted the rest before a reload (a
+  // re-audit's drops at 0.5-10 kHz), and 10 s are half a period of a 0.05 Hz pendulum: no crest
+  // rests that long.
+  const int cap = std::max(kQuietSamples, static_cast<int>(10.0 / tau));
+  const int rest = FindRestAfterMotion(y, noise, begin, &length, cap);
   if (rest < 0) return std::nullopt;
   const Eigen::VectorXd level = y.middleRows(rest, length).colwise().mean().transpose();
   const auto off = [&](int j, double band) {
@@ -108,7 +112,11 @@ std::optional<NextExcitation> FindNextExcitation(const Measurement& record, doub
   for (int j = away; j < std::min(n, away + length) && !quick; ++j) {
     quick = ((y.row(j).transpose() - level).array().abs() > step).any();
   }
-  if (!quick && internal::Reversals(y, noise, away, n) < 2) return std::nullopt;
+  // The swing within the rest's length, not over the rest of the record: a sensor's random-walk
+  // drift wanders past 10 noise std both ways over a minute (a re-audit's record was cut so).
+  if (!quick && internal::Reversals(y, noise, away, std::min(n, away + length)) < 2) {
+    return std::nullopt;
+  }
   int start = away;
   while (start > rest + length && off(start - 1, 3)) --start;
   NextExcitation next;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -127,7 +128,65 @@ TEST(NextExcitationTest, RestDriftBeatingAndALongDecayAreNone) {
   for (Eigen::Index j = 1500; j < drifting.values.rows(); ++j) {
     drifting.values.row(j).array() += 50 * kNextNoise * (j - 1500) / 600.0;
   }
-  EXPECT_FALSE(FindNextExcitation(drifting, 1.0).has_value());
+  EXPECT_FALSE(FindNextExcitation(drifting, 3.0).has_value());
+
+  testing::SignalSpec beating = TwoModes(6000);  // 60 s; 2.00 and 2.04 Hz: a 25 s beat
+  beating.modes = {{2.00, 0.01, {5e-3, 5e-3}, {0.0, 0.0}}, {2.04, 0.01, {5e-3, 5e-3}, {0.0, 0.0}}};
+  const Eigen::MatrixXd beats = testing::Synthesize(beating);
+  EXPECT_FALSE(FindNextExcitation(Concatenate({Held(beats, 100), beats}, 6), 1.0).has_value());
+
+  testing::SignalSpec light = TwoModes(2000);
+  for (testing::TrueMode& mode : light.modes) mode.decay_per_s = 0.05;
+  const Eigen::MatrixXd ringing = testing::Synthesize(light);
+  EXPECT_FALSE(FindNextExcitation(Concatenate({Held(ringing, 100), ringing}, 7), 1.0).has_value());
+}
+
+// A minute's decay at 1 kHz (1.2 Hz at 2 %: at rest only from about 47 s) reloaded over 1 s at
+// 60 s: a rest as long as a quarter of the time since the release (15 s) did not fit before the
+// reload, and nothing was cut (a re-audit's drops at 0.5-10 kHz); a rest of 10 s does. A random-
+// walk drift of the sensor after the decay wanders past 10 noise std both ways over a minute, but
+// is no swing within the rest's length: not cut (the re-audit's thermal drift, cut by a first
+// version).
+TEST(NextExcitationTest, ALongDecayAtAHighRateAndADriftingTail) {
+  constexpr double kRate = 1000.0, kSigma = 2e-6;
+  const auto decay = [](double s) {
+    return 0.01 * std::exp(-0.15 * s) * std::cos(2 * M_PI * 1.2 * s);
+  };
+  std::mt19937_64 rng(8);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Measurement drop;
+  drop.channels = {"x"};
+  drop.units = {"m"};
+  drop.sample_interval_s = 1 / kRate;
+  drop.values.resize(75000, 1);
+  for (Eigen::Index j = 0; j < drop.values.rows(); ++j) {
+    const double t = static_cast<double>(j) / kRate;
+    const double ramp = t < 60 ? 0 : t < 61 ? 0.5 * (1 - std::cos(M_PI * (t - 60))) : 1;
+    const double y = t < 1 ? 0.01 : t < 62 ? decay(t - 1) + ramp * 0.01 : decay(t - 62);
+    drop.values(j, 0) = y + kSigma * normal(rng);
+  }
+  const std::optional<NextExcitation> reload = FindNextExcitation(drop, 1.0);
+  ASSERT_TRUE(reload.has_value());
+  EXPECT_GE(reload->time_s, 60.0);
+  EXPECT_LE(reload->time_s, 60.06);
+
+  // The re-audit's record: 100 Hz, 150 s, held at 5 mm until 3 s, 1.5 Hz at 1 % (at rest from
+  // about 40 s), a thermal drift of 200 noise std (time constant 60 s) and a random walk of a
+  // quarter of the noise per sample, noise 0.002 mm.
+  Measurement drifting;
+  drifting.channels = {"x"};
+  drifting.units = {"mm"};
+  drifting.sample_interval_s = 0.01;
+  drifting.values.resize(15000, 1);
+  double walk = 0;
+  for (Eigen::Index j = 0; j < drifting.values.rows(); ++j) {
+    const double t = 0.01 * static_cast<double>(j), s = t - 3;
+    walk += 0.0005 * normal(rng);
+    const double w = 2 * M_PI * 1.5;
+    drifting.values(j, 0) = (t < 3 ? 5.0 : 5.0 * std::exp(-0.01 * w * s) * std::cos(w * s)) +
+                            0.4 * (1 - std::exp(-t / 60)) + walk + 0.002 * normal(rng);
+  }
+  EXPECT_FALSE(FindNextExcitation(drifting, 3.0).has_value());
 
   testing::SignalSpec beating = TwoModes(6000);  // 60 s; 2.00 and 2.04 Hz: a 25 s beat
   beating.modes = {{2.00, 0.01, {5e-3, 5e-3}, {0.0, 0.0}}, {2.04, 0.01, {5e-3, 5e-3}, {0.0, 0.0}}};
