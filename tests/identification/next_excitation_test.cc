@@ -128,7 +128,7 @@ TEST(NextExcitationTest, RestDriftBeatingAndALongDecayAreNone) {
   for (Eigen::Index j = 1500; j < drifting.values.rows(); ++j) {
     drifting.values.row(j).array() += 50 * kNextNoise * (j - 1500) / 600.0;
   }
-  EXPECT_FALSE(FindNextExcitation(drifting, 3.0).has_value());
+  EXPECT_FALSE(FindNextExcitation(drifting, 1.0).has_value());
 
   testing::SignalSpec beating = TwoModes(6000);  // 60 s; 2.00 and 2.04 Hz: a 25 s beat
   beating.modes = {{2.00, 0.01, {5e-3, 5e-3}, {0.0, 0.0}}, {2.04, 0.01, {5e-3, 5e-3}, {0.0, 0.0}}};
@@ -187,16 +187,6 @@ TEST(NextExcitationTest, ALongDecayAtAHighRateAndADriftingTail) {
                             0.4 * (1 - std::exp(-t / 60)) + walk + 0.002 * normal(rng);
   }
   EXPECT_FALSE(FindNextExcitation(drifting, 3.0).has_value());
-
-  testing::SignalSpec beating = TwoModes(6000);  // 60 s; 2.00 and 2.04 Hz: a 25 s beat
-  beating.modes = {{2.00, 0.01, {5e-3, 5e-3}, {0.0, 0.0}}, {2.04, 0.01, {5e-3, 5e-3}, {0.0, 0.0}}};
-  const Eigen::MatrixXd beats = testing::Synthesize(beating);
-  EXPECT_FALSE(FindNextExcitation(Concatenate({Held(beats, 100), beats}, 6), 1.0).has_value());
-
-  testing::SignalSpec light = TwoModes(2000);
-  for (testing::TrueMode& mode : light.modes) mode.decay_per_s = 0.05;
-  const Eigen::MatrixXd ringing = testing::Synthesize(light);
-  EXPECT_FALSE(FindNextExcitation(Concatenate({Held(ringing, 100), ringing}, 7), 1.0).has_value());
 }
 
 }  // namespace
