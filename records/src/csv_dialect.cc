@@ -63,7 +63,46 @@ std::vector<TextLine> SplitLines(const std::string& text, bool* bom, bool* crlf)
   return lines;
 }
 
+namespace {
+
+// Fields of a line whose columns are aligned by blanks (a `.txt` from numpy.savetxt, a
+// spreadsheet's "formatted text", an oscilloscope's `.dat`): runs of spaces and tabs part them;
+// a bracketed unit after a name ("time [s]", "y (mm)") belongs to it.
+std::vector<std::string> SplitOnBlanks(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  bool quoted = false;
+  const auto close = [&] {
+    if (field.empty()) return;
+    const char open = field.front();
+    const bool after_name =
+        !fields.empty() && fields.back().front() != '[' && fields.back().front() != '(';
+    if ((open == '[' || open == '(') && after_name && !quoted) {
+      fields.back() += " " + field;
+    } else {
+      fields.push_back(field);
+    }
+    field.clear();
+  };
+  for (const char c : line) {
+    if (c == '"') quoted = !quoted;
+    if ((c == ' ' || c == '\t') && !quoted) {
+      close();
+    } else {
+      field += c;
+    }
+  }
+  close();
+  for (std::string& f : fields) {
+    if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = f.substr(1, f.size() - 2);
+  }
+  return fields;
+}
+
+}  // namespace
+
 std::vector<std::string> SplitFields(const std::string& line, char separator) {
+  if (separator == ' ') return SplitOnBlanks(line);
   std::vector<std::string> fields;
   std::string field;
   bool quoted = false;
@@ -119,6 +158,18 @@ bool IsCommentOrBlank(const std::string& line) {
   return trimmed.empty() || trimmed.front() == '#';
 }
 
+std::string CommentBody(const std::string& line) {
+  const std::string trimmed = mbid::internal::Trim(line);
+  size_t at = 0;
+  while (at < trimmed.size() && trimmed[at] == '#') ++at;
+  return mbid::internal::Trim(trimmed.substr(at));
+}
+
+std::string HeaderText(const std::vector<TextLine>& lines, const CsvDialect& dialect) {
+  const std::string& text = lines[static_cast<size_t>(dialect.header)].text;
+  return dialect.header_in_comment ? CommentBody(text) : text;
+}
+
 // Whether the content lines from `first` on (up to kRowsChecked of them) are all rows of
 // `columns` fields that are data: a header candidate's rows must go on as it says. Two data lines
 // of a ';' file with decimal commas ("1,49;34,999;-12" then "1,5;35;-11,998") split on ',' as a
@@ -133,6 +184,52 @@ bool RowsFollow(const std::vector<TextLine>& lines, const std::vector<int>& cont
   return true;
 }
 
+// numpy.savetxt(header=...) and many scripts name the columns in a comment line right above the
+// numbers ("# time_s angle_rad"): taken where no line of names stands elsewhere.
+bool FindHeaderInComment(const std::vector<TextLine>& lines, const std::vector<int>& content,
+                         CsvDialect* dialect) {
+  if (content.empty()) return false;
+  int above = content.front() - 1;
+  while (above >= 0 && mbid::internal::Trim(lines[static_cast<size_t>(above)].text).empty()) {
+    --above;
+  }
+  if (above < 0) return false;
+  const std::string body = CommentBody(lines[static_cast<size_t>(above)].text);
+  for (const char separator : {',', ';', '\t', ' '}) {
+    const auto header = SplitFields(body, separator);
+    const bool names = std::all_of(header.begin(), header.end(), [&](const std::string& cell) {
+      return !cell.empty() && ClassifyCell(cell, separator) == CellKind::kText;
+    });
+    if (header.size() < 2 || !names || !RowsFollow(lines, content, 0, header.size(), separator)) {
+      continue;
+    }
+    dialect->separator = separator;
+    dialect->header = above;
+    dialect->header_in_comment = true;
+    dialect->units_row = -1;
+    dialect->field_count = static_cast<int>(header.size());
+    dialect->preamble_lines = 0;
+    return true;
+  }
+  return false;
+}
+
+int FirstLineOfNumbers(const std::vector<TextLine>& lines) {
+  for (const TextLine& line : lines) {
+    if (IsCommentOrBlank(line.text)) continue;
+    for (const char separator : {',', ';', '\t', ' '}) {
+      const auto fields = SplitFields(line.text, separator);
+      if (std::all_of(fields.begin(), fields.end(), [&](const std::string& cell) {
+            return ClassifyCell(cell, separator) == CellKind::kNumber;
+          })) {
+        return line.number;
+      }
+    }
+    return 0;
+  }
+  return 0;
+}
+
 bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
   std::vector<int> content;  // indices of lines that are neither comments nor blank
   for (size_t i = 0; i < lines.size(); ++i) {
@@ -141,7 +238,9 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
   // A header stands among the first lines, after a preamble of at most this many.
   constexpr size_t kMaxPreamble = 1000;
   bool found = false, found_follows = false;
-  for (const char separator : {',', ';', '\t'}) {
+  // Blanks part the columns only where no other separator does: a tab file's names hold spaces.
+  for (const char separator : {',', ';', '\t', ' '}) {
+    if (separator == ' ' && found) break;
     bool passed_one = false;  // a candidate whose rows did not follow
     for (size_t k = 0; k + 1 < content.size() && k <= kMaxPreamble; ++k) {
       const auto header = SplitFields(lines[content[k]].text, separator);
@@ -185,6 +284,7 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
     }
   }
   if (found) return true;
+  if (FindHeaderInComment(lines, content, dialect)) return true;
   // One column (a single channel logged without a time column: its sample rate comes from
   // --sample-rate-hz): a name, maybe a units row, then numbers, one per line. The separator is
   // one the lines do not hold, so that a decimal comma stays in its number.
@@ -216,7 +316,11 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
 }
 
 std::string CsvDialect::Describe(bool decimal_comma, bool thousands) const {
-  std::string text = separator == '\t' ? "tab-separated" : fmt::format("'{}'-separated", separator);
+  std::string text = field_count == 1    ? "one column"
+                     : separator == '\t' ? "tab-separated"
+                     : separator == ' '  ? "blank-separated"
+                                         : fmt::format("'{}'-separated", separator);
+  if (header_in_comment) text += ", header in a comment";
   if (decimal_comma) text += ", decimal comma";
   if (thousands) text += ", thousands separators";
   if (crlf) text += ", CRLF";

@@ -17,7 +17,8 @@ struct TextLine {
 // The file's lines without a UTF-8 byte order mark and without CR/CRLF line ends.
 std::vector<TextLine> SplitLines(const std::string& text, bool* bom, bool* crlf);
 
-// Fields of one line, trimmed and without surrounding double quotes ("a;b" stays one field).
+// Fields of one line, trimmed and without surrounding double quotes ("a;b" stays one field);
+// separator ' ' splits on runs of blanks.
 std::vector<std::string> SplitFields(const std::string& line, char separator);
 
 // Whether a row of `fields` fits a header of `columns` fields: as many, or one more that is
@@ -40,17 +41,29 @@ struct CsvDialect {
   int header = -1;     // index into the lines
   int units_row = -1;  // index into the lines, or -1
   int field_count = 0;
-  int preamble_lines = 0;  // lines before the header other than comments and blank lines
+  int preamble_lines = 0;          // lines before the header other than comments and blank lines
+  bool header_in_comment = false;  // "# time_s angle_rad" right above the numbers
   // "';'-separated, decimal comma, thousands separators, CRLF, BOM, 3 preamble lines, units row"
   std::string Describe(bool decimal_comma, bool thousands = false) const;
 };
 
 // The header is the first line followed (after an optional units row: every cell empty or a
 // unit) by a data row with as many fields; the separator is the one of ',' ';' tab that finds
-// a header with the most fields. Returns false when no separator finds one.
+// a header with the most fields, else blanks (' ': runs of spaces and tabs); else a comment line
+// of names right above the numbers. Returns false when none is found.
 bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect);
+
+// The line number of the file's first content line when it is numbers alone (a file without a
+// header), else 0.
+int FirstLineOfNumbers(const std::vector<TextLine>& lines);
 
 // Whether the line is a comment ('#') or blank: neither header nor data.
 bool IsCommentOrBlank(const std::string& line);
+
+// A comment line's text after its '#'s.
+std::string CommentBody(const std::string& line);
+
+// The header's text (a header in a comment without its '#').
+std::string HeaderText(const std::vector<TextLine>& lines, const CsvDialect& dialect);
 
 }  // namespace mbid::records::internal

@@ -84,7 +84,8 @@ SlashOrder DecideSlashOrder(const std::string& path, const std::vector<TextLine>
 }
 
 constexpr char kExpected[] =
-    "a table of numbers with a header line, separated by ',', ';' or tabs (docs/records.md)";
+    "a table of numbers with a header line, separated by ',', ';', tabs or blanks "
+    "(docs/records.md)";
 
 // The decimal place of a number's last printed digit, as a power of ten: "0.0123" -> -4,
 // "1.5e-3" -> -4, "12" -> 0 (as mbid's CSV reader counts it).
@@ -204,13 +205,18 @@ RawTable ReadCsv(const std::string& path) {
   CsvDialect dialect;
   const std::vector<TextLine> lines = SplitLines(text, &dialect.bom, &dialect.crlf);
   if (!DetectDialect(lines, &dialect)) {
+    const int first = FirstLineOfNumbers(lines);
+    if (first > 0) {
+      throw InputError(path, LineField(first), "rows of numbers without a line of names above them",
+                       "a header line naming each column with its unit, the time first "
+                       "(time [s], theta [deg]; numpy.savetxt's header= writes one)");
+    }
     throw InputError(path, "", "no header line followed by rows of numbers with as many fields",
                      kExpected);
   }
   const char separator = dialect.separator;
   const int header_line = lines[static_cast<size_t>(dialect.header)].number;
-  const std::vector<std::string> header_cells =
-      SplitFields(lines[static_cast<size_t>(dialect.header)].text, separator);
+  const std::vector<std::string> header_cells = SplitFields(HeaderText(lines, dialect), separator);
   std::vector<std::string> unit_cells(header_cells.size());
   if (dialect.units_row >= 0) {
     unit_cells = SplitFields(lines[static_cast<size_t>(dialect.units_row)].text, separator);
@@ -403,8 +409,8 @@ RawTable ReadCsv(const std::string& path) {
 
   // mbid's own CSV: ',' and a first column named exactly `time`; channels without a unit are
   // SI by contract (docs/file-formats.md).
-  table.si_by_contract = separator == ',' && dialect.units_row < 0 && !header_cells.empty() &&
-                         header_cells.front() == "time";
+  table.si_by_contract = separator == ',' && dialect.units_row < 0 && !dialect.header_in_comment &&
+                         !header_cells.empty() && header_cells.front() == "time";
   table.format = table.si_by_contract ? "mbid-csv" : "csv";
   table.dialect = dialect.Describe(decimal.mark == DecimalMark::kComma, thousands);
   if (date_column >= 0) table.dialect += fmt::format(", dates in column {}", date_column + 1);

@@ -22,7 +22,7 @@ struct Format {
 
 const std::vector<Format>& Formats() {
   static const std::vector<Format> formats = {
-      {{".csv", ".txt"},
+      {{".csv", ".txt", ".tsv", ".dat", ".asc"},
        [](const std::string& p, const std::string&) { return internal::ReadCsv(p); }},
       {{".h5", ".hdf5"}, &internal::ReadHdf5},
       {{".uff", ".unv", ".uff58", ".uffb"},

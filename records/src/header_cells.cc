@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <utility>
 
 #include "internal.h"
 #include "units.h"
@@ -61,6 +62,30 @@ bool IsTimeColumnName(const std::string& name, std::string* unit) {
     }
   }
   return false;
+}
+
+std::string UnitFromNameSuffix(const std::string& name) {
+  // Longest first: `_m_s2` before `_s2`-less `_m_s`, `_mm_s` before `_m_s`... each is matched as
+  // a whole suffix after an underscore, so `_rad_s` is not taken for `_s`.
+  static const std::pair<const char*, const char*> kSuffixes[] = {
+      {"_rad_s2", "rad/s^2"}, {"_deg_s2", "deg/s^2"},
+      {"_mm_s2", "mm/s^2"},   {"_m_s2", "m/s^2"},
+      {"_rad_s", "rad/s"},    {"_deg_s", "deg/s"},
+      {"_mm_s", "mm/s"},      {"_m_s", "m/s"},
+      {"_mrad", "mrad"},      {"_rad", "rad"},
+      {"_deg", "deg"},        {"_um", "um"},
+      {"_mm", "mm"},          {"_m", "m"},
+      {"_rpm", "rpm"},        {"_mps2", "m/s^2"},
+      {"_mps", "m/s"}};
+  const std::string lower = Lower(name);
+  for (const auto& [suffix, unit] : kSuffixes) {
+    const std::string tail(suffix);
+    if (lower.size() > tail.size() &&
+        lower.compare(lower.size() - tail.size(), tail.size(), tail) == 0) {
+      return unit;
+    }
+  }
+  return "";
 }
 
 }  // namespace mbid::records::internal

@@ -240,6 +240,12 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
     std::string target = target_it == options.target_units.end() ? "" : target_it->second;
     const std::string field = DescribeColumn(*s.column);
     std::string unit = s.unit;
+    if (unit.empty() && !table.si_by_contract) {
+      unit = internal::UnitFromNameSuffix(s.column->name);
+      if (!unit.empty()) {
+        r.conversions.push_back(fmt::format("{}: unit {} from the name's suffix", s.channel, unit));
+      }
+    }
     if (unit.empty()) {
       if (!table.si_by_contract) {
         throw InputError(path, field, fmt::format("no unit for column '{}'", s.column->name),

@@ -47,7 +47,8 @@ const BadFile kBadFiles[] = {
     {"GapRefused", "# preamble comment\nt [s];x [mm];y [mm]\n0;1;1\n1;2;\n2;3;3\n",
      "line 4, column 3 (y)", "gap", "--fill-gaps linear"},
     {"NoTimeColumn", "a [mm];b [mm]\n0;1\n1;2\n", "header", "no time column", "sample_rate_hz"},
-    {"NoHeader", "0;1\n1;2\n", "", "no header", "header"},
+    {"NoHeader", "0;1\n1;2\n", "line 1", "without a line of names", "header line naming"},
+    {"NoTable", "Messung 7\nok\n", "", "no header", "header"},
     {"TwoUnits", "t [s];x [mm]\ns;m\n0;1\n1;2\n", "line 1, column 2", "'mm' in the header",
      "one unit"},
     // A Latin-1 export: refused where it is read, not when the JSON summary is written.

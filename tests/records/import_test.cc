@@ -188,6 +188,42 @@ TEST(ImportTest, AColumnNameThatCannotNameAChannelSaysHowToReadIt) {
   EXPECT_DOUBLE_EQ(m.values(1, 0), 2.5e-3);
 }
 
+// Text tables aligned by blanks (numpy.savetxt, an oscilloscope's .dat, "formatted text") and
+// names in a comment line right above the numbers (numpy.savetxt's header=) were refused as "no
+// header line"; a name's unit suffix (`theta_deg`) was "no unit". Each is read to the printed
+// digit: values are printed with 6 decimals of a decay of amplitude 1.
+TEST(ImportTest, BlankSeparatedTablesAndHeadersInACommentAreRead) {
+  TempDir dir;
+  const auto decay = [](double t) { return std::exp(-0.2 * t) * std::cos(2 * M_PI * 1.3 * t); };
+  std::string aligned = "  t [s]      y [mm]\ttheta_deg\n";
+  std::string commented = "# produced by a script\n# time_s,acc_m_s2,theta_deg\n";
+  for (int j = 0; j < 200; ++j) {
+    const double t = 0.01 * j;
+    aligned += fmt::format("{:7.2f}   {:10.6f}\t{:.6f}\n", t, decay(t), 2 * decay(t));
+    commented += fmt::format("{:.2f},{:.6f},{:.6f}\n", t, decay(t), 2 * decay(t));
+  }
+  WriteText(dir.File("aligned.dat"), aligned);
+  WriteText(dir.File("savetxt.csv"), commented);
+  for (const char* name : {"aligned.dat", "savetxt.csv"}) {
+    ImportReport report;
+    const Measurement m = ImportMeasurement(dir.File(name), {}, &report);
+    ASSERT_EQ(m.samples(), 200) << name;
+    EXPECT_EQ(m.sample_interval_s, 0.01);
+    const bool blanks = name[0] == 'a';
+    EXPECT_EQ(report.dialect, blanks ? "blank-separated" : "','-separated, header in a comment");
+    EXPECT_THAT(report.conversions,
+                ::testing::Contains("theta_deg: unit deg from the name's suffix"));
+    const double scale = blanks ? 1e-3 : 1.0;  // y [mm] -> m; acc_m_s2 is SI
+    EXPECT_NEAR(m.values(37, 0), decay(0.37) * scale, 5e-7 * scale) << name;
+    EXPECT_NEAR(m.values(37, 1), 2 * decay(0.37) * kDeg, 5e-7 * kDeg) << name;
+  }
+  // Numbers alone: which column is the time, and in what unit, is not guessed.
+  WriteText(dir.File("bare.txt"), "0.0 1.0\n0.01 0.9\n0.02 0.8\n");
+  const InputError bare = CatchInputError([&] { ImportMeasurement(dir.File("bare.txt")); });
+  EXPECT_EQ(bare.field(), "line 1");
+  EXPECT_THAT(bare.problem(), HasSubstr("without a line of names"));
+}
+
 // Epoch stamps (a logger's PC clock): in ms, scaled to s before the first was subtracted, exact
 // 1 ms steps read as 1.00017 ms and the file was refused as a dropped sample; in s printed to
 // 0.01 s, each stamp parses 2.4e-7 s off its printed value, with the same result. Both are read
@@ -429,7 +465,9 @@ TEST(ImportTest, OneChannelWithoutATimeColumn) {
   EXPECT_DOUBLE_EQ(m.values(1, 0), -2e-3);
   const std::string comma = dir.File("komma.csv");
   WriteText(comma, "Neigung\ndeg\n0,5\n1,25\n");
-  const Measurement c = ImportMeasurement(comma, options);
+  ImportReport report;
+  const Measurement c = ImportMeasurement(comma, options, &report);
+  EXPECT_EQ(report.dialect, "one column, decimal comma, units row");
   ASSERT_EQ(c.samples(), 2);
   EXPECT_DOUBLE_EQ(c.values(1, 0), 1.25 * M_PI / 180);
 }
