@@ -281,36 +281,42 @@ int Main(int argc, char** argv) {
     return mbid::app::RunCampaignCommand(campaign_path, output_dir, campaign_workers,
                                          campaign_resume, common);
   }
-  if (identify->parsed()) {
-    mbid::identification::ParseMethod(identify_method, &identify_options.method);
-    mbid::identification::ParseBackboneMode(identify_backbone, &identify_options.backbone);
-    if (common.import.release_none) {
-      identify_options.release = mbid::identification::ReleaseMode::kNone;
-    } else if (common.import.release_time_s) {
-      identify_options.release = mbid::identification::ReleaseMode::kGiven;
-      identify_options.release_time_s = *common.import.release_time_s;
+  // -o, --json and --export appear together when the command succeeds, or none of them.
+  mbid::OutputSet outputs_together;
+  const int code = [&] {
+    if (identify->parsed()) {
+      mbid::identification::ParseMethod(identify_method, &identify_options.method);
+      mbid::identification::ParseBackboneMode(identify_backbone, &identify_options.backbone);
+      if (common.import.release_none) {
+        identify_options.release = mbid::identification::ReleaseMode::kNone;
+      } else if (common.import.release_time_s) {
+        identify_options.release = mbid::identification::ReleaseMode::kGiven;
+        identify_options.release_time_s = *common.import.release_time_s;
+      }
+      identify_options.offset =
+          identify_offset == "none"   ? mbid::identification::OffsetRemoval::kNone
+          : identify_offset == "mean" ? mbid::identification::OffsetRemoval::kMean
+                                      : mbid::identification::OffsetRemoval::kFit;
+      return mbid::app::RunIdentifyCommand(data_path, identify_options, output_path, common);
     }
-    identify_options.offset = identify_offset == "none" ? mbid::identification::OffsetRemoval::kNone
-                              : identify_offset == "mean"
-                                  ? mbid::identification::OffsetRemoval::kMean
-                                  : mbid::identification::OffsetRemoval::kFit;
-    return mbid::app::RunIdentifyCommand(data_path, identify_options, output_path, common);
-  }
-  if (update->parsed()) {
-    return mbid::app::RunUpdateCommand(scenario_path, update_data, output_path, common);
-  }
-  if (plan->parsed()) {
-    return mbid::app::RunPlanCommand(scenario_path, plan_data, plan_candidates, common);
-  }
-  if (structure->parsed()) {
-    return mbid::app::RunStructureCommand(scenario_path, structure_data, structure_max_rigid,
-                                          structure_threads, output_path, common);
-  }
-  if (modes->parsed()) return mbid::app::RunModesCommand(scenario_path, common);
-  if (simulate->parsed()) {
-    return mbid::app::RunSimulateCommand(scenario_path, output_path, common, export_paths);
-  }
-  return static_cast<int>(mbid::app::ExitCode::kOther);
+    if (update->parsed()) {
+      return mbid::app::RunUpdateCommand(scenario_path, update_data, output_path, common);
+    }
+    if (plan->parsed()) {
+      return mbid::app::RunPlanCommand(scenario_path, plan_data, plan_candidates, common);
+    }
+    if (structure->parsed()) {
+      return mbid::app::RunStructureCommand(scenario_path, structure_data, structure_max_rigid,
+                                            structure_threads, output_path, common);
+    }
+    if (modes->parsed()) return mbid::app::RunModesCommand(scenario_path, common);
+    if (simulate->parsed()) {
+      return mbid::app::RunSimulateCommand(scenario_path, output_path, common, export_paths);
+    }
+    return static_cast<int>(mbid::app::ExitCode::kOther);
+  }();
+  if (code == 0) outputs_together.Commit();
+  return code;
 }
 
 }  // namespace

@@ -4,10 +4,12 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <stdexcept>
 #include <system_error>
 
@@ -127,6 +129,10 @@ void AtomicFile::Commit() {
     throw std::runtime_error("cannot commit " + path_ + ": nothing was written to " + temp_path_);
   }
   if (sync_) internal::SyncFile(temp_path_);
+  if (OutputSet::Defer(path_, temp_path_, &interrupt_cleanup_, sync_)) {
+    committed_ = true;  // the set renames it, or removes it
+    return;
+  }
   CrashPoint("file-commit");
   interrupt_cleanup_->Commit([this] {
     std::error_code error;
@@ -139,6 +145,70 @@ void AtomicFile::Commit() {
   committed_ = true;
   CrashPoint("file-committed");
   if (sync_) internal::SyncFolder(fs::path(path_).parent_path().string());
+}
+
+namespace {
+
+std::mutex active_set_mutex;
+OutputSet* active_set = nullptr;
+
+bool IsSummary(const std::string& path) {
+  return path.size() >= 5 && path.compare(path.size() - 5, 5, ".json") == 0;
+}
+
+}  // namespace
+
+OutputSet::OutputSet() {
+  std::lock_guard<std::mutex> lock(active_set_mutex);
+  if (active_set != nullptr) throw std::logic_error("a second OutputSet while one is active");
+  active_set = this;
+}
+
+OutputSet::~OutputSet() {
+  {
+    std::lock_guard<std::mutex> lock(active_set_mutex);
+    active_set = nullptr;
+  }
+  if (committed_) return;
+  for (const Pending& pending : pending_) {
+    std::error_code ignored;
+    fs::remove(pending.temp_path, ignored);
+  }
+}
+
+bool OutputSet::Defer(const std::string& path, const std::string& temp_path,
+                      std::unique_ptr<RemoveOnInterrupt>* interrupt_cleanup, bool sync) {
+  std::lock_guard<std::mutex> lock(active_set_mutex);
+  if (active_set == nullptr) return false;
+  active_set->pending_.push_back({path, temp_path, std::move(*interrupt_cleanup), sync});
+  return true;
+}
+
+void OutputSet::Commit() {
+  {
+    std::lock_guard<std::mutex> lock(active_set_mutex);
+    active_set = nullptr;  // no file joins the set while it is renamed
+  }
+  std::stable_partition(pending_.begin(), pending_.end(),
+                        [](const Pending& p) { return !IsSummary(p.path); });
+  if (!pending_.empty()) CrashPoint("file-commit");
+  HoldInterruptCleanup([this] {
+    for (Pending& pending : pending_) {
+      pending.interrupt_cleanup->Commit([&pending] {
+        std::error_code error;
+        fs::rename(pending.temp_path, pending.path, error);
+        if (error) {
+          throw std::runtime_error("cannot rename " + pending.temp_path + " to " + pending.path +
+                                   ": " + error.message());
+        }
+      });
+      CrashPoint("file-committed");
+    }
+  });
+  committed_ = true;
+  for (const Pending& pending : pending_) {
+    if (pending.sync) internal::SyncFolder(fs::path(pending.path).parent_path().string());
+  }
 }
 
 namespace {

@@ -16,7 +16,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Registry {
-  std::mutex mutex;
+  std::recursive_mutex mutex;  // HoldInterruptCleanup's commits lock it again
   unsigned long next_id = 0;
   std::map<unsigned long, std::string> paths;
 };
@@ -87,9 +87,14 @@ void InstallInterruptCleanup() {
   if (status != 0) pthread_sigmask(SIG_UNBLOCK, &watched_signals, nullptr);
 }
 
+void HoldInterruptCleanup(const std::function<void()>& commits) {
+  std::lock_guard<std::recursive_mutex> lock(TheRegistry().mutex);
+  commits();
+}
+
 RemoveOnInterrupt::RemoveOnInterrupt(std::string path) {
   Registry& registry = TheRegistry();
-  std::lock_guard<std::mutex> lock(registry.mutex);
+  std::lock_guard<std::recursive_mutex> lock(registry.mutex);
   id_ = registry.next_id++;
   registry.paths.emplace(id_, std::move(path));
 }
@@ -97,13 +102,13 @@ RemoveOnInterrupt::RemoveOnInterrupt(std::string path) {
 RemoveOnInterrupt::~RemoveOnInterrupt() {
   if (!watched_) return;
   Registry& registry = TheRegistry();
-  std::lock_guard<std::mutex> lock(registry.mutex);
+  std::lock_guard<std::recursive_mutex> lock(registry.mutex);
   registry.paths.erase(id_);
 }
 
 void RemoveOnInterrupt::Commit(const std::function<void()>& rename) {
   Registry& registry = TheRegistry();
-  std::lock_guard<std::mutex> lock(registry.mutex);
+  std::lock_guard<std::recursive_mutex> lock(registry.mutex);
   rename();
   registry.paths.erase(id_);
   watched_ = false;

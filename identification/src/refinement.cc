@@ -10,10 +10,20 @@
 
 #include "internal.h"
 #include "mbid/common/eigen_decompositions.h"
+#include "mbid/common/stop.h"
 #include "mbid/identification/modal_fit.h"
 
 namespace mbid::identification {
 namespace {
+
+// A long record's refinement runs for seconds: a requested stop (stop.h) ends it at the next
+// iteration.
+class StopWhenRequested final : public ceres::IterationCallback {
+ public:
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return StopRequested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+};
 
 // Rows per residual block: short enough for cache-friendly Jacobian blocks.
 constexpr int kChunkSamples = 1024;
@@ -253,8 +263,11 @@ RefinementSummary RefineModalModel(const Eigen::MatrixXd& values, double sample_
   solver_options.gradient_tolerance = options.gradient_tolerance;
   solver_options.num_threads = 1;
   solver_options.logging_type = ceres::SILENT;
+  StopWhenRequested stop;
+  solver_options.callbacks = {&stop};
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
+  ThrowIfStopRequested();
 
   RefinementSummary result;
   result.model.with_offset = initial.with_offset;

@@ -5,14 +5,18 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
+#include <signal.h>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "mbid/common/stop.h"
 #include "mbid/mbid.h"
 #include "mbid/records/records.h"
 #include "mbid/validation/identification_settings.h"
@@ -20,6 +24,94 @@
 namespace py = pybind11;
 
 namespace {
+
+// Ctrl-C during a long call. Python runs its SIGINT handler between bytecodes, which a call in
+// C++ never reaches: a run went on for 25 s, its gnuplot children (same process group) died, and
+// a "gnuplot failed" RuntimeError came before the KeyboardInterrupt, raised later inside the
+// user's own except block. For the call's length SIGINT asks mbid to stop (stop.h) instead; the
+// call then unwinds within a moment, and Python's handler (KeyboardInterrupt by default) runs as
+// the call returns, whatever the stopped computation threw.
+std::atomic<bool> sigint_seen{false};
+
+void OnSigint(int) {
+  sigint_seen.store(true);
+  mbid::RequestStop();
+}
+
+class StopOnSigint {
+ public:
+  StopOnSigint() {
+    std::lock_guard<std::mutex> lock(Mutex());
+    if (Depth()++ > 0) return;  // calls from several threads share one handler
+    sigint_seen.store(false);
+    mbid::ClearStopRequest();
+    struct sigaction ours {};
+    ours.sa_handler = OnSigint;
+    sigemptyset(&ours.sa_mask);
+    if (sigaction(SIGINT, nullptr, &Previous()) == 0 && Previous().sa_handler != SIG_IGN) {
+      sigaction(SIGINT, &ours, nullptr);
+      Installed() = true;
+    }
+  }
+  ~StopOnSigint() { Restore(); }
+
+  // Python's handler back; with the GIL held, raises what it raises for a SIGINT seen meanwhile.
+  void Finish() {
+    Restore();
+    if (!sigint_seen.load()) return;
+    PyErr_SetInterrupt();
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    // A handler of the user's that raised nothing: the computation was still cut short.
+    throw std::runtime_error("mbid: interrupted by SIGINT");
+  }
+
+ private:
+  void Restore() {
+    if (restored_) return;
+    restored_ = true;
+    std::lock_guard<std::mutex> lock(Mutex());
+    if (--Depth() > 0) return;
+    if (Installed()) sigaction(SIGINT, &Previous(), nullptr);
+    Installed() = false;
+    mbid::ClearStopRequest();
+  }
+  static std::mutex& Mutex() {
+    static std::mutex mutex;
+    return mutex;
+  }
+  static int& Depth() {
+    static int depth = 0;
+    return depth;
+  }
+  static bool& Installed() {
+    static bool installed = false;
+    return installed;
+  }
+  static struct sigaction& Previous() {
+    static struct sigaction previous {};
+    return previous;
+  }
+  bool restored_ = false;
+};
+
+// Runs `call` without the GIL, stoppable by Ctrl-C (above).
+template <typename Call>
+auto Interruptible(Call&& call) -> decltype(call()) {
+  StopOnSigint stop;
+  try {
+    auto result = [&] {
+      py::gil_scoped_release release;
+      return call();
+    }();
+    stop.Finish();
+    return result;
+  } catch (const py::error_already_set&) {
+    throw;
+  } catch (...) {
+    stop.Finish();  // a SIGINT's KeyboardInterrupt over what the stopped computation threw
+    throw;
+  }
+}
 
 py::array_t<double> ToArray(const Eigen::VectorXd& v) {
   py::array_t<double> array(v.size());
@@ -409,8 +501,7 @@ PYBIND11_MODULE(_mbid, m) {
       "simulate",
       [](const py::object& scenario_object) {
         const mbid::Scenario scenario = AsScenario(scenario_object, "simulate");
-        py::gil_scoped_release release;
-        return mbid::Simulate(scenario);
+        return Interruptible([&] { return mbid::Simulate(scenario); });
       },
       py::arg("scenario"), "Simulates the scenario's test (a Scenario or its file): a Record.");
   m.def(
@@ -432,9 +523,10 @@ PYBIND11_MODULE(_mbid, m) {
           applied = mbid::validation::RecordFileOptions(mbid::validation::ReadRecordScenario(*path),
                                                         *path, options, &said);
         }
-        py::gil_scoped_release release;
-        return scenario ? mbid::IdentifyTest(record, *scenario, applied)
-                        : mbid::Identify(record, applied);
+        return Interruptible([&] {
+          return scenario ? mbid::IdentifyTest(record, *scenario, applied)
+                          : mbid::Identify(record, applied);
+        });
       },
       py::arg("record"), py::arg("options") = IdentificationOptions(),
       py::arg("scenario") = py::none(),
@@ -446,8 +538,7 @@ PYBIND11_MODULE(_mbid, m) {
       [](const py::object& time, const std::map<std::string, py::object>& channels,
          const std::map<std::string, std::string>& units, const IdentificationOptions& options) {
         const mbid::Measurement record = MakeRecord(time, channels, units);
-        py::gil_scoped_release release;
-        return mbid::Identify(record, options);
+        return Interruptible([&] { return mbid::Identify(record, options); });
       },
       py::arg("time"), py::arg("channels"), py::arg("units") = std::map<std::string, std::string>{},
       py::arg("options") = IdentificationOptions(),
@@ -458,8 +549,7 @@ PYBIND11_MODULE(_mbid, m) {
       [](const py::object& scenario_object, const py::object& records_object) {
         const mbid::Scenario scenario = AsScenario(scenario_object, "update");
         const std::vector<mbid::Measurement> records = AsRecords(records_object);
-        py::gil_scoped_release release;
-        return mbid::Update(scenario, records);
+        return Interruptible([&] { return mbid::Update(scenario, records); });
       },
       py::arg("scenario"), py::arg("records"),
       "Tunes the scenario's model (a Scenario or its file) to the records (Records or their "
@@ -474,8 +564,7 @@ PYBIND11_MODULE(_mbid, m) {
         if (output_folder) options.output_folder = output_folder->string();
         options.overwrite = overwrite;
         options.quiet = quiet;
-        py::gil_scoped_release release;
-        return mbid::RunValidationCycle(scenario, options);
+        return Interruptible([&] { return mbid::RunValidationCycle(scenario, options); });
       },
       py::arg("scenario"), py::arg("output_folder") = py::none(), py::arg("overwrite") = false,
       py::arg("quiet") = true,

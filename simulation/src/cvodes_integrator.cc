@@ -22,6 +22,7 @@
 #include "cvodes_integrator_impl.h"
 #include "dense_solve.h"
 #include "mbid/common/error.h"
+#include "mbid/common/stop.h"
 #include "serial_vector_ops.h"
 
 namespace mbid::simulation {
@@ -121,6 +122,7 @@ const SimTK::State& CvodesIntegrator::Impl::AdvanceTo(double t, Realization real
         << " s";
     throw std::invalid_argument(why.str());
   }
+  ThrowIfStopRequested();  // a Python user's Ctrl-C (stop.h)
   if (t > t_now) {
     // By default CVODES stops exactly at t rather than stepping past it and interpolating:
     // inputs that change between calls then never act before their time, and the returned

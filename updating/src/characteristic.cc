@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "characteristic_internal.h"
+#include "mbid/common/stop.h"
 
 namespace mbid::updating {
 using internal::CalcCharacteristicMatrix;
@@ -341,6 +342,7 @@ CharacteristicResult SolveCharacteristicEquation(const CharacteristicProblem& pr
     ceres_problem.AddResidualBlock(new CharacteristicCost(problem, scale), nullptr, x.data());
     ceres::Solver::Summary summary;
     ceres::Solve(solver, &ceres_problem, &summary);
+    ThrowIfStopRequested();
     CharacteristicSolution solution;
     solution.c = problem.c_reference.cwiseProduct(x.head(n));
     solution.d = problem.d_reference.cwiseProduct(x.tail(n));

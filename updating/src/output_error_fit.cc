@@ -14,6 +14,7 @@
 #include "fit_unknowns.h"
 #include "mbid/common/eigen_decompositions.h"
 #include "mbid/common/error.h"
+#include "mbid/common/stop.h"
 #include "nan.h"
 #include "prepared_test.h"
 #include "statistics.h"
@@ -42,7 +43,7 @@ class ProgressCallback final : public ceres::IterationCallback {
                    label_.c_str(), summary.iteration, summary.cost, summary.step_norm,
                    summary.iteration > 0 && !summary.step_is_successful ? " (rejected)" : "");
     }
-    return ceres::SOLVER_CONTINUE;
+    return StopRequested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
   }
 
  private:
@@ -172,6 +173,7 @@ int Solve(FitProblem& fit, const UpdateOptions& options, int tests, int first_st
     ceres::Solver::Options solver = base;
     solver.callbacks = {&progress};
     ceres::Solve(solver, &fit.problem, &summary);
+    ThrowIfStopRequested();
     if (pass == 1) first_initial_cost = summary.initial_cost;
     result->iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
     all_history.insert(all_history.end(), history.begin(), history.end());

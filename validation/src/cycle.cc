@@ -6,6 +6,7 @@
 #include <cctype>
 
 #include "mbid/common/output_folder.h"
+#include "mbid/common/stop.h"
 #include "mbid/validation/identification_settings.h"
 #include "mbid/validation/record_source.h"
 #include "mbid/validation/release_cut.h"
@@ -141,6 +142,7 @@ CycleResult RunCycle(const Scenario& scenario, const CycleOptions& options) {
   const bool several = result.tests.size() > 1;
   std::vector<std::string> verdicts;
   for (RunTest& test : result.tests) {
+    ThrowIfStopRequested();  // between tests too, where no simulation runs
     const std::string prefix = several ? "test " + test.name + ": " : "";
     const size_t test_count = result.tests.size();
     AnalyseTest(
@@ -154,6 +156,7 @@ CycleResult RunCycle(const Scenario& scenario, const CycleOptions& options) {
       result.reasons.push_back(prefix + reason);
     }
   }
+  ThrowIfStopRequested();  // a stopped test's failures are no verdict
   result.verdict = CombineVerdicts(verdicts);
   result.verdict_line = VerdictLine(result.tests, result.min_correlation, result.verdict);
   return result;

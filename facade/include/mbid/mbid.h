@@ -16,6 +16,7 @@
 
 #include "mbid/common/error.h"
 #include "mbid/common/measurement.h"
+#include "mbid/common/stop.h"
 #include "mbid/identification/modal_result.h"
 #include "mbid/identification/options.h"
 #include "mbid/records/records.h"

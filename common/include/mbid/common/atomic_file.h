@@ -40,6 +40,36 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+// A command's outputs committed together. While an OutputSet lives (at most one per process),
+// AtomicFile::Commit() syncs its temporary and hands the rename to the set; Commit() then renames
+// them all where no SIGINT, SIGTERM or SIGHUP clean-up can run in between, `.json` summaries
+// last (they name the others). An interruption between two commits had left a --json summary
+// naming an -o file that was never written, and the rerun refused as the summary existed.
+// Destroyed without Commit() (a failure, a non-zero exit), it removes the temporaries. kill -9
+// between two renames (microseconds: every file is synced before) can still leave the first.
+class OutputSet {
+ public:
+  OutputSet();
+  ~OutputSet();
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+
+  void Commit();
+
+ private:
+  friend class AtomicFile;
+  struct Pending {
+    std::string path, temp_path;
+    std::unique_ptr<RemoveOnInterrupt> interrupt_cleanup;
+    bool sync = true;
+  };
+  // Takes a synced temporary and its clean-up; false (nothing taken) when no set is active.
+  static bool Defer(const std::string& path, const std::string& temp_path,
+                    std::unique_ptr<RemoveOnInterrupt>* interrupt_cleanup, bool sync);
+  std::vector<Pending> pending_;
+  bool committed_ = false;
+};
+
 // A command's file named on its command line: the flag or argument that names it ("--json",
 // "-o", "DATA") and the path.
 struct NamedFile {

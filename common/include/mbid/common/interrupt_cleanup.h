@@ -20,6 +20,10 @@ namespace mbid {
 // which the normal error path cleans up, instead of killing the process mid-file.
 void InstallInterruptCleanup();
 
+// Runs `commits` (several RemoveOnInterrupt::Commit calls) where no clean-up can run between
+// them: an interruption sees all the temporaries or all the committed results.
+void HoldInterruptCleanup(const std::function<void()>& commits);
+
 // Registers `path` (a file or folder) for removal on interruption during the object's life.
 class RemoveOnInterrupt {
  public:
