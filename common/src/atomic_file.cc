@@ -96,6 +96,7 @@ AtomicFile::AtomicFile(std::string path, bool sync) : path_(std::move(path)), sy
   if (path_.empty()) {
     throw InputError("(output)", "", "empty output path", "a file name");
   }
+  CheckOutputName(path_);
   const fs::path parent = fs::path(path_).parent_path();
   std::error_code ec;
   if (!parent.empty() && !fs::is_directory(parent, ec)) {
@@ -263,9 +264,21 @@ bool ParseAtomicTemporaryName(const std::string& name, std::string* target, int*
   return true;
 }
 
+void CheckOutputName(const std::string& path) {
+  const auto control = std::find_if(path.begin(), path.end(), [](char c) {
+    return static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+  });
+  if (control == path.end()) return;
+  throw InputError(path, "",
+                   "the output's name holds a control character (" +
+                       OneLine(std::string(1, *control)) + ", a line break or the like)",
+                   "a name of printable characters");
+}
+
 void CheckOutputsReplaceable(const std::vector<NamedFile>& outputs, bool overwrite) {
   for (const NamedFile& output : outputs) {
     if (output.path.empty() || output.path == "-") continue;
+    CheckOutputName(output.path);
     std::error_code error;
     const fs::path folder = fs::absolute(output.path, error).parent_path();
     if (!fs::is_directory(folder, error)) {

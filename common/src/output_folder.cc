@@ -14,6 +14,7 @@
 #include <system_error>
 
 #include "internal.h"
+#include "mbid/common/atomic_file.h"
 #include "mbid/common/crash_point.h"
 #include "mbid/common/error.h"
 
@@ -68,6 +69,7 @@ OutputFolder::OutputFolder(const fs::path& final_path, std::string kind, bool ov
       overwrite_(overwrite),
       is_previous_(std::move(is_previous)) {
   if (final_path.empty()) throw InputError("(output)", "", "empty output folder", "a folder name");
+  CheckOutputName(final_path.string());
   // "DIR/", "." and "a/.." name the folder before the separator.
   fs::path absolute = fs::absolute(final_path).lexically_normal();
   if (!absolute.has_filename()) absolute = absolute.parent_path();

@@ -66,12 +66,24 @@ void ValidateUtf8(std::string_view text, const std::string& source, const std::s
 }
 
 void ValidateUtf8Text(std::string_view text, const std::string& source) {
-  const size_t at = FindInvalidUtf8(text);
+  size_t at = FindInvalidUtf8(text);
+  // A NUL byte is valid UTF-8 but no text: zeroed blocks of a damaged file, a logger's unfinished
+  // write. YAML read it as "not a mapping".
+  const size_t nul = text.find('\0');
+  const bool is_nul = nul != std::string_view::npos && (at == std::string_view::npos || nul < at);
+  if (is_nul) at = nul;
   if (at == std::string_view::npos) return;
   const size_t newline = at == 0 ? std::string_view::npos : text.rfind('\n', at - 1);
   const size_t column_start = newline == std::string_view::npos ? 0 : newline + 1;
   const auto line =
       1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+  if (is_nul) {
+    throw InputError(source, fmt::format("line {}", line),
+                     fmt::format("a NUL byte at column {} (zeroed blocks of a damaged file, or an "
+                                 "unfinished write)",
+                                 at - column_start + 1),
+                     "text without NUL bytes: the file as its writer completed it");
+  }
   throw InputError(source, fmt::format("line {}", line),
                    fmt::format("{} at column {}", DescribeByte(text, at), at - column_start + 1),
                    kExpected);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 
 #include "header_cells.h"
 #include "internal.h"
@@ -238,6 +239,7 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
   // A header stands among the first lines, after a preamble of at most this many.
   constexpr size_t kMaxPreamble = 1000;
   bool found = false, found_follows = false;
+  std::optional<CsvDialect> first_row_broken;
   // Blanks part the columns only where no other separator does: a tab file's names hold spaces.
   for (const char separator : {',', ';', '\t', ' '}) {
     if (separator == ' ' && found) break;
@@ -247,19 +249,40 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
       if (header.size() < 2 || IsDataRow(header, separator)) continue;
       // Below a candidate whose rows broke off, only names make a header: a data row with a
       // text cell ("0.01,zero") is the bad row the first candidate's error should name.
-      if (passed_one && std::any_of(header.begin(), header.end(), [&](const std::string& cell) {
-            return ClassifyCell(cell, separator) != CellKind::kText && !cell.empty();
-          })) {
-        continue;
-      }
+      const bool names = std::all_of(header.begin(), header.end(), [&](const std::string& cell) {
+        return ClassifyCell(cell, separator) == CellKind::kText || cell.empty();
+      });
+      if (passed_one && !names) continue;
       auto next = SplitFields(lines[content[k + 1]].text, separator);
       if (!FitRow(&next, header.size())) continue;
       int units_row = -1;
       if (!IsDataRow(next, separator)) {
-        if (k + 2 >= content.size() || !IsUnitsRow(next)) continue;
-        auto data = SplitFields(lines[content[k + 2]].text, separator);
-        if (!FitRow(&data, header.size()) || !IsDataRow(data, separator)) continue;
-        units_row = content[k + 1];
+        const auto data = [&] {
+          auto row = SplitFields(lines[content[k + 2]].text, separator);
+          return FitRow(&row, header.size()) && IsDataRow(row, separator);
+        };
+        if (k + 2 < content.size() && IsUnitsRow(next) && data()) {
+          units_row = content[k + 1];
+        } else {
+          // Names over a row of numbers with a damaged cell ("0,1" and a NUL, a cell of 10^7
+          // digits): the row below had been taken for the header ("no time column"). This one
+          // stands where no other does, and the bad cell's error names it.
+          const bool numbers = std::any_of(next.begin(), next.end(), [&](const std::string& c) {
+            return ClassifyCell(c, separator) == CellKind::kNumber;
+          });
+          if (names && numbers) {
+            if (!first_row_broken) {
+              first_row_broken = *dialect;
+              first_row_broken->separator = separator;
+              first_row_broken->header = content[k];
+              first_row_broken->units_row = -1;
+              first_row_broken->field_count = static_cast<int>(header.size());
+              first_row_broken->preamble_lines = static_cast<int>(k);
+            }
+            passed_one = true;
+          }
+          continue;
+        }
       }
       // A header whose rows go on as it says wins; then the most fields ("a,b;c" is not a ';'
       // file); ties go to the earlier separator. A header whose rows break off soon still
@@ -285,6 +308,10 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
   }
   if (found) return true;
   if (FindHeaderInComment(lines, content, dialect)) return true;
+  if (first_row_broken) {
+    *dialect = *first_row_broken;
+    return true;
+  }
   // One column (a single channel logged without a time column: its sample rate comes from
   // --sample-rate-hz): a name, maybe a units row, then numbers, one per line. The separator is
   // one the lines do not hold, so that a decimal comma stays in its number.

@@ -54,6 +54,18 @@ TEST(Utf8Test, TextErrorsNameLineAndColumn) {
   EXPECT_EQ(first.problem(), "invalid UTF-8: byte 0xFF at column 1");
 }
 
+// NUL is valid UTF-8 but no text: a scenario starting with zeroed blocks was "not a mapping".
+TEST(Utf8Test, ANulByteIsNamedWhereItIs) {
+  using namespace std::string_view_literals;
+  const InputError e = CatchInputError([] { ValidateUtf8Text("\0\1\2name: x\n"sv, "s.yaml"); });
+  EXPECT_EQ(e.field(), "line 1");
+  EXPECT_THAT(e.problem(), HasSubstr("NUL byte at column 1"));
+  const InputError later =
+      CatchInputError([] { ValidateUtf8Text("a: 1\nb: \0\xFF\n"sv, "s.yaml"); });
+  EXPECT_EQ(later.field(), "line 2");
+  EXPECT_THAT(later.problem(), HasSubstr("NUL byte at column 4"));  // the first bad byte
+}
+
 TEST(Utf8Test, YamlThatIsNotUtf8IsRefusedWhereItIsRead) {
   const InputError e = CatchInputError([] {
     YamlReader::FromString(

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <string_view>
 
 #include "mbid/common/error.h"
 #include "mbid/records/records.h"
@@ -19,10 +20,10 @@ using ::testing::HasSubstr;
 
 struct BadFile {
   const char* name;
-  const char* text;
-  const char* field;     // the field the error must name exactly
-  const char* problem;   // a phrase of the problem
-  const char* expected;  // a phrase of what is expected
+  std::string_view text;  // may hold a NUL byte
+  const char* field;      // the field the error must name exactly
+  const char* problem;    // a phrase of the problem
+  const char* expected;   // a phrase of what is expected
 };
 
 // Header on line 1, data from line 2 unless a preamble says otherwise.
@@ -36,6 +37,12 @@ const BadFile kBadFiles[] = {
     {"AngleAsTime", "Zeit [deg];x [mm]\n0;1\n1;2\n", "column 1 (Zeit)", "cannot be converted", "s"},
     {"FieldCount", "t [s];x [mm]\n0;1\n1;2\n2;3;4\n3;4\n", "line 4", "3 fields", "2 fields"},
     {"NotANumber", "t [s];x [mm]\n0;1\n1;zwei\n", "line 3, column 2 (x)", "'zwei'", "number"},
+    // The first row's bad cell: the row below had been taken for the header ("no time column").
+    {"FirstRowNotANumber", "t [s],x [mm]\n0,1x\n1,2\n2,3\n", "line 2, column 2 (x)", "'1x'",
+     "number"},
+    // Zeroed blocks of a damaged file (the same "no time column" before).
+    {"NulByte", std::string_view("t [s],x [mm]\n0,1\0\n1,2\n2,3\n", 26), "line 2",
+     "NUL byte at column 4", "without NUL"},
     // A number, but none a double holds: said so, not "not a number".
     {"BeyondADouble", "t [s];x [mm]\n0;1\n1;1e400\n", "line 3, column 2 (x)",
      "'1e400' is a number beyond a double's range", "number"},
@@ -63,7 +70,7 @@ TEST_P(BadFileTest, NamesFileAndPlace) {
   const BadFile& bad = GetParam();
   TempDir dir;
   const std::string path = dir.File("bad.csv");
-  WriteText(path, bad.text);
+  WriteText(path, std::string(bad.text));
   const InputError e = CatchInputError([&] { ImportMeasurement(path); });
   EXPECT_EQ(e.source(), path);
   EXPECT_EQ(e.field(), bad.field);

@@ -88,6 +88,12 @@ void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
 // `target` and `pid` (either may be null) receive its target's file name and its writer's pid.
 bool ParseAtomicTemporaryName(const std::string& name, std::string* target, int* pid);
 
+// Throws InputError when an output's name holds a line break or another control character
+// (a script's variable with its newline): the figures' gnuplot scripts cannot name such a file,
+// and a run failed after all its work. Checked by AtomicFile, OutputFolder and
+// CheckOutputsReplaceable, before any work.
+void CheckOutputName(const std::string& path);
+
 // Throws InputError (naming the output's flag and path) before any work when an output's folder
 // does not exist, or the output exists and `overwrite` is false: nothing of the user's is
 // replaced unasked (--overwrite). Outputs "" and "-" are skipped.

@@ -17,7 +17,8 @@ size_t FindInvalidUtf8(std::string_view text);
 // Throws InputError(source, field, ...) naming the bad byte if `text` is not valid UTF-8.
 void ValidateUtf8(std::string_view text, const std::string& source, const std::string& field);
 
-// The same for a whole text file: the error names the line and column (1-based) of the byte.
+// The same for a whole text file, which also holds no NUL byte: the error names the line and
+// column (1-based) of the byte.
 void ValidateUtf8Text(std::string_view text, const std::string& source);
 
 }  // namespace mbid
