@@ -32,6 +32,24 @@
 namespace mbid::identification {
 namespace {
 
+// Values far from 1 leave a double's range in the analysis' sums of squares and products: records
+// of 1e80 and 1e-200 found "no modes", one reason saying "-nan times what white noise gives"
+// (1e-95 to 1e70 identify as at 1). No structure moves so in SI units: a unit stated wrongly.
+void CheckMagnitudes(const Measurement& measurement, const std::string& origin) {
+  constexpr double kLargest = 1e60, kSmallest = 1e-60;
+  for (Eigen::Index c = 0; c < measurement.values.cols(); ++c) {
+    const double largest = measurement.values.col(c).cwiseAbs().maxCoeff();
+    if (!(largest > kLargest) && !(largest > 0 && largest < kSmallest)) continue;
+    const auto k = static_cast<size_t>(c);
+    throw InputError(
+        origin, "channel " + measurement.channels[k],
+        fmt::format("values up to {:.3g} {}", largest,
+                    k < measurement.units.size() ? measurement.units[k] : std::string()),
+        "values between 1e-60 and 1e60 in magnitude, whose powers the analysis forms within a "
+        "double's range (a unit stated wrongly, --unit, is the likely cause)");
+  }
+}
+
 // The most samples a record is analysed again at its full rate for a start the decimation
 // filter hides (the full-rate analysis grows with the samples; longer records keep the flag).
 constexpr Eigen::Index kLongestFullRateReanalysis = 200000;
@@ -100,6 +118,7 @@ void AddTimeBaseUncertainty(double u, ModalResult* result) {
 
 ModalResult Identify(const Measurement& measurement, const IdentificationOptions& options,
                      const std::string& origin) {
+  CheckMagnitudes(measurement, origin);
   if (options.remove_drift) return IdentifyRemovingDrift(measurement, options, origin);
   ModalResult result;
   options.Validate("identification options");

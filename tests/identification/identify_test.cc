@@ -656,6 +656,28 @@ Error Catch(const Measurement& record, const IdentificationOptions& options) {
   throw std::logic_error("nothing thrown");
 }
 
+// The noiseless three modes scaled by 1e-50 and 1e50 are found as at scale 1 (the poles do not
+// depend on the scale); at 1e-200 and 1e80 the analysis left a double's range: "no modes found",
+// with a "-nan" in the reason at 1e-200; now a wrong unit said as such (exit 2).
+TEST(IdentifyTest, ValuesBeyondWhatSquaresHoldAreRefusedAndOthersScaleFree) {
+  const SignalSpec spec = ThreeModes();
+  for (const double scale : {1e-50, 1e50}) {
+    const ModalResult result =
+        Identify(MakeRecord(spec, scale * Synthesize(spec)), IdentificationOptions());
+    SignalSpec scaled = spec;
+    for (auto& mode : scaled.modes) {
+      for (double& a : mode.amplitude) a *= scale;
+    }
+    ExpectModes(result, scaled, 1e-8, 1e-6, 1e-6);
+  }
+  for (const double scale : {1e-200, 1e-70, 1e70, 1e80}) {
+    const InputError error =
+        Catch<InputError>(MakeRecord(spec, scale * Synthesize(spec)), IdentificationOptions());
+    EXPECT_EQ(error.field(), "channel a");
+    EXPECT_NE(error.expected().find("between 1e-60 and 1e60"), std::string::npos);
+  }
+}
+
 TEST(IdentifyTest, NonFiniteSampleNamesChannelAndSample) {
   const SignalSpec spec = ThreeModes();
   Measurement record = MakeRecord(spec, Synthesize(spec));
