@@ -402,6 +402,46 @@ updating: {noise_std_rad: 1.0e-5, global_search: {enabled: false},
       << ::testing::PrintToString(run.reasons);
 }
 
+// A stiff pin at 45.9 Hz sampled at 100 Hz, started where its mode is at 54.5 Hz (above Nyquist,
+// the samples show it at 45.5 Hz): the fit ended at the alias (c_pin 622605 against 450000, 53.6
+// Hz), where before no start came from below Nyquist (a trial's mast pin, "passed" 38 of its
+// standard deviations off). The joint sets with the best end's modes moved to their aliases are
+// fitted too: the truth fits lower (cost 211 against 447 at the alias, the F-test separates them)
+// and is the result. Route 1 and the pole-equivalent sets are off, one design point: the alias
+// sets alone reach it.
+TEST(FacadeTest, AModeAboveNyquistIsAlsoFittedAtItsAlias) {
+  const std::string text = R"(name: pin-and-bob
+model:
+  type: multibody
+  bodies:
+    arm: {parent: ground, joint: {type: revolute, coordinates: [pin], axis: [0, 1, 0]},
+          mass_kg: 10.0, com_m: [0.5, 0, 0], inertia_kgm2: [0.1, 0.9, 0.9]}
+    bob: {parent: arm, joint: {type: revolute, coordinates: [swing], axis: [0, 1, 0],
+          in_parent_m: [1.0, 0, 0]}, mass_kg: 2.0, com_m: [0, 0, -0.5],
+          inertia_kgm2: [0.02, 0.02, 0.01]}
+  springs:
+    pin: {stiffness_Nm_per_rad: 4.5e5, damping_Nms_per_rad: 30.0}
+    swing: {stiffness_Nm_per_rad: 20.0, damping_Nms_per_rad: 0.2}
+  outputs:
+    arm_angle: {type: coordinate, coordinate: pin}
+    bob_angle: {type: coordinate, coordinate: swing}
+excitation: {type: initial_deflection, deflection_rad: {pin: 0.001, swing: 0.05}}
+simulation: {duration_s: 2}
+sensors: {sample_rate_hz: 100, channels: [arm_angle, bob_angle], noise_std_rad: 1.0e-5, seed: 3}
+updating: {noise_std_rad: 1.0e-5, algebraic_start: false,
+           global_search: {design_starts: 1, pole_equivalent_starts: false},
+           start: {c_pin: 6.3e5, d_pin: 40.0, c_swing: 15.0, d_swing: 0.25}}
+)";
+  const mbid::Scenario scenario = mbid::LoadScenarioFromText(text, "pin.yaml");
+  const mbid::UpdateResult tuned = mbid::Update(scenario, {mbid::Simulate(scenario)});
+  const mbid::ParameterValue& c = tuned.parameters.at("c_pin");
+  EXPECT_NEAR(c.value, 4.5e5, 3 * c.std);
+  EXPECT_TRUE(c.determined) << c.why_undetermined;
+  EXPECT_FALSE(tuned.non_unique);
+  EXPECT_EQ(tuned.search.aliased, 1);
+  EXPECT_EQ(tuned.search.minima.front().starts.front().rfind("alias set", 0), 0u);
+}
+
 // `passed` needs a credible fit. Weights that state the noise 30 % low (7e-6 rad against the
 // record's 1e-5) leave a white excess, chi^2/dof about 2, taken for a noise level stated too low:
 // the standard deviations are inflated by about 1.4, but the fit is not credible (a trial's hammer

@@ -376,7 +376,7 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
   // trading roles give the same frequencies and dampings and differ only in what the record's
   // mode shapes show, so a poorly excited mode leaves such a set as good a fit. The design
   // finds them by chance; eq. 7 lists them.
-  if (search.pole_equivalent_starts && !search.complete_starts) {
+  const auto best_so_far = [&full]() -> const Run* {
     const Run* provisional = nullptr;
     for (const Run& run : full) {
       if (run.failed || !Converged(run.fit)) continue;
@@ -384,6 +384,10 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
         provisional = &run;
       }
     }
+    return provisional;
+  };
+  if (search.pole_equivalent_starts && !search.complete_starts) {
+    const Run* provisional = best_so_far();
     std::vector<SearchStart> equivalent;
     if (provisional != nullptr) {
       equivalent = PoleEquivalentStarts(model, provisional->fit, search.seed);
@@ -397,6 +401,34 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
     fit_promising(equivalent, "set(s) with the best end's poles");
     result.starts += static_cast<int>(equivalent.size());
     result.pole_equivalent = static_cast<int>(equivalent.size());
+  }
+  // A mode of the best end at or above the records' Nyquist frequency shows in them only as its
+  // alias below, which a joint set with that mode there shows as well (and a logger's
+  // anti-alias filter records nothing above). A trial's stiff mast pin, 46.7 Hz sampled at
+  // 100 Hz, was tuned to 53.3 Hz, 30 % too stiff and 38 of its standard deviations off,
+  // "passed" as unique: Route 1 had no such mode and the design was skipped; the fit from the
+  // alias ends lower. These sets are fitted whatever settled the search.
+  double nyquist_hz = std::numeric_limits<double>::infinity();
+  for (const TestRecord& test : tests) {
+    nyquist_hz = std::min(nyquist_hz, 0.5 / test.record.sample_interval_s);
+  }
+  if (const Run* provisional = best_so_far(); provisional != nullptr) {
+    std::vector<std::string> moved;
+    const std::vector<SearchStart> aliased =
+        internal::AliasStarts(model, provisional->fit, search.seed, nyquist_hz, &moved);
+    if (!aliased.empty()) {
+      say(
+          fmt::format("global search: {} set(s) with the best end's modes above Nyquist moved to "
+                      "their aliases ({}) fitted on the whole records",
+                      aliased.size(), fmt::join(moved, ", ")));
+      fit_promising(aliased, "set(s) with the best end's aliased modes");
+      result.starts += static_cast<int>(aliased.size());
+      result.aliased = static_cast<int>(aliased.size());
+      result.notes.push_back(fmt::format(
+          "a mode of the best end lies above the records' Nyquist frequency {:.4g} Hz ({}): the "
+          "joint sets with it at its alias were fitted too",
+          nyquist_hz, fmt::join(moved, ", ")));
+    }
   }
   result.full_fits = static_cast<int>(full.size());
 
@@ -466,16 +498,40 @@ GlobalSearchResult SearchGlobally(const model::MechanicalModel& model,
       }
     }
     if (result.non_unique) {
+      // Minima that differ only by a mode above Nyquist and its alias: which one the test had,
+      // the samples cannot say; a logger's anti-alias filter can.
+      std::string alias_note;
+      if (result.aliased > 0 &&
+          internal::FrequenciesAbove(model, result.best, nyquist_hz).empty()) {
+        bool all_above = true;
+        std::vector<std::string> above;
+        for (const SearchMinimum& minimum : result.minima) {
+          if (!minimum.alternative) continue;
+          const std::vector<double> f = internal::FrequenciesAbove(model, minimum.fit, nyquist_hz);
+          all_above = all_above && !f.empty();
+          for (double hz : f) above.push_back(fmt::format("{:.4g} Hz", hz));
+        }
+        if (all_above) {
+          alias_note = fmt::format(
+              ". The alternatives put a mode above the records' Nyquist frequency {:.4g} Hz ({}), "
+              "where the samples show only its alias, a mode of the best's: a record taken "
+              "through an anti-alias filter (most loggers) has no mode above Nyquist, and with "
+              "one the best's values stand; without, sample faster to tell them apart",
+              nyquist_hz, fmt::join(above, ", "));
+        }
+      }
       result.best.warnings.push_back(fmt::format(
           "non-unique: {} other minimum(s) fit the records as well as the best (F-test at {}); "
-          "they differ in {}",
-          alternatives, search.significance, fmt::join(result.differing, ", ")));
+          "they differ in {}{}",
+          alternatives, search.significance, fmt::join(result.differing, ", "), alias_note));
     }
     result.notes.push_back(fmt::format(
-        "global search: {} starts ({} given, {} design, {} with the best end's poles), {} "
+        "global search: {} starts ({} given, {} design, {} with the best end's poles{}), {} "
         "whole-record fits, {} distinct minima, {} alternative(s)",
-        result.starts, result.starts - result.screened - result.pole_equivalent, result.screened,
-        result.pole_equivalent, result.full_fits, result.minima.size(), alternatives));
+        result.starts, result.starts - result.screened - result.pole_equivalent - result.aliased,
+        result.screened, result.pole_equivalent,
+        result.aliased > 0 ? fmt::format(", {} with its aliased modes", result.aliased) : "",
+        result.full_fits, result.minima.size(), alternatives));
     if (best.starts.front() != primary_label) {
       result.notes.push_back(fmt::format("the best minimum was reached from {}, not from {}",
                                          fmt::join(best.starts, ", "), primary_label));

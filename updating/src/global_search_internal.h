@@ -48,6 +48,20 @@ UpdateOptions StartOptions(const UpdateOptions& options,
 std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& model,
                                               const UpdateResult& fit, std::uint64_t seed);
 
+// The admissible solutions of eq. 7 for the exact poles of `model` carrying `fit`'s values with
+// each mode at or above `nyquist_hz` moved to its alias below it (|f - k f_s|, the same decay):
+// the sets whose modes a record sampled so shows as it shows the fit's. Empty when no mode is
+// above, or on PoleEquivalentStarts' conditions. `aliased` (if set) gets "53.28 Hz -> 46.72 Hz"
+// per moved mode.
+// The damped frequencies (Hz) of the exact modes of `model` carrying `fit`'s values at or above
+// `nyquist_hz`.
+std::vector<double> FrequenciesAbove(const model::MechanicalModel& model, const UpdateResult& fit,
+                                     double nyquist_hz);
+
+std::vector<SearchStart> AliasStarts(const model::MechanicalModel& model, const UpdateResult& fit,
+                                     std::uint64_t seed, double nyquist_hz,
+                                     std::vector<std::string>* aliased = nullptr);
+
 // Parameters (shared, tuned) in which two end points differ beyond the clustering tolerance
 // and 3 standard deviations: both ends' combined (one minimum reached twice), or only `a`'s
 // (`a` the best: is the other end inside its confidence interval?).

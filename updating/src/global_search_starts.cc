@@ -123,10 +123,14 @@ UpdateOptions StartOptions(const UpdateOptions& options,
   return start;
 }
 
-std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& model,
-                                              const UpdateResult& fit, std::uint64_t seed) {
-  std::vector<SearchStart> starts;
-  if (!FindFreeCoordinate(model).empty()) return starts;
+namespace {
+
+// The tuned model of `fit` and its oscillating poles, where eq. 7 can give every joint set with
+// such poles: every coordinate has a tuned spring and damper and every mode oscillates.
+std::unique_ptr<model::MechanicalModel> TunedForEquation7(
+    const model::MechanicalModel& model, const UpdateResult& fit,
+    std::vector<std::complex<double>>* lambda) {
+  if (!FindFreeCoordinate(model).empty()) return nullptr;
   std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
   ApplyEstimates(fit, *tuned);
   const model::LinearModel linear = tuned->Linearize();
@@ -134,23 +138,79 @@ std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& mode
     for (const std::string& name : {"c_" + coordinate, "d_" + coordinate}) {
       bool found = false;
       for (const ParameterEstimate& p : fit.parameters) found = found || p.name == name;
-      if (!found) return starts;
+      if (!found) return nullptr;
     }
   }
-  std::vector<std::complex<double>> lambda;
   for (const model::Mode& mode : model::CalcModes(linear)) {
-    if (mode.lambda.imag() > 0) lambda.push_back(mode.lambda);
+    if (mode.lambda.imag() > 0) lambda->push_back(mode.lambda);
   }
-  if (static_cast<int>(lambda.size()) != tuned->coordinate_count()) return starts;
+  if (static_cast<int>(lambda->size()) != tuned->coordinate_count()) return nullptr;
+  return tuned;
+}
+
+std::vector<SearchStart> StartsWithPoles(const model::MechanicalModel& tuned,
+                                         const std::vector<std::complex<double>>& lambda,
+                                         const UpdateResult& fit, std::uint64_t seed,
+                                         const std::string& label);
+
+}  // namespace
+
+std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& model,
+                                              const UpdateResult& fit, std::uint64_t seed) {
+  std::vector<std::complex<double>> lambda;
+  const std::unique_ptr<model::MechanicalModel> tuned = TunedForEquation7(model, fit, &lambda);
+  if (!tuned) return {};
+  return StartsWithPoles(*tuned, lambda, fit, seed, "pole-equivalent set");
+}
+
+std::vector<double> FrequenciesAbove(const model::MechanicalModel& model, const UpdateResult& fit,
+                                     double nyquist_hz) {
+  std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
+  ApplyEstimates(fit, *tuned);
+  std::vector<double> above;
+  for (const model::Mode& mode : model::CalcModes(tuned->Linearize())) {
+    if (mode.frequency_hz() >= nyquist_hz) above.push_back(mode.frequency_hz());
+  }
+  return above;
+}
+
+std::vector<SearchStart> AliasStarts(const model::MechanicalModel& model, const UpdateResult& fit,
+                                     std::uint64_t seed, double nyquist_hz,
+                                     std::vector<std::string>* aliased) {
+  std::vector<std::complex<double>> lambda;
+  const std::unique_ptr<model::MechanicalModel> tuned = TunedForEquation7(model, fit, &lambda);
+  if (!tuned || !(nyquist_hz > 0)) return {};
+  const double rate_hz = 2 * nyquist_hz;
+  bool moved = false;
+  for (std::complex<double>& pole : lambda) {
+    const double f = pole.imag() / (2 * M_PI);
+    if (f < nyquist_hz) continue;
+    const double alias = std::abs(f - std::round(f / rate_hz) * rate_hz);
+    if (!(alias > 0)) continue;  // at a multiple of the rate: no oscillation to move it to
+    if (aliased != nullptr) aliased->push_back(fmt::format("{:.4g} Hz -> {:.4g} Hz", f, alias));
+    pole = {pole.real(), 2 * M_PI * alias};
+    moved = true;
+  }
+  if (!moved) return {};
+  return StartsWithPoles(*tuned, lambda, fit, seed, "alias set");
+}
+
+namespace {
+
+std::vector<SearchStart> StartsWithPoles(const model::MechanicalModel& tuned,
+                                         const std::vector<std::complex<double>>& lambda,
+                                         const UpdateResult& fit, std::uint64_t seed,
+                                         const std::string& label) {
+  std::vector<SearchStart> starts;
   CharacteristicOptions options;
   options.seed = seed;
   const CharacteristicResult sets = SolveCharacteristicEquation(
-      MakeCharacteristicProblem(*tuned, lambda, std::nullopt, std::nullopt), options);
+      MakeCharacteristicProblem(tuned, lambda, std::nullopt, std::nullopt), options);
   for (size_t s = 0; s < sets.solutions.size(); ++s) {
     const CharacteristicSolution& set = sets.solutions[s];
     if (!set.admissible) continue;
     SearchStart start;
-    start.label = fmt::format("pole-equivalent set {}", s);
+    start.label = fmt::format("{} {}", label, s);
     bool same = true;  // the tuned set itself (to eq. 7's convergence)
     for (size_t i = 0; i < sets.coordinates.size(); ++i) {
       const Eigen::Index k = static_cast<Eigen::Index>(i);
@@ -164,5 +224,7 @@ std::vector<SearchStart> PoleEquivalentStarts(const model::MechanicalModel& mode
   }
   return starts;
 }
+
+}  // namespace
 
 }  // namespace mbid::updating::internal

@@ -104,8 +104,9 @@ struct GlobalSearchResult {
   int starts = 0;                      // given + design
   int screened = 0;                    // design points fitted on the windows
   int pole_equivalent = 0;             // sets with the best end's poles (eq. 7)
-  int full_fits = 0;                   // whole-record local fits
-  int residual_count = 0;              // samples x channels over the tests
+  int aliased = 0;         // sets with its modes above the records' Nyquist moved to their aliases
+  int full_fits = 0;       // whole-record local fits
+  int residual_count = 0;  // samples x channels over the tests
   double wall_time_s = 0;
   double screen_time_s = 0;        // of the given starts' and design points' batch
   std::vector<std::string> notes;  // what the search did, in words
