@@ -210,6 +210,25 @@ TEST(SettingsTest, AlgebraicStartFillsOnlyTheStartsNotGiven) {
       EXPECT_EQ(s.initial, 4e4);
     }
   }
+  // The default bounds hold the model's value too (Route 1's c_tilt of 2.8e5 from poles that
+  // missed a stiff pin's mode gave bounds [2.8e3, 2.8e7] without the scenario's 1.4e9 and the
+  // truth 1e9): here c_alpha 4e7 from Route 1, 4.9e7 the model's.
+  algebraic.c_reference = Eigen::Vector4d(4.9e7, 1.1e6, 5.5e6, 9.4e6);
+  algebraic.d_reference = Eigen::Vector4d(5.2e5, 1.78e5, 4.4e4, 1.16e5);
+  UpdatingSettings wide = Read("updating: {bounds: {c_eta: [1.0e6, 1.0e7]}}", *crane.model);
+  ASSERT_TRUE(ApplyAlgebraicStart(algebraic, wide.options, &why)) << why;
+  for (const ParameterSetting& s : wide.options.parameters) {
+    if (s.name == "c_alpha") {
+      EXPECT_DOUBLE_EQ(s.lower, 4e7 / 100);
+      EXPECT_DOUBLE_EQ(s.upper, 4.9e7 * 100);
+    } else if (s.name == "d_gamma") {
+      EXPECT_DOUBLE_EQ(s.lower, 1.5e5 / 100);
+      EXPECT_DOUBLE_EQ(s.upper, 1.78e5 * 100);
+    } else if (s.name == "c_eta") {
+      EXPECT_EQ(s.lower, 1e6);  // explicit bounds stay
+      EXPECT_EQ(s.upper, 1e7);
+    }
+  }
   // A set outside explicit bounds is not used, and nothing changes.
   UpdatingSettings bounded = Read("updating: {bounds: {c_alpha: [5.0e7, 6.0e7]}}", *crane.model);
   EXPECT_FALSE(ApplyAlgebraicStart(algebraic, bounded.options, &why));

@@ -316,6 +316,8 @@ CharacteristicResult SolveCharacteristicEquation(const CharacteristicProblem& pr
   result.coordinates = problem.coordinates;
   result.coordinate_units = problem.coordinate_units;
   result.outputs = problem.outputs;
+  result.c_reference = problem.c_reference;
+  result.d_reference = problem.d_reference;
   result.starts = options.starts;
   result.best_residual = std::numeric_limits<double>::infinity();
 

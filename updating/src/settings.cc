@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <thread>
+#include <tuple>
 #include <utility>
 
 #include "mbid/simulation/scenario_sections.h"
@@ -336,11 +338,16 @@ bool ApplyAlgebraicStart(const CharacteristicResult& algebraic, UpdateOptions& o
   const CharacteristicSolution& set = algebraic.solutions[static_cast<size_t>(algebraic.chosen)];
   UpdateOptions changed = options;
   int applied = 0;
+  const auto reference = [](const Eigen::VectorXd& values, Eigen::Index k) {
+    return k < values.size() ? values[k] : std::numeric_limits<double>::quiet_NaN();
+  };
   for (size_t i = 0; i < algebraic.coordinates.size(); ++i) {
     const Eigen::Index k = static_cast<Eigen::Index>(i);
-    for (const auto& [name, value] :
-         {std::pair<std::string, double>{"c_" + algebraic.coordinates[i], set.c[k]},
-          std::pair<std::string, double>{"d_" + algebraic.coordinates[i], set.d[k]}}) {
+    for (const auto& [name, value, model_value] :
+         {std::tuple<std::string, double, double>{"c_" + algebraic.coordinates[i], set.c[k],
+                                                  reference(algebraic.c_reference, k)},
+          std::tuple<std::string, double, double>{"d_" + algebraic.coordinates[i], set.d[k],
+                                                  reference(algebraic.d_reference, k)}}) {
       ParameterSetting* setting = FindSetting(changed, name);
       if (setting == nullptr || !std::isnan(setting->initial)) continue;
       if ((!std::isnan(setting->lower) && value < setting->lower) ||
@@ -351,6 +358,13 @@ bool ApplyAlgebraicStart(const CharacteristicResult& algebraic, UpdateOptions& o
         return fail(reason.str());
       }
       setting->initial = value;
+      // The default bounds (two decades either side of the start) hold the model's own value
+      // too: poles that missed a stiff joint's mode gave c_tilt 2.8e5 for a scenario's 1.4e9
+      // (truth 1e9), and the fit stopped at the bound, "does not explain the records".
+      if (value > 0 && model_value > 0) {
+        if (std::isnan(setting->lower)) setting->lower = std::min(value, model_value) / 100;
+        if (std::isnan(setting->upper)) setting->upper = std::max(value, model_value) * 100;
+      }
       ++applied;
     }
   }

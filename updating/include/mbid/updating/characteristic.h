@@ -150,7 +150,8 @@ struct CharacteristicResult {
   // ascending mismatch, then the others by mismatch; without one by distance to the reference.
   // Then the inadmissible sets by residual.
   std::vector<CharacteristicSolution> solutions;
-  int chosen = -1;  // index into solutions, -1 unless kSolved
+  int chosen = -1;                           // index into solutions, -1 unless kSolved
+  Eigen::VectorXd c_reference, d_reference;  // the problem's (the model's values)
   // Other admissible sets agree with the test almost as well (CharacteristicOptions::
   // ambiguity_ratio): the choice is not backed by the record. `rivals` are their indices.
   bool ambiguous = false;
