@@ -80,6 +80,20 @@ bool IsPrecise(const IdentifiedMode& tone, double decay_per_s, const Spread& spr
          spread.decay_per_s <= 0.25 * decay_per_s;
 }
 
+// The difference of a mode with itself: lambda + conj(lambda) = -2 sigma, no frequency. A
+// linkage's quadratic terms (centripetal, geometric) shift its mean by the square of a mode's
+// amplitude, decaying twice as fast as the mode: fitted as a pole, a slow "mode" of less than a
+// cycle (0.037 Hz, decay 0.48 1/s beside a 1.31 Hz mode of decay 0.27 1/s on a trial's two-link
+// arm) that made every multi-link free decay unreliable as "a trend or drift". A pole whose
+// frequency is within its own 3 standard deviations of 0 and below its bandwidth, and whose decay
+// is twice a mode's (3 combined standard deviations plus 25 %, those narrower than the decay).
+bool MatchesMeanShift(const IdentifiedMode& tone, double decay_per_s, const Spread& spread) {
+  return tone.frequency_hz <= 3 * tone.std_frequency_hz &&
+         2 * M_PI * tone.frequency_hz <= tone.decay_rate_per_s &&
+         spread.decay_per_s <= decay_per_s &&
+         std::abs(tone.decay_rate_per_s - decay_per_s) <= spread.decay_per_s + 0.25 * decay_per_s;
+}
+
 constexpr size_t kMaxParents = 6;
 constexpr size_t kMaxProducts = 8;
 
@@ -275,9 +289,18 @@ void MarkCombinationTones(const AnalysisRecord& record, const IdentificationOpti
         } else if (a != b &&
                    Matches(tone, std::abs(high.frequency_hz - low.frequency_hz), decay, spread)) {
           tone.combination = fmt::format("f{} - f{}", std::max(a, b) + 1, std::min(a, b) + 1);
+        } else if (a == b && MatchesMeanShift(tone, decay, spread)) {
+          tone.combination = fmt::format("f{} - f{}", a + 1, a + 1);
         }
         if (tone.combination.empty()) continue;
         const double ratio = largest[m] / std::max(largest[a], largest[b]);
+        // A mean shift is no oscillation whose frequency could be precise: its decay is.
+        const bool mean_shift = a == b && tone.combination.find('-') != std::string::npos;
+        if (mean_shift && ratio <= kMaxLargeToneRatio && spread.decay_per_s <= 0.25 * decay) {
+          if (ratio > kMaxToneRatio)
+            large = fmt::format("{:.2g} % of f{}'s amplitude", 100 * ratio, a + 1);
+          continue;
+        }
         const std::string share = fmt::format("{:.2g} % of f{}'s amplitude", 100 * ratio,
                                               (largest[a] >= largest[b] ? a : b) + 1);
         if (ratio <= kMaxToneRatio) continue;
@@ -290,12 +313,16 @@ void MarkCombinationTones(const AnalysisRecord& record, const IdentificationOpti
       }
     }
     if (!tone.combination.empty()) {
+      const size_t minus = tone.combination.find(" - ");
+      const bool mean_shift = minus != std::string::npos && tone.combination.substr(0, minus) ==
+                                                                tone.combination.substr(minus + 3);
       result->warnings.push_back(fmt::format(
           "the mode at {:.4g} Hz is a combination tone ({}): it matches the sum of those modes' "
           "poles in frequency and decay and is weaker than both; a quadratic nonlinearity "
           "(centripetal accelerations, joint geometry) makes such a component, not a mode of "
-          "the structure{}",
+          "the structure{}{}",
           tone.frequency_hz, tone.combination,
+          mean_shift ? " (a mean shift: no frequency, twice the mode's decay)" : "",
           large.empty() ? ""
                         : fmt::format(". With {} it is stronger than a tone of small vibrations "
                                       "(under {} %), but its pole is the sum's to within {} % "

@@ -38,6 +38,7 @@ namespace {
 void CheckMagnitudes(const Measurement& measurement, const std::string& origin) {
   constexpr double kLargest = 1e60, kSmallest = 1e-60;
   for (Eigen::Index c = 0; c < measurement.values.cols(); ++c) {
+    if (!measurement.values.col(c).allFinite()) continue;  // named where the record is checked
     const double largest = measurement.values.col(c).cwiseAbs().maxCoeff();
     if (!(largest > kLargest) && !(largest > 0 && largest < kSmallest)) continue;
     const auto k = static_cast<size_t>(c);

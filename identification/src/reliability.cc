@@ -207,12 +207,19 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
           record.decimation > 1 ? fmt::format(", decimation {}", record.decimation) : ""));
     }
     // Less than a cycle in the analysed record: a slow trend or drift fits as well as a mode (a
-    // 0.02 Hz sine over 20 s, 0.4 of a cycle, came out as a "reliable" 0.021 Hz mode).
+    // 0.02 Hz sine over 20 s, 0.4 of a cycle, came out as a "reliable" 0.021 Hz mode). One marked
+    // as a combination tone is no mode of the structure either way: the slowly decaying mean
+    // shift of a linkage's quadratic terms (a difference tone near 0 Hz) made every multi-link
+    // free decay unreliable, mbid's own simulated test at 0.2 deg too.
     if (mode.frequency_hz * duration_s < 1) {
-      reasons.push_back(fmt::format(
-          "the mode at {:.4g} Hz completes {:.2g} of a cycle in the analysed {:.4g} s: a trend or "
-          "drift cannot be told from it (remove_drift, or a longer record)",
-          mode.frequency_hz, mode.frequency_hz * duration_s, duration_s));
+      (mode.combination.empty() ? reasons : result->warnings)
+          .push_back(fmt::format(
+              "the mode at {:.4g} Hz completes {:.2g} of a cycle in the analysed {:.4g} s: a trend "
+              "or drift cannot be told from it (remove_drift, or a longer record){}",
+              mode.frequency_hz, mode.frequency_hz * duration_s, duration_s,
+              mode.combination.empty() ? ""
+                                       : "; it is marked as a combination tone (" +
+                                             mode.combination + "), no mode of the structure"));
     }
     // The refinement admits growth by e over the record at most (decay -1 / its duration,
     // refinement.cc): a mode that ends there was pushed to the bound, where its standard
