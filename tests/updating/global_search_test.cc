@@ -356,6 +356,11 @@ TEST(CredibilityTest, ColouredResidualInflatesTheStandardDeviations) {
   // lacks something leaves such a residual too.
   EXPECT_FALSE(result.parameters[0].determined);
   EXPECT_NE(result.parameters[0].why_undetermined.find("not credible"), std::string::npos);
+  // At the noise's level, so the reason says so, and names coloured sensor noise beside a model
+  // that lacks something (a trial's filtered logger at chi^2/dof 0.99 read "above the noise").
+  EXPECT_NE(result.parameters[0].why_undetermined.find("at the records' noise"), std::string::npos)
+      << result.parameters[0].why_undetermined;
+  EXPECT_NE(result.parameters[0].why_undetermined.find("coloured sensor noise"), std::string::npos);
 }
 
 TEST(CredibilityTest, WhiteExcessOverTheNoiseOnlyInflates) {

@@ -256,11 +256,23 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
       // Not white or above the noise, though within what chi^2 lets pass: a model that lacks
       // something leaves such a residual too (a hanger's mass 30 % off: chi^2/dof 0.94 under an
       // identification's noise 20 % high, correlation time 5 samples, c_q1 3046 stds off).
+      // Which of the two, in numbers: a trial's coloured sensor noise (chi^2/dof 0.99) read as
+      // "above the noise".
       p.determined = false;
-      p.why_undetermined = fmt::format(
-          "the fit is not credible: its residual is above the noise or not white (standard "
-          "deviations scaled up by {:.3g}), as a model that lacks something leaves it",
-          result.std_inflation);
+      p.why_undetermined =
+          excess > kNoticeableExcess
+              ? fmt::format(
+                    "the fit is not credible: its residual is {:.3g} times the records' "
+                    "noise (standard deviations scaled up by {:.3g}), as a model that "
+                    "lacks something leaves it",
+                    std::sqrt(excess), result.std_inflation)
+              : fmt::format(
+                    "the fit is not credible: its residual is at the records' noise (chi^2/dof "
+                    "= {:.3g}) but not white (correlation time {:.3g} samples on {}; standard "
+                    "deviations scaled up by {:.3g}): a model that lacks something leaves such a "
+                    "residual, and so does coloured sensor noise (an oversampled record through "
+                    "an anti-alias filter); the records cannot tell which",
+                    result.chi_square_per_dof, worst_time, worst_channel, result.std_inflation);
     } else if (!MarkIfSpreadUndetermined(p, result.std_inflation,
                                          options.undetermined_relative_std) &&
                !p.determined && p.why_undetermined.empty()) {
