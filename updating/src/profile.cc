@@ -350,6 +350,12 @@ void ProfileLikelihood(const model::MechanicalModel& model, const std::vector<Te
         const std::string value = FormatValue(side == &low ? out.lower : out.upper);
         if (!side->failure.empty()) {
           ends.push_back(end + ", where a constrained fit failed");
+        } else if (side->fits == 0) {
+          // "rises by 0 of 6.84 within 0 fits" said nothing: no step was possible there.
+          ends.push_back(
+              fmt::format("{}: the estimate is at its bound {} (no profile point beyond it; wider "
+                          "updating.bounds let the records decide)",
+                          end, value));
         } else if (side->at_bound) {
           ends.push_back(fmt::format("{}: 2 x cost rises by {:.3g} of {:.3g} up to the bound {}",
                                      end, rise, out.threshold, value));
