@@ -14,6 +14,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "mbid/common/stop.h"
@@ -154,6 +155,38 @@ std::string PathArgument(const py::object& object, const std::string& function) 
                        "; expected a str or os.PathLike");
 }
 
+// A dict with str keys as a std::map, or a TypeError of one line naming the argument (pybind11's
+// own for `{1: y}` was 4-6 lines listing the signature).
+template <typename Value>
+std::map<std::string, Value> StringKeyed(const py::object& object, const std::string& argument,
+                                         const std::string& values) {
+  if (!py::isinstance<py::dict>(object)) {
+    throw py::type_error("identify_arrays(): " + argument + " is of type " + TypeName(object) +
+                         "; expected a dict of names to " + values);
+  }
+  std::map<std::string, Value> map;
+  for (const std::pair<py::handle, py::handle> item : py::reinterpret_borrow<py::dict>(object)) {
+    const py::handle key = item.first;
+    const py::handle value = item.second;
+    if (!py::isinstance<py::str>(key)) {
+      throw py::type_error("identify_arrays(): a key of " + argument + " is of type " +
+                           TypeName(py::reinterpret_borrow<py::object>(key)) +
+                           "; expected a str (a channel name)");
+    }
+    if constexpr (std::is_same_v<Value, std::string>) {
+      if (!py::isinstance<py::str>(value)) {
+        throw py::type_error(
+            "identify_arrays(): " + argument + "['" + key.cast<std::string>() + "'] is of type " +
+            TypeName(py::reinterpret_borrow<py::object>(value)) + "; expected a unit string");
+      }
+      map[key.cast<std::string>()] = value.cast<std::string>();
+    } else {
+      map[key.cast<std::string>()] = py::reinterpret_borrow<py::object>(value);
+    }
+  }
+  return map;
+}
+
 // A scenario argument: an mbid.Scenario or the path of its file. Anything else is a TypeError of
 // one line naming the function and the argument (pybind11's own lists every overload).
 mbid::Scenario AsScenario(const py::object& object, const std::string& function) {
@@ -173,14 +206,20 @@ mbid::Measurement AsRecord(const py::handle& object, const std::string& function
 }
 
 // update()'s records: a list (any iterable) of records or paths, or a single one.
-std::vector<mbid::Measurement> AsRecords(const py::object& object) {
+// `paths` (if set) gets each record's file, "" for a Record object.
+std::vector<mbid::Measurement> AsRecords(const py::object& object,
+                                         std::vector<std::string>* paths = nullptr) {
   std::vector<mbid::Measurement> records;
+  const auto add = [&](const py::object& item, const std::string& field) {
+    records.push_back(AsRecord(item, "update", field));
+    if (paths != nullptr) paths->push_back(AsPath(item).value_or(""));
+  };
   if (py::isinstance<mbid::Measurement>(object) || AsPath(object)) {
-    records.push_back(AsRecord(object, "update", "records"));
+    add(object, "records");
   } else if (py::isinstance<py::iterable>(object)) {
     for (const py::handle item : object) {
-      records.push_back(
-          AsRecord(item, "update", "records[" + std::to_string(records.size()) + "]"));
+      add(py::reinterpret_borrow<py::object>(item),
+          "records[" + std::to_string(records.size()) + "]");
     }
   } else {
     throw py::type_error("update(): records is of type " + TypeName(object) +
@@ -239,9 +278,25 @@ mbid::Measurement MakeRecord(const py::object& time_object,
     if (last_bit > 0.1 * mbid::kTimeUniformityTolerance * step) resolution_s = last_bit;
   }
   mbid::Measurement m;
-  m.sample_interval_s = mbid::CheckUniformTime(
-      t, "identify_arrays", [](Eigen::Index j) { return "time[" + std::to_string(j) + "]"; },
-      resolution_s, &m.start_time_s);
+  try {
+    m.sample_interval_s = mbid::CheckUniformTime(
+        t, "identify_arrays", [](Eigen::Index j) { return "time[" + std::to_string(j) + "]"; },
+        resolution_s, &m.start_time_s);
+  } catch (const mbid::InputError& error) {
+    // The reader's advice (a record entry's sample_rate_hz, --sample-rate-hz) is no argument of
+    // this call: times made from the rate are.
+    const size_t advice = error.expected().find(", or, for a time printed coarser than its step");
+    const size_t jitter = error.expected().find("; for a logger that samples at a fixed rate");
+    const size_t cut = std::min(advice, jitter);
+    if (cut == std::string::npos) throw;
+    throw mbid::InputError(
+        error.source(), error.field(), error.problem(),
+        error.expected().substr(0, cut) +
+            (advice < jitter ? ", or times made from the rate: numpy.arange(n) / rate_hz (float64; "
+                               "float16 holds 3 digits)"
+                             : "; for a logger that samples at a fixed rate, times made from it: "
+                               "numpy.arange(n) / rate_hz"));
+  }
   if (channels.empty()) {
     throw mbid::InputError("identify_arrays", "channels", "no channel",
                            "a dict {name: array} with at least one channel");
@@ -535,12 +590,14 @@ PYBIND11_MODULE(_mbid, m) {
       "where the forcing ends.");
   m.def(
       "identify_arrays",
-      [](const py::object& time, const std::map<std::string, py::object>& channels,
-         const std::map<std::string, std::string>& units, const IdentificationOptions& options) {
-        const mbid::Measurement record = MakeRecord(time, channels, units);
+      [](const py::object& time, const py::object& channels, const py::object& units,
+         const IdentificationOptions& options) {
+        const mbid::Measurement record =
+            MakeRecord(time, StringKeyed<py::object>(channels, "channels", "arrays"),
+                       StringKeyed<std::string>(units, "units", "unit strings"));
         return Interruptible([&] { return mbid::Identify(record, options); });
       },
-      py::arg("time"), py::arg("channels"), py::arg("units") = std::map<std::string, std::string>{},
+      py::arg("time"), py::arg("channels"), py::arg("units") = py::dict(),
       py::arg("options") = IdentificationOptions(),
       "Identifies the modes of a free decay given as arrays: time (s, uniform) and {name: "
       "values}.");
@@ -548,20 +605,39 @@ PYBIND11_MODULE(_mbid, m) {
       "update",
       [](const py::object& scenario_object, const py::object& records_object) {
         const mbid::Scenario scenario = AsScenario(scenario_object, "update");
-        const std::vector<mbid::Measurement> records = AsRecords(records_object);
-        return Interruptible([&] { return mbid::Update(scenario, records); });
+        std::vector<std::string> paths;
+        const std::vector<mbid::Measurement> records = AsRecords(records_object, &paths);
+        try {
+          return Interruptible([&] { return mbid::Update(scenario, records); });
+        } catch (const mbid::InputError& error) {
+          // The library names a record by its place ("record 1"); a file given by its path is
+          // named by it, as the command line does.
+          for (size_t i = 0; i < paths.size(); ++i) {
+            if (!paths[i].empty() && error.source() == "record " + std::to_string(i + 1)) {
+              throw mbid::InputError(paths[i], error.field(), error.problem(), error.expected());
+            }
+          }
+          throw;
+        }
       },
       py::arg("scenario"), py::arg("records"),
       "Tunes the scenario's model (a Scenario or its file) to the records (Records or their "
       "files): .parameters['c_alpha'].value, .std.");
   m.def(
       "run",
-      [](const py::object& scenario_object,
-         const std::optional<std::filesystem::path>& output_folder, bool overwrite, bool quiet) {
+      [](const py::object& scenario_object, const py::object& output_folder, bool overwrite,
+         bool quiet) {
         const mbid::Scenario scenario = AsScenario(scenario_object, "run");
         mbid::ValidationOptions options;
         // None: in memory (a default path would come back from Python as ".").
-        if (output_folder) options.output_folder = output_folder->string();
+        if (!output_folder.is_none()) {
+          const std::optional<std::string> path = AsPath(output_folder);
+          if (!path) {
+            throw py::type_error("run(): output_folder is of type " + TypeName(output_folder) +
+                                 "; expected None, a str or os.PathLike");
+          }
+          options.output_folder = *path;
+        }
         options.overwrite = overwrite;
         options.quiet = quiet;
         return Interruptible([&] { return mbid::RunValidationCycle(scenario, options); });

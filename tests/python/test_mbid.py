@@ -421,13 +421,40 @@ class ErrorTest(unittest.TestCase):
                  (lambda: mbid.identify({}), "identify(): record is of type dict"),
                  (lambda: mbid.update(REFERENCE, 7), "update(): records is of type int"),
                  (lambda: mbid.update(REFERENCE, [7]), "update(): records[0] is of type int"),
-                 (lambda: mbid.run([]), "run(): scenario is of type list")]
+                 (lambda: mbid.run([]), "run(): scenario is of type list"),
+                 # These were pybind11's 4-6 lines (a trial's):
+                 (lambda: mbid.run(REFERENCE, output_folder=5),
+                  "run(): output_folder is of type int"),
+                 (lambda: mbid.identify_arrays(np.arange(3.0), {1: np.arange(3.0)}),
+                  "identify_arrays(): a key of channels is of type int"),
+                 (lambda: mbid.identify_arrays(np.arange(3.0), [np.arange(3.0)]),
+                  "identify_arrays(): channels is of type list"),
+                 (lambda: mbid.identify_arrays(np.arange(3.0), {"a": np.arange(3.0)}, {"a": 3}),
+                  "identify_arrays(): units['a'] is of type int")]
         for call, start in cases:
             with self.assertRaises(TypeError) as raised:
                 call()
             message = str(raised.exception)
             self.assertTrue(message.startswith(start), message)
             self.assertEqual(message.count("\n"), 0, message)
+
+    def test_a_record_file_is_named_by_its_path_and_advice_fits_the_call(self):
+        # update() named a file given by its path "record 1"; the command line names the file.
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "unknown.csv")
+            with open(path, "w") as f:
+                f.write("time,zzz\n0,1\n0.01,2\n0.02,1\n0.03,0\n")
+            with self.assertRaises(mbid.InputError) as raised:
+                mbid.update(REFERENCE, [path])
+            self.assertTrue(str(raised.exception).startswith(path + ":channels:"),
+                            str(raised.exception))
+        # float16 times of a 200 Hz record repeat near 8 s: the advice was a record entry's
+        # sample_rate_hz, which identify_arrays has not; it names times made from the rate.
+        t = (np.arange(2000) * 0.005).astype(np.float16)
+        with self.assertRaises(mbid.InputError) as raised:
+            mbid.identify_arrays(t, {"a": np.cos(t.astype(float))}, {"a": "m"})
+        self.assertNotIn("sample_rate_hz", str(raised.exception))
+        self.assertIn("numpy.arange(n) / rate_hz", str(raised.exception))
 
     def test_units_are_converted_to_si_or_refused(self):
         # A unit decay stated in deg comes back with amplitude pi / 180 rad, as a file's would;
