@@ -525,6 +525,39 @@ sensors: {sample_rate_hz: 100, channels: [angle], noise_std_rad: 1.0e-5, seed: 3
       << ::testing::PrintToString(run.reasons);
 }
 
+// A test deflecting the swing 0.05 rad and the pin not at all, both deflections fitted: the pin's
+// came out near 0 with a std of a few urad, "undetermined" for a relative std of its own value
+// (a trial's 2e-6 +- 5e-6 rad, "rank 8 of 8"). It is relative to the test's largest deflection of
+// its unit: known to be small, determined.
+TEST(FacadeTest, ADeflectionFittedNearZeroIsKnownToBeSmall) {
+  const std::string text = R"(name: swing
+model:
+  type: multibody
+  bodies:
+    arm: {parent: ground, joint: {type: revolute, coordinates: [pin], axis: [0, 1, 0]},
+          mass_kg: 10.0, com_m: [0.5, 0, 0], inertia_kgm2: [0.1, 0.9, 0.9]}
+    bob: {parent: arm, joint: {type: revolute, coordinates: [swing], axis: [0, 1, 0],
+          in_parent_m: [1.0, 0, 0]}, mass_kg: 2.0, com_m: [0, 0, -0.5],
+          inertia_kgm2: [0.02, 0.02, 0.01]}
+  springs:
+    pin: {stiffness_Nm_per_rad: 2.0e3, damping_Nms_per_rad: 3.0}
+    swing: {stiffness_Nm_per_rad: 20.0, damping_Nms_per_rad: 0.2}
+  outputs:
+    arm_angle: {type: coordinate, coordinate: pin}
+    bob_angle: {type: coordinate, coordinate: swing}
+excitation: {type: initial_deflection, deflection_rad: {pin: 0.0, swing: 0.05}}
+simulation: {duration_s: 3}
+sensors: {sample_rate_hz: 100, channels: [arm_angle, bob_angle], noise_std_rad: 1.0e-5, seed: 3}
+updating: {noise_std_rad: 1.0e-5, fit_initial_deflection: true, global_search: {enabled: false}}
+)";
+  const mbid::Scenario scenario = mbid::LoadScenarioFromText(text, "swing.yaml");
+  const mbid::UpdateResult tuned = mbid::Update(scenario, {mbid::Simulate(scenario)});
+  const mbid::ParameterValue& pin = tuned.parameters.at("record 1:deflection_pin");
+  EXPECT_NEAR(pin.value, 0.0, 4 * pin.std);
+  EXPECT_LT(pin.std, 1e-3 * 0.05);  // the records know it to a thousandth of the test's size
+  EXPECT_TRUE(pin.determined) << pin.why_undetermined;
+}
+
 // `passed` needs a credible fit. Weights that state the noise 30 % low (7e-6 rad against the
 // record's 1e-5) leave a white excess, chi^2/dof about 2, taken for a noise level stated too low:
 // the standard deviations are inflated by about 1.4, but the fit is not credible (a trial's hammer

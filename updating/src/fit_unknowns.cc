@@ -1,6 +1,7 @@
 #include "fit_unknowns.h"
 
 #include <algorithm>
+#include <map>
 #include <sstream>
 
 #include "mbid/common/error.h"
@@ -71,9 +72,17 @@ std::vector<Unknown> ResolveUnknowns(const model::MechanicalModel& model,
                          "initial deflections as nuisance parameters of initial_deflection "
                          "tests only");
       }
+      // The test's largest deflection of each unit (rad, m): the scale of each.
+      std::map<std::string, double> largest;
+      for (const auto& [coordinate, value] : deflection->deflection_rad) {
+        const std::string unit = model.coordinate_unit(coordinate);
+        double& at = largest[unit];
+        at = std::max(at, std::abs(value));
+      }
       for (const auto& [coordinate, value] : deflection->deflection_rad) {
         Unknown unknown;
         unknown.kind = Unknown::Kind::kDeflection;
+        unknown.scale = largest[model.coordinate_unit(coordinate)];
         unknown.name = test.name + ":deflection_" + coordinate;
         // A prismatic coordinate's deflection is a length (excitation.deflection_m).
         const std::string unit = model.coordinate_unit(coordinate);

@@ -23,6 +23,10 @@ struct Unknown {
   std::string coordinate;  // kDeflection
   bool log_scale = true;
   double initial = 0, lower = 0, upper = 0;
+  // A linear-scale unknown's standard deviation is relative to the larger of its value and this:
+  // a deflection fitted near 0 (2e-6 +- 5e-6 rad beside a test's 0.04) is known to be small,
+  // not "undetermined" for a relative std of 2.5. 0: its value alone.
+  double scale = 0;
 
   // Ceres' coordinate x and back.
   double ToInternal(double value) const { return log_scale ? std::log(value) : value; }

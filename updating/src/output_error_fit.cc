@@ -292,9 +292,10 @@ void AddEstimates(const FitProblem& fit, const std::vector<TestRecord>& tests,
     if (variance >= 0 && std::isfinite(variance)) {
       const double std_internal = std::sqrt(variance);
       estimate.std = unknown.log_scale ? estimate.value * std_internal : std_internal;
-      estimate.relative_std = unknown.log_scale
-                                  ? std_internal
-                                  : std_internal / std::max(std::abs(estimate.value), 1e-6);
+      estimate.relative_std =
+          unknown.log_scale
+              ? std_internal
+              : std_internal / std::max({std::abs(estimate.value), unknown.scale, 1e-6});
     }
     // A record's time base known to +-u (a sample interval printed to few digits) scales the
     // frequencies by up to u: a stiffness (omega^2) by 2 u, a damping (decay) by u, as a uniform
