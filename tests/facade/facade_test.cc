@@ -405,6 +405,27 @@ updating: {noise_std_rad: 1.0e-5, global_search: {enabled: false},
       << ::testing::PrintToString(run.reasons);
 }
 
+// An arm on a pin (stiffness and damping given) carrying a pendulum, both angles measured: the
+// model section of a scenario.
+std::string ArmAndBob(double pin_stiffness, double pin_damping) {
+  return fmt::format(R"(model:
+  type: multibody
+  bodies:
+    arm: {{parent: ground, joint: {{type: revolute, coordinates: [pin], axis: [0, 1, 0]}},
+          mass_kg: 10.0, com_m: [0.5, 0, 0], inertia_kgm2: [0.1, 0.9, 0.9]}}
+    bob: {{parent: arm, joint: {{type: revolute, coordinates: [swing], axis: [0, 1, 0],
+          in_parent_m: [1.0, 0, 0]}}, mass_kg: 2.0, com_m: [0, 0, -0.5],
+          inertia_kgm2: [0.02, 0.02, 0.01]}}
+  springs:
+    pin: {{stiffness_Nm_per_rad: {}, damping_Nms_per_rad: {}}}
+    swing: {{stiffness_Nm_per_rad: 20.0, damping_Nms_per_rad: 0.2}}
+  outputs:
+    arm_angle: {{type: coordinate, coordinate: pin}}
+    bob_angle: {{type: coordinate, coordinate: swing}}
+)",
+                     pin_stiffness, pin_damping);
+}
+
 // A stiff pin at 45.9 Hz sampled at 100 Hz, started where its mode is at 54.5 Hz (above Nyquist,
 // the samples show it at 45.5 Hz): the fit ended at the alias (c_pin 622605 against 450000, 53.6
 // Hz), where before no start came from below Nyquist (a trial's mast pin, "passed" 38 of its
@@ -413,22 +434,9 @@ updating: {noise_std_rad: 1.0e-5, global_search: {enabled: false},
 // and is the result. Route 1 and the pole-equivalent sets are off, one design point: the alias
 // sets alone reach it.
 TEST(FacadeTest, AModeAboveNyquistIsAlsoFittedAtItsAlias) {
-  const std::string text = R"(name: pin-and-bob
-model:
-  type: multibody
-  bodies:
-    arm: {parent: ground, joint: {type: revolute, coordinates: [pin], axis: [0, 1, 0]},
-          mass_kg: 10.0, com_m: [0.5, 0, 0], inertia_kgm2: [0.1, 0.9, 0.9]}
-    bob: {parent: arm, joint: {type: revolute, coordinates: [swing], axis: [0, 1, 0],
-          in_parent_m: [1.0, 0, 0]}, mass_kg: 2.0, com_m: [0, 0, -0.5],
-          inertia_kgm2: [0.02, 0.02, 0.01]}
-  springs:
-    pin: {stiffness_Nm_per_rad: 4.5e5, damping_Nms_per_rad: 30.0}
-    swing: {stiffness_Nm_per_rad: 20.0, damping_Nms_per_rad: 0.2}
-  outputs:
-    arm_angle: {type: coordinate, coordinate: pin}
-    bob_angle: {type: coordinate, coordinate: swing}
-excitation: {type: initial_deflection, deflection_rad: {pin: 0.001, swing: 0.05}}
+  const std::string text =
+      "name: pin-and-bob\n" + ArmAndBob(4.5e5, 30.0) +
+      R"(excitation: {type: initial_deflection, deflection_rad: {pin: 0.001, swing: 0.05}}
 simulation: {duration_s: 2}
 sensors: {sample_rate_hz: 100, channels: [arm_angle, bob_angle], noise_std_rad: 1.0e-5, seed: 3}
 updating: {noise_std_rad: 1.0e-5, algebraic_start: false,
@@ -531,22 +539,9 @@ sensors: {sample_rate_hz: 100, channels: [angle], noise_std_rad: 1.0e-5, seed: 3
 // (a trial's 2e-6 +- 5e-6 rad, "rank 8 of 8"). It is relative to the test's largest deflection of
 // its unit: known to be small, determined.
 TEST(FacadeTest, ADeflectionFittedNearZeroIsKnownToBeSmall) {
-  const std::string text = R"(name: swing
-model:
-  type: multibody
-  bodies:
-    arm: {parent: ground, joint: {type: revolute, coordinates: [pin], axis: [0, 1, 0]},
-          mass_kg: 10.0, com_m: [0.5, 0, 0], inertia_kgm2: [0.1, 0.9, 0.9]}
-    bob: {parent: arm, joint: {type: revolute, coordinates: [swing], axis: [0, 1, 0],
-          in_parent_m: [1.0, 0, 0]}, mass_kg: 2.0, com_m: [0, 0, -0.5],
-          inertia_kgm2: [0.02, 0.02, 0.01]}
-  springs:
-    pin: {stiffness_Nm_per_rad: 2.0e3, damping_Nms_per_rad: 3.0}
-    swing: {stiffness_Nm_per_rad: 20.0, damping_Nms_per_rad: 0.2}
-  outputs:
-    arm_angle: {type: coordinate, coordinate: pin}
-    bob_angle: {type: coordinate, coordinate: swing}
-excitation: {type: initial_deflection, deflection_rad: {pin: 0.0, swing: 0.05}}
+  const std::string text =
+      "name: swing\n" + ArmAndBob(2.0e3, 3.0) +
+      R"(excitation: {type: initial_deflection, deflection_rad: {pin: 0.0, swing: 0.05}}
 simulation: {duration_s: 3}
 sensors: {sample_rate_hz: 100, channels: [arm_angle, bob_angle], noise_std_rad: 1.0e-5, seed: 3}
 updating: {noise_std_rad: 1.0e-5, fit_initial_deflection: true, global_search: {enabled: false}}
