@@ -370,26 +370,33 @@ TEST(FacadeTest, AnOpenProfileMakesTheVerdictInconclusive) {
   EXPECT_TRUE(result.updated.parameters.at("c_alpha").determined);
 }
 
+// A pendulum on a spring of 100 N m/rad and the given damping, released from 0.01 rad and
+// recorded 4 s at 100 Hz: a scenario without its name.
+std::string Pendulum(double damping) {
+  return fmt::format(R"(model:
+  type: multibody
+  bodies:
+    bob: {{parent: ground, joint: {{type: revolute, coordinates: [swing], axis: [0, 1, 0]}},
+          mass_kg: 10.0, com_m: [0, 0, -0.5], inertia_kgm2: [0.2, 0.2, 0.05]}}
+  springs:
+    swing: {{stiffness_Nm_per_rad: 100.0, damping_Nms_per_rad: {}}}
+  outputs:
+    angle: {{type: coordinate, coordinate: swing}}
+excitation: {{type: initial_deflection, deflection_rad: {{swing: 0.01}}}}
+simulation: {{duration_s: 4}}
+sensors: {{sample_rate_hz: 100, channels: [angle], noise_std_rad: 1.0e-5, seed: 3}}
+)",
+                     damping);
+}
+
 // An overdamped machine (what damper sizing designs): a pendulum on a joint at 1.5 times critical
 // damping, sqrt((c + m g L) J) = sqrt((100 + 10 * 9.81 * 0.5) * 3.05) = 20.06, d = 3 * 20.06 =
 // 60.18, rings at no frequency, and `update` and `run` stopped at "no modes found" (exit 3). The
 // time-domain fit needs no modes: both joint parameters come back within 3 standard deviations;
 // the run is inconclusive (no identification), not a failure to run.
 TEST(FacadeTest, AnOverdampedMachineIsTunedWithoutModes) {
-  const std::string text = R"(name: pendulum
-model:
-  type: multibody
-  bodies:
-    bob: {parent: ground, joint: {type: revolute, coordinates: [swing], axis: [0, 1, 0]},
-          mass_kg: 10.0, com_m: [0, 0, -0.5], inertia_kgm2: [0.2, 0.2, 0.05]}
-  springs:
-    swing: {stiffness_Nm_per_rad: 100.0, damping_Nms_per_rad: 60.18}
-  outputs:
-    angle: {type: coordinate, coordinate: swing}
-excitation: {type: initial_deflection, deflection_rad: {swing: 0.01}}
-simulation: {duration_s: 4}
-sensors: {sample_rate_hz: 100, channels: [angle], noise_std_rad: 1.0e-5, seed: 3}
-updating: {noise_std_rad: 1.0e-5, global_search: {enabled: false},
+  const std::string text = "name: pendulum\n" + Pendulum(60.18) +
+                           R"(updating: {noise_std_rad: 1.0e-5, global_search: {enabled: false},
            start: {c_swing: 80.0, d_swing: 50.0}}
 )";
   const mbid::Scenario scenario = mbid::LoadScenarioFromText(text, "overdamped.yaml");
@@ -500,20 +507,7 @@ sensors: {sample_rate_hz: 500, channels: [th1, th2, w2, atx, atz], noise_std_rad
 // (a trial's two-link arm, K = -0.44), telling the user the model is wrong; nothing is known of
 // it: inconclusive, naming the late start and the way out (the release instant).
 TEST(FacadeTest, ARecordThatStartsAfterTheReleaseIsNoFailureOfTheModel) {
-  const std::string pendulum = R"(name: pendulum
-model:
-  type: multibody
-  bodies:
-    bob: {parent: ground, joint: {type: revolute, coordinates: [swing], axis: [0, 1, 0]},
-          mass_kg: 10.0, com_m: [0, 0, -0.5], inertia_kgm2: [0.2, 0.2, 0.05]}
-  springs:
-    swing: {stiffness_Nm_per_rad: 100.0, damping_Nms_per_rad: 2.0}
-  outputs:
-    angle: {type: coordinate, coordinate: swing}
-excitation: {type: initial_deflection, deflection_rad: {swing: 0.01}}
-simulation: {duration_s: 4}
-sensors: {sample_rate_hz: 100, channels: [angle], noise_std_rad: 1.0e-5, seed: 3}
-)";
+  const std::string pendulum = "name: pendulum\n" + Pendulum(2.0);
   const mbid::Measurement full = mbid::Simulate(mbid::LoadScenarioFromText(pendulum, "p.yaml"));
   const std::filesystem::path folder =
       std::filesystem::temp_directory_path() / ("mbid_late_" + std::to_string(::getpid()));
