@@ -44,10 +44,10 @@ bool BarelyMoves(const RunTest& test) {
 bool ModesLeaveWhatAModelMayExplain(const std::string& reason) {
   // A channel the modes leave uncorrelated: an overdamped joint's motion has no oscillating mode
   // (a cart at 1.5 times critical beside a swinging arm: K = 0.425, the fit exact).
-  for (const char* words : {"times the record's noise level: the modes do not explain the record",
-                            "times the power it has elsewhere: something there is not in the modes",
-                            "are correlated (", "is amplitude dependent (",
-                            "is below min_correlation"}) {
+  for (const char* words :
+       {"times the record's noise level: the modes do not explain the record",
+        "times the power it has elsewhere: something there is not in the modes", "are correlated (",
+        "is amplitude dependent (", "is below min_correlation"}) {
     if (reason.find(words) != std::string::npos) return true;
   }
   return false;
