@@ -17,9 +17,7 @@ int RunModesCommand(const std::string& scenario_path, const CommonOptions& commo
   const auto model = scenario.MakeModel();
   const model::LinearModel linear = model->Linearize();
   const std::vector<model::Mode> modes = model::CalcModes(linear);
-  std::vector<std::string> doubts = model::FindGrowingModes(modes);
-  for (const std::string& line : model::FindImpreciseModes(modes)) doubts.push_back(line);
-  for (const std::string& line : doubts) {
+  for (const std::string& line : model::FindModeDoubts(modes)) {
     std::cerr << "mbid: warning: " << line << "\n";
   }
   if (!common.json_path.empty()) WriteJson(LinearModelToJson(linear, modes), common.json_path);

@@ -70,8 +70,7 @@ int RunSimulateCommand(const std::string& scenario_path, const std::string& outp
 
   const validation::ModelTruth truth = validation::CalcModelTruth(*model);
   std::vector<std::string> warnings = simulation::FindStartFarFromRest(*model, excitation);
-  for (const std::string& line : model::FindGrowingModes(truth.modes)) warnings.push_back(line);
-  for (const std::string& line : model::FindImpreciseModes(truth.modes)) warnings.push_back(line);
+  for (const std::string& line : model::FindModeDoubts(truth.modes)) warnings.push_back(line);
   for (const std::string& line :
        simulation::FindAliasedModes(truth.modes, result.measured.sample_interval_s)) {
     warnings.push_back(line);

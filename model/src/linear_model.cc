@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include "mbid/common/eigen_decompositions.h"
 
@@ -48,6 +49,12 @@ std::vector<std::string> FindImpreciseModes(const std::vector<Mode>& modes) {
       "stiffness to make it rigid is better welded, joint type: weld; a body far lighter than "
       "the others, merged)",
       smallest / (2 * M_PI), fastest / (2 * M_PI), error)};
+}
+
+std::vector<std::string> FindModeDoubts(const std::vector<Mode>& modes) {
+  std::vector<std::string> lines = FindGrowingModes(modes);
+  for (std::string& line : FindImpreciseModes(modes)) lines.push_back(std::move(line));
+  return lines;
 }
 
 std::string StiffnessUnits(const std::string& coordinate_unit) {

@@ -51,9 +51,7 @@ nlohmann::json LinearModelToJson(const model::LinearModel& linear,
                       {"C", MatrixToJson(linear.C)},       {"H", MatrixToJson(linear.H)}};
   json["modes"] = nlohmann::json::array();
   for (const model::Mode& mode : modes) json["modes"].push_back(ModelModeToJson(mode, linear));
-  std::vector<std::string> warnings = model::FindGrowingModes(modes);
-  for (const std::string& line : model::FindImpreciseModes(modes)) warnings.push_back(line);
-  json["warnings"] = warnings;
+  json["warnings"] = model::FindModeDoubts(modes);
   return json;
 }
 

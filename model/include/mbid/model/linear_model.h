@@ -64,4 +64,7 @@ std::vector<std::string> FindGrowingModes(const std::vector<Mode>& modes);
 // given a stiffness 1e12 times the others' to make it rigid.
 std::vector<std::string> FindImpreciseModes(const std::vector<Mode>& modes);
 
+// What the two above say of `modes`: the warnings of a model's exact modes.
+std::vector<std::string> FindModeDoubts(const std::vector<Mode>& modes);
+
 }  // namespace mbid::model
