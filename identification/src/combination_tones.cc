@@ -272,7 +272,8 @@ void MarkCombinationTones(const AnalysisRecord& record, const IdentificationOpti
   std::vector<std::string> too_strong(n);  // per mode: a sum it matches, too strong for a tone
   for (size_t m = 0; m < n; ++m) {
     IdentifiedMode& tone = modes[m];
-    std::string large;  // the amplitude of a precise tone above kMaxToneRatio
+    std::string large;        // the amplitude of a precise tone above kMaxToneRatio
+    bool mean_shift = false;  // the tone is a mode with itself (MatchesMeanShift)
     for (size_t a = 0; a < n && tone.combination.empty(); ++a) {
       for (size_t b = a; b < n && tone.combination.empty(); ++b) {
         if (a == m || b == m || !(largest[m] < std::min(largest[a], largest[b]))) continue;
@@ -291,18 +292,17 @@ void MarkCombinationTones(const AnalysisRecord& record, const IdentificationOpti
           tone.combination = fmt::format("f{} - f{}", std::max(a, b) + 1, std::min(a, b) + 1);
         } else if (a == b && MatchesMeanShift(tone, decay, spread)) {
           tone.combination = fmt::format("f{} - f{}", a + 1, a + 1);
+          mean_shift = true;
         }
         if (tone.combination.empty()) continue;
         const double ratio = largest[m] / std::max(largest[a], largest[b]);
-        // A mean shift is no oscillation whose frequency could be precise: its decay is.
-        const bool mean_shift = a == b && tone.combination.find('-') != std::string::npos;
-        if (mean_shift && ratio <= kMaxLargeToneRatio && spread.decay_per_s <= 0.25 * decay) {
-          if (ratio > kMaxToneRatio)
-            large = fmt::format("{:.2g} % of f{}'s amplitude", 100 * ratio, a + 1);
-          continue;
-        }
         const std::string share = fmt::format("{:.2g} % of f{}'s amplitude", 100 * ratio,
                                               (largest[a] >= largest[b] ? a : b) + 1);
+        // A mean shift is no oscillation whose frequency could be precise: its decay is.
+        if (mean_shift && ratio <= kMaxLargeToneRatio && spread.decay_per_s <= 0.25 * decay) {
+          if (ratio > kMaxToneRatio) large = share;
+          continue;
+        }
         if (ratio <= kMaxToneRatio) continue;
         if (ratio <= kMaxLargeToneRatio && IsPrecise(tone, decay, spread)) {
           large = share;
@@ -310,12 +310,10 @@ void MarkCombinationTones(const AnalysisRecord& record, const IdentificationOpti
         }
         if (too_strong[m].empty()) too_strong[m] = tone.combination + " with " + share;
         tone.combination.clear();
+        mean_shift = false;
       }
     }
     if (!tone.combination.empty()) {
-      const size_t minus = tone.combination.find(" - ");
-      const bool mean_shift = minus != std::string::npos && tone.combination.substr(0, minus) ==
-                                                                tone.combination.substr(minus + 3);
       result->warnings.push_back(fmt::format(
           "the mode at {:.4g} Hz is a combination tone ({}): it matches the sum of those modes' "
           "poles in frequency and decay and is weaker than both; a quadratic nonlinearity "
