@@ -171,6 +171,19 @@ std::string HeaderText(const std::vector<TextLine>& lines, const CsvDialect& dia
   return dialect.header_in_comment ? CommentBody(text) : text;
 }
 
+namespace {
+
+// Where the header is and what follows it; the byte order mark and line ends stay as found.
+void PlaceHeader(CsvDialect* dialect, char separator, int header, int units_row, size_t fields,
+                 size_t preamble_lines, bool in_comment = false) {
+  dialect->separator = separator;
+  dialect->header = header;
+  dialect->header_in_comment = in_comment;
+  dialect->units_row = units_row;
+  dialect->field_count = static_cast<int>(fields);
+  dialect->preamble_lines = static_cast<int>(preamble_lines);
+}
+
 // Whether the content lines from `first` on (up to kRowsChecked of them) are all rows of
 // `columns` fields that are data: a header candidate's rows must go on as it says. Two data lines
 // of a ';' file with decimal commas ("1,49;34,999;-12" then "1,5;35;-11,998") split on ',' as a
@@ -204,16 +217,13 @@ bool FindHeaderInComment(const std::vector<TextLine>& lines, const std::vector<i
     if (header.size() < 2 || !names || !RowsFollow(lines, content, 0, header.size(), separator)) {
       continue;
     }
-    dialect->separator = separator;
-    dialect->header = above;
-    dialect->header_in_comment = true;
-    dialect->units_row = -1;
-    dialect->field_count = static_cast<int>(header.size());
-    dialect->preamble_lines = 0;
+    PlaceHeader(dialect, separator, above, -1, header.size(), 0, true);
     return true;
   }
   return false;
 }
+
+}  // namespace
 
 int FirstLineOfNumbers(const std::vector<TextLine>& lines) {
   for (const TextLine& line : lines) {
@@ -273,11 +283,7 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
           if (names && numbers) {
             if (!first_row_broken) {
               first_row_broken = *dialect;
-              first_row_broken->separator = separator;
-              first_row_broken->header = content[k];
-              first_row_broken->units_row = -1;
-              first_row_broken->field_count = static_cast<int>(header.size());
-              first_row_broken->preamble_lines = static_cast<int>(k);
+              PlaceHeader(&*first_row_broken, separator, content[k], -1, header.size(), k);
             }
             passed_one = true;
           }
@@ -293,11 +299,7 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
           (follows == found_follows && static_cast<int>(header.size()) > dialect->field_count)) {
         found = true;
         found_follows = follows;
-        dialect->separator = separator;
-        dialect->header = content[k];
-        dialect->units_row = units_row;
-        dialect->field_count = static_cast<int>(header.size());
-        dialect->preamble_lines = static_cast<int>(k);
+        PlaceHeader(dialect, separator, content[k], units_row, header.size(), k);
       }
       // A logger's preamble line of a name and numbers ("Messbereich;-10;10") reads as a row
       // under the one above it ("Abtastrate;100;Hz"): the header whose rows follow is looked
@@ -330,11 +332,7 @@ bool DetectDialect(const std::vector<TextLine>& lines, CsvDialect* dialect) {
         if (!IsDataRow(SplitFields(lines[content[k + 2]].text, separator), separator)) continue;
         units_row = content[k + 1];
       }
-      dialect->separator = separator;
-      dialect->header = content[k];
-      dialect->units_row = units_row;
-      dialect->field_count = 1;
-      dialect->preamble_lines = static_cast<int>(k);
+      PlaceHeader(dialect, separator, content[k], units_row, 1, k);
       return true;
     }
     break;
