@@ -16,6 +16,11 @@ std::string Lower(std::string text) {
   return text;
 }
 
+bool EndsWith(const std::string& text, const std::string& tail) {
+  return text.size() > tail.size() &&
+         text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
+}
+
 bool IsTimeBase(const std::string& lower) {
   for (const char* base : {"time", "t", "zeit", "timestamp", "datetime", "x_value"}) {
     if (lower == base) return true;
@@ -54,9 +59,7 @@ bool IsTimeColumnName(const std::string& name, std::string* unit) {
   if (IsTimeBase(lower)) return true;
   for (const char* suffix : {"_s", "_ms", "_us"}) {
     const std::string tail(suffix);
-    if (lower.size() > tail.size() &&
-        lower.compare(lower.size() - tail.size(), tail.size(), tail) == 0 &&
-        IsTimeBase(lower.substr(0, lower.size() - tail.size()))) {
+    if (EndsWith(lower, tail) && IsTimeBase(lower.substr(0, lower.size() - tail.size()))) {
       *unit = tail.substr(1);
       return true;
     }
@@ -79,11 +82,7 @@ std::string UnitFromNameSuffix(const std::string& name) {
       {"_mps", "m/s"}};
   const std::string lower = Lower(name);
   for (const auto& [suffix, unit] : kSuffixes) {
-    const std::string tail(suffix);
-    if (lower.size() > tail.size() &&
-        lower.compare(lower.size() - tail.size(), tail.size(), tail) == 0) {
-      return unit;
-    }
+    if (EndsWith(lower, suffix)) return unit;
   }
   return "";
 }
