@@ -29,6 +29,11 @@ Measurement ApplySensor(const Measurement& clean, const SensorOptions& options) 
   return measured;
 }
 
+double AliasFrequencyHz(double frequency_hz, double sample_interval_s) {
+  const double rate_hz = 1 / sample_interval_s;
+  return std::abs(frequency_hz - std::round(frequency_hz / rate_hz) * rate_hz);
+}
+
 std::vector<std::string> FindAliasedModes(const std::vector<model::Mode>& modes,
                                           double sample_interval_s) {
   std::vector<std::string> lines;
@@ -36,7 +41,7 @@ std::vector<std::string> FindAliasedModes(const std::vector<model::Mode>& modes,
   for (size_t k = 0; k < modes.size(); ++k) {
     const double f = modes[k].frequency_hz();
     if (!(f >= 0.5 * rate_hz)) continue;
-    const double alias = std::abs(f - std::round(f / rate_hz) * rate_hz);
+    const double alias = AliasFrequencyHz(f, sample_interval_s);
     lines.push_back(fmt::format(
         "the model's mode {} at {:.4g} Hz lies above the Nyquist frequency {:.4g} Hz of the "
         "sampling: the record aliases it to {:.4g} Hz; sampling at {:.4g} Hz or more records it",

@@ -14,6 +14,7 @@
 
 #include "global_search_internal.h"
 #include "mbid/model/linear_model.h"
+#include "mbid/simulation/sensor.h"
 #include "mbid/updating/characteristic.h"
 #include "output_error_fit.h"
 
@@ -131,17 +132,17 @@ std::unique_ptr<model::MechanicalModel> TunedForEquation7(
     const model::MechanicalModel& model, const UpdateResult& fit,
     std::vector<std::complex<double>>* lambda) {
   if (!FindFreeCoordinate(model).empty()) return nullptr;
-  std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
-  ApplyEstimates(fit, *tuned);
-  const model::LinearModel linear = tuned->Linearize();
-  for (const std::string& coordinate : linear.coordinates) {
+  // Checked before the linearization, which a payload's rest makes costly.
+  for (const std::string& coordinate : model.coordinate_names()) {
     for (const std::string& name : {"c_" + coordinate, "d_" + coordinate}) {
       bool found = false;
       for (const ParameterEstimate& p : fit.parameters) found = found || p.name == name;
       if (!found) return nullptr;
     }
   }
-  for (const model::Mode& mode : model::CalcModes(linear)) {
+  std::unique_ptr<model::MechanicalModel> tuned = model.Clone();
+  ApplyEstimates(fit, *tuned);
+  for (const model::Mode& mode : model::CalcModes(tuned->Linearize())) {
     if (mode.lambda.imag() > 0) lambda->push_back(mode.lambda);
   }
   if (static_cast<int>(lambda->size()) != tuned->coordinate_count()) return nullptr;
@@ -180,12 +181,11 @@ std::vector<SearchStart> AliasStarts(const model::MechanicalModel& model, const 
   std::vector<std::complex<double>> lambda;
   const std::unique_ptr<model::MechanicalModel> tuned = TunedForEquation7(model, fit, &lambda);
   if (!tuned || !(nyquist_hz > 0)) return {};
-  const double rate_hz = 2 * nyquist_hz;
   bool moved = false;
   for (std::complex<double>& pole : lambda) {
     const double f = pole.imag() / (2 * M_PI);
     if (f < nyquist_hz) continue;
-    const double alias = std::abs(f - std::round(f / rate_hz) * rate_hz);
+    const double alias = simulation::AliasFrequencyHz(f, 0.5 / nyquist_hz);
     if (!(alias > 0)) continue;  // at a multiple of the rate: no oscillation to move it to
     if (aliased != nullptr) aliased->push_back(fmt::format("{:.4g} Hz -> {:.4g} Hz", f, alias));
     pole = {pole.real(), 2 * M_PI * alias};

@@ -38,6 +38,10 @@ inline constexpr double kWholeSampleTolerance = kTimeUniformityTolerance;
 // with `seed`.
 Measurement ApplySensor(const Measurement& clean, const SensorOptions& options);
 
+// The frequency at which samples every `sample_interval_s` show an oscillation of `frequency_hz`:
+// its alias |f - k / tau| in [0, Nyquist].
+double AliasFrequencyHz(double frequency_hz, double sample_interval_s);
+
 // One line per mode of `modes` at or above the Nyquist frequency of `sample_interval_s`: the
 // record shows it at its alias |f - k / tau|, as a mode of its own that the data cannot tell
 // from a real one ("the model's mode 3 at 7.107 Hz lies above the Nyquist frequency 5 Hz: the
