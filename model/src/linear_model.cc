@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -109,12 +110,11 @@ std::vector<Mode> CalcModes(const LinearModel& linear) {
   const bool symmetric = linear.M.isApprox(linear.M.transpose(), 1e-12) &&
                          linear.C.isApprox(linear.C.transpose(), 1e-12) &&
                          linear.D.isApprox(linear.D.transpose(), 1e-12);
-  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> undamped(
-      symmetric ? linear.C : Eigen::MatrixXd::Identity(n, n),
-      symmetric ? linear.M : Eigen::MatrixXd::Identity(n, n));
-  if (symmetric && undamped.info() == Eigen::Success) {
-    const Eigen::MatrixXd& phi = undamped.eigenvectors();
-    const Eigen::VectorXd& omega2 = undamped.eigenvalues();
+  std::optional<Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>> undamped;
+  if (symmetric) undamped.emplace(linear.C, linear.M);  // not solved for the other form
+  if (undamped && undamped->info() == Eigen::Success) {
+    const Eigen::MatrixXd& phi = undamped->eigenvectors();
+    const Eigen::VectorXd& omega2 = undamped->eigenvalues();
     scale = omega2.cwiseAbs().cwiseSqrt();
     for (Eigen::Index i = 0; i < n; ++i) {
       if (!(scale[i] > 0)) scale[i] = 1;
