@@ -28,6 +28,15 @@ std::string MakeTempPath(const std::string& path) {
   return path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
 }
 
+// A complete temporary given its final name (atomic within its folder).
+void RenameInto(const std::string& temp_path, const std::string& path) {
+  std::error_code error;
+  fs::rename(temp_path, path, error);
+  if (error) {
+    throw std::runtime_error("cannot rename " + temp_path + " to " + path + ": " + error.message());
+  }
+}
+
 // Temporaries "<path>.tmp-<pid>-<n>" of this very output left by processes that no longer exist
 // (kill -9, a crash, a power cut): nobody else names files so, and nobody will commit them.
 void RemoveStaleTemporaries(const std::string& path) {
@@ -135,14 +144,7 @@ void AtomicFile::Commit() {
     return;
   }
   CrashPoint("file-commit");
-  interrupt_cleanup_->Commit([this] {
-    std::error_code error;
-    fs::rename(temp_path_, path_, error);
-    if (error) {
-      throw std::runtime_error("cannot rename " + temp_path_ + " to " + path_ + ": " +
-                               error.message());
-    }
-  });
+  interrupt_cleanup_->Commit([this] { RenameInto(temp_path_, path_); });
   committed_ = true;
   CrashPoint("file-committed");
   if (sync_) internal::SyncFolder(fs::path(path_).parent_path().string());
@@ -195,14 +197,8 @@ void OutputSet::Commit() {
   if (!pending_.empty()) CrashPoint("file-commit");
   HoldInterruptCleanup([this] {
     for (Pending& pending : pending_) {
-      pending.interrupt_cleanup->Commit([&pending] {
-        std::error_code error;
-        fs::rename(pending.temp_path, pending.path, error);
-        if (error) {
-          throw std::runtime_error("cannot rename " + pending.temp_path + " to " + pending.path +
-                                   ": " + error.message());
-        }
-      });
+      pending.interrupt_cleanup->Commit(
+          [&pending] { RenameInto(pending.temp_path, pending.path); });
       CrashPoint("file-committed");
     }
   });
