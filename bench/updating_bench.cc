@@ -188,6 +188,36 @@ void BM_ExcavatorSensitivityRun(benchmark::State& state) {
   state.counters["steps"] = static_cast<double>(result.statistics.steps);
 }
 
+// The excavator arm's test (all four channels) sampled at 100 Hz (the anchor) and at a logger's
+// 1, 5 and 10 kHz: a plain simulation (second argument 0) and a sensitivity run of its six joint
+// parameters (1). Its fastest mode (7.4 Hz) needs 120 output evaluations per period: above
+// 893 Hz only every 2nd, 5th, 11th sample is evaluated, the rest interpolated (sample_rows.h).
+// Before, the cost grew with the samples (each a Simbody realization, and for sensitivities
+// their difference quotients).
+void BM_ExcavatorHighRate(benchmark::State& state) {
+  const mbid::YamlReader root =
+      mbid::YamlReader::FromFile(std::string(MBID_SOURCE_DIR) + "/scenarios/excavator-arm.yaml");
+  const auto model = mbid::model::MakeModel(root.Child("model"));
+  const auto excitation = mbid::simulation::ReadExcitation(root.Child("excitation"), *model);
+  const auto simulation = mbid::simulation::ReadSimulationOptions(root.Child("simulation"));
+  mbid::simulation::SensorOptions sensors =
+      mbid::simulation::ReadSensorOptions(root.Child("sensors"), *model);
+  sensors.sample_rate_hz = static_cast<double>(state.range(0));
+  std::vector<std::string> names;
+  for (const mbid::model::Parameter& p : model->parameters()) names.push_back(p.name);
+  for (auto _ : state) {
+    if (state.range(1) == 0) {
+      benchmark::DoNotOptimize(
+          mbid::simulation::Simulate(*model, excitation, simulation, sensors).exact.values.data());
+    } else {
+      benchmark::DoNotOptimize(mbid::simulation::SimulateWithSensitivities(
+                                   *model, excitation, simulation, sensors, names, {}, {})
+                                   .exact.values.data());
+    }
+  }
+  state.counters["samples"] = simulation.duration_s * sensors.sample_rate_hz + 1;
+}
+
 // Route 1 (eq. 7, 100 starts, then eq. 8 on the record for each set) for the crane's exact
 // poles: what `mbid update` and `mbid run` spend between identification and the fit.
 void BM_Route1(benchmark::State& state) {
@@ -238,6 +268,9 @@ BENCHMARK(BM_AnchorSensitivityRun)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_AnchorSensitivityRun)->ArgsProduct({{1, 3}, {0}, {1}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Route1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ExcavatorHighRate)
+    ->ArgsProduct({{100, 1000, 5000, 10000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ExcavatorSensitivityRun)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // One fit takes seconds: one iteration each, wall time (the threads work in parallel).
 BENCHMARK(BM_UpdateSensitivitiesCentered)

@@ -9,14 +9,18 @@
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
 #include "mbid/simulation/cvodes_integrator.h"
+#include "sample_rows.h"
 #include "simulation_setup.h"
 
 namespace mbid::simulation {
 namespace {
 
 using internal::ChannelSource;
+using internal::ChooseOutputStride;
+using internal::FirstRowAtOrAfter;
 using internal::MakeForcedModel;
 using internal::ResolveChannels;
+using internal::SampleRows;
 
 // Relative step of the central differences of the initial coordinates: the static equilibrium
 // is solved to roundoff and is smooth in the parameters, so the O(h^2) error is ~1e-8.
@@ -166,7 +170,6 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   const std::vector<ChannelSource> sources = ResolveChannels(model, sensors.channels);
   const double tau = sensors.sample_interval_s();
   const internal::SampleGrid grid = internal::MakeSampleGrid(options.duration_s, sensors);
-  const int samples = grid.count;
 
   SensitivityResult result;
   result.parameters = model_parameters;
@@ -230,7 +233,8 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   // As in Simulate: the linearization as Newton Jacobian, for the state and the sensitivities.
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
   SimTK::State initial = simulated.MakeState(result.initial_q, zero);
-  integrator.set_jacobian(internal::CalcNewtonJacobian(simulated, initial));
+  const Eigen::MatrixXd newton_jacobian = internal::CalcNewtonJacobian(simulated, initial);
+  integrator.set_jacobian(newton_jacobian);
   integrator.Initialize(std::move(initial));
   const int ny = integrator.state().getNY();
   Eigen::MatrixXd initial_sensitivity = Eigen::MatrixXd::Zero(ny, count);
@@ -244,8 +248,6 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   exact.start_time_s = grid.first_time_s();
   exact.source = "simulation";
   const int channel_count = static_cast<int>(sources.size());
-  exact.values.resize(samples, channel_count);
-  result.output_sensitivities.assign(count, Eigen::MatrixXd(samples, channel_count));
 
   // Position outputs depend on q alone; rate outputs (velocities, accelerations) also on u and
   // the time, and accelerations on the parameters through the forces. A scratch state of the
@@ -261,48 +263,56 @@ SensitivityResult SimulateWithSensitivities(const model::MechanicalModel& model,
   const bool directional = 2 * count < by_jacobians;
   Eigen::MatrixXd dy_dtheta = Eigen::MatrixXd::Zero(simulated.output_count(), count);
   bool forcing_done = !(forcing_end_s > 0);
-  for (int row = 0; row < grid.skipped + grid.count; ++row) {
-    const double t = grid.Time(row);
-    if (!forcing_done && t >= forcing_end_s) {
-      // Restart the multistep history at the kink of the load, sensitivities carried over.
-      integrator.AdvanceTo(forcing_end_s, CvodesIntegrator::Realization::kNone);
-      result.statistics += integrator.statistics();
-      const Eigen::MatrixXd carried = integrator.sensitivities();
-      integrator.Initialize(SimTK::State(integrator.state()));
-      integrator.InitializeSensitivities(p, scale, carried, sensitivity);
-      forcing_done = true;
-    }
-    // Outputs realize what they need themselves (the crane's: nothing).
-    const SimTK::State& state =
-        t == 0 ? integrator.state() : integrator.AdvanceTo(t, CvodesIntegrator::Realization::kNone);
-    const int j = row - grid.skipped;
-    if (j < 0) continue;  // visited for the same steps as a record from t = 0
-    const Eigen::VectorXd y = simulated.CalcOutputs(state, highest_order);
-    Eigen::VectorXd q(n);
-    for (int i = 0; i < n; ++i) q[i] = state.getQ()[i];
-    const Eigen::MatrixXd& s = integrator.sensitivities();
-    scratch.setTime(state.getTime());
-    if (directional) {
-      CalcDirectionalOutputDerivatives(simulated, state, s, p, scale, model_parameters,
-                                       highest_order, &scratch, &dy_dtheta);
-    } else {
-      CalcOutputJacobians(simulated, state, p, scale, model_parameters, highest_order, &scratch,
-                          &dy_dY, &dy_dp);
-    }
-    for (int c = 0; c < channel_count; ++c) {
-      const ChannelSource& source = sources[c];
-      exact.values(j, c) = source.is_output ? y[source.index] : q[source.index];
-      for (int k = 0; k < count; ++k) {
-        double value = s(source.index, k);
-        if (source.is_output && directional) {
-          value = dy_dtheta(source.index, k);
-        } else if (source.is_output) {
-          value = dy_dY.row(source.index).dot(s.col(k).head(jacobian_columns));
-          if (k < model_count) value += dy_dp(source.index, k);
+  // A row holds the channels' values, then each sensitivity's channels.
+  const int width = channel_count * (1 + count);
+  const Eigen::MatrixXd rows = SampleRows(
+      grid, FirstRowAtOrAfter(grid, forcing_end_s),
+      ChooseOutputStride(tau, newton_jacobian, options.integrator.interpolate_outputs), width,
+      [&](double t, double* row) {
+        if (!forcing_done && t >= forcing_end_s) {
+          // Restart the multistep history at the kink of the load, sensitivities carried over.
+          integrator.AdvanceTo(forcing_end_s, CvodesIntegrator::Realization::kNone);
+          result.statistics += integrator.statistics();
+          const Eigen::MatrixXd carried = integrator.sensitivities();
+          integrator.Initialize(SimTK::State(integrator.state()));
+          integrator.InitializeSensitivities(p, scale, carried, sensitivity);
+          forcing_done = true;
         }
-        result.output_sensitivities[k](j, c) = value;
-      }
-    }
+        // Outputs realize what they need themselves (the crane's: nothing). Rows before the
+        // record's start are visited for the same steps as a record from t = 0.
+        const SimTK::State& state =
+            t == 0 ? integrator.state()
+                   : integrator.AdvanceTo(t, CvodesIntegrator::Realization::kNone);
+        if (row == nullptr) return;
+        const Eigen::VectorXd y = simulated.CalcOutputs(state, highest_order);
+        const Eigen::MatrixXd& s = integrator.sensitivities();
+        scratch.setTime(state.getTime());
+        if (directional) {
+          CalcDirectionalOutputDerivatives(simulated, state, s, p, scale, model_parameters,
+                                           highest_order, &scratch, &dy_dtheta);
+        } else {
+          CalcOutputJacobians(simulated, state, p, scale, model_parameters, highest_order, &scratch,
+                              &dy_dY, &dy_dp);
+        }
+        for (int c = 0; c < channel_count; ++c) {
+          const ChannelSource& source = sources[c];
+          row[c] = source.is_output ? y[source.index] : state.getQ()[source.index];
+          for (int k = 0; k < count; ++k) {
+            double value = s(source.index, k);
+            if (source.is_output && directional) {
+              value = dy_dtheta(source.index, k);
+            } else if (source.is_output) {
+              value = dy_dY.row(source.index).dot(s.col(k).head(jacobian_columns));
+              if (k < model_count) value += dy_dp(source.index, k);
+            }
+            row[channel_count * (1 + k) + c] = value;
+          }
+        }
+      });
+  exact.values = rows.leftCols(channel_count);
+  result.output_sensitivities.clear();
+  for (int k = 0; k < count; ++k) {
+    result.output_sensitivities.push_back(rows.middleCols(channel_count * (1 + k), channel_count));
   }
   result.statistics += integrator.statistics();
   return result;

@@ -10,6 +10,7 @@
 #include "mbid/common/error.h"
 #include "mbid/model/simbody.h"
 #include "mbid/simulation/cvodes_integrator.h"
+#include "sample_rows.h"
 #include "simulation_setup.h"
 
 namespace mbid::simulation {
@@ -115,30 +116,31 @@ SimulationResult Simulate(const model::MechanicalModel& model, const Excitation&
   exact.sample_interval_s = tau;
   exact.start_time_s = grid.first_time_s();
   exact.source = "simulation";
-  exact.values.resize(grid.count, static_cast<Eigen::Index>(sources.size()));
 
   bool forcing_done = !forced;
   IntegratorStatistics before_restart;
-  for (int i = 0; i < grid.skipped + grid.count; ++i) {
-    const double t = grid.Time(i);
-    if (!forcing_done && t >= result.forcing_end_s) {
-      // Stop exactly where the forcing switches off (a kink in the load) and restart the
-      // multistep history there.
-      SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s, kUnrealized);
-      before_restart = integrator.statistics();
-      integrator = internal::MakeIntegrator(simulated, options.integrator, jacobian);
-      integrator.Initialize(std::move(at_end));
-      forcing_done = true;
-    }
-    const SimTK::State& state = t == 0 ? integrator.state() : integrator.AdvanceTo(t, kUnrealized);
-    const int j = i - grid.skipped;
-    if (j < 0) continue;
-    const Eigen::VectorXd y = simulated.CalcOutputs(state, highest_order);
-    for (size_t c = 0; c < sources.size(); ++c) {
-      exact.values(j, static_cast<Eigen::Index>(c)) =
-          sources[c].is_output ? y[sources[c].index] : state.getQ()[sources[c].index];
-    }
-  }
+  const int first_free = forced ? internal::FirstRowAtOrAfter(grid, result.forcing_end_s) : 0;
+  const int stride =
+      internal::ChooseOutputStride(tau, jacobian, options.integrator.interpolate_outputs);
+  exact.values = internal::SampleRows(
+      grid, first_free, stride, static_cast<int>(sources.size()), [&](double t, double* row) {
+        if (!forcing_done && t >= result.forcing_end_s) {
+          // Stop exactly where the forcing switches off (a kink in the load) and restart the
+          // multistep history there.
+          SimTK::State at_end = integrator.AdvanceTo(result.forcing_end_s, kUnrealized);
+          before_restart = integrator.statistics();
+          integrator = internal::MakeIntegrator(simulated, options.integrator, jacobian);
+          integrator.Initialize(std::move(at_end));
+          forcing_done = true;
+        }
+        const SimTK::State& state =
+            t == 0 ? integrator.state() : integrator.AdvanceTo(t, kUnrealized);
+        if (row == nullptr) return;
+        const Eigen::VectorXd y = simulated.CalcOutputs(state, highest_order);
+        for (size_t c = 0; c < sources.size(); ++c) {
+          row[c] = sources[c].is_output ? y[sources[c].index] : state.getQ()[sources[c].index];
+        }
+      });
   // Counters restart with each integrator: the forced stretch, then the free decay.
   result.statistics = before_restart;
   result.statistics += integrator.statistics();
