@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <vector>
 
 #include "internal.h"
 #include "mbid/common/error.h"
@@ -88,6 +89,47 @@ std::string Suggestion(const std::string& word, const std::vector<std::string>& 
   return "did you mean '" + best + "'?";
 }
 
+// Where the innermost flow collection ('{' or '[') still open at `line`/`column` (0-based, the
+// parser's mark) was opened, with the bracket: yaml-cpp reports an unclosed one where it gave up,
+// often lines later. Quoted scalars and comments are skipped; empty if none is open.
+struct OpenFlow {
+  char bracket = 0;
+  int line = 0, column = 0;
+};
+OpenFlow FindOpenFlow(const std::string& text, int line, int column) {
+  std::vector<OpenFlow> open;
+  int l = 0, c = 0;
+  char quote = 0;
+  bool comment = false;
+  for (size_t i = 0; i < text.size() && (l < line || (l == line && c < column)); ++i) {
+    const char ch = text[i];
+    if (ch == '\n') {
+      ++l;
+      c = 0;
+      comment = false;
+      continue;
+    }
+    if (comment) {
+    } else if (quote != 0) {
+      if (ch == '\\' && quote == '"') {
+        ++i;
+        ++c;
+      } else if (ch == quote) {
+        quote = 0;  // '' inside single quotes closes and reopens: the same state
+      }
+    } else if (ch == '#' && (c == 0 || text[i - 1] == ' ' || text[i - 1] == '\t')) {
+      comment = true;
+    } else if (ch == '"' || ch == '\'') {
+      quote = ch;
+    } else if (ch == '{' || ch == '[') {
+      open.push_back({ch, l, c});
+    } else if ((ch == '}' || ch == ']') && !open.empty()) {
+      open.pop_back();
+    }
+    ++c;
+  }
+  return open.empty() ? OpenFlow{} : open.back();
+}
 }  // namespace
 
 std::string ClosestMatch(const std::string& word, const std::vector<std::string>& candidates) {
@@ -113,6 +155,17 @@ YamlReader YamlReader::FromString(const std::string& text, const std::string& so
   try {
     return YamlReader(YAML::Load(text), source, "");
   } catch (const YAML::ParserException& e) {
+    const OpenFlow flow = e.msg.find("flow") != std::string::npos
+                              ? FindOpenFlow(text, e.mark.line, e.mark.column)
+                              : OpenFlow{};
+    if (flow.bracket != 0 && flow.line < e.mark.line) {
+      throw InputError(
+          source, fmt::format("line {}", flow.line + 1),
+          fmt::format("the '{}' at column {} is not closed (YAML syntax error at line {}, column "
+                      "{}: {})",
+                      flow.bracket, flow.column + 1, e.mark.line + 1, e.mark.column + 1, e.msg),
+          fmt::format("a '{}' closing it", flow.bracket == '{' ? '}' : ']'));
+    }
     throw InputError(source, fmt::format("line {}", e.mark.line + 1),
                      fmt::format("YAML syntax error at column {}: {}", e.mark.column + 1, e.msg),
                      "valid YAML");

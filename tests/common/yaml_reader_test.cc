@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include "test_util.h"
 
 namespace mbid {
@@ -244,12 +246,32 @@ TEST(YamlReaderBadInputTest, Vector3GivenAsNumber) {
 TEST(YamlReaderBadInputTest, SyntaxErrorNamesTheLine) {
   TempDir dir;
   const std::string path = dir.File("broken.yaml");
-  // Line 3 opens a flow sequence that is never closed.
-  testing::WriteText(path, "name: x\nmodel:\n  com_m: [0, 0, 1\n  mass_kg: 3\n");
+  // A key without its colon on line 3.
+  testing::WriteText(path, "name: x\nmodel:\n  com_m [0, 0, 1]\n  mass_kg: 3\n");
   const InputError e = CatchInputError([&] { YamlReader::FromFile(path); });
   EXPECT_EQ(e.source(), path);
   EXPECT_THAT(e.field(), HasSubstr("line "));
   EXPECT_EQ(e.expected(), "valid YAML");
+}
+
+// yaml-cpp reports a flow collection that is never closed where it gives up, lines later (a
+// trial's file: "end of map flow not found" on the line of the next section): the error names
+// the bracket that opened it. Brackets in quotes and comments do not count.
+TEST(YamlReaderBadInputTest, AnUnclosedFlowIsNamedWhereItOpens) {
+  for (const auto& [text, line, column, bracket] :
+       {std::tuple{"name: x\nmodel: {type: truck_crane\nexcitation: {type: initial_deflection}\n",
+                   "line 2", 8, "'{'"},
+        std::tuple{"name: '[x'  # a [ in a comment\nmodel:\n  com_m: [0, 0, 1\n  mass_kg: 3\n"
+                   "other: 1\n",
+                   "line 3", 10, "'['"},
+        std::tuple{"a: {b: [1, 2], c: \"}\", d: {e: 1}\nf: 2\n", "line 1", 4, "'{'"}}) {
+    const InputError e = CatchInputError([&] { YamlReader::FromString(text, kSource); });
+    EXPECT_EQ(e.field(), line) << text;
+    EXPECT_THAT(e.problem(), HasSubstr("the " + std::string(bracket) + " at column " +
+                                       std::to_string(column) + " is not closed"))
+        << text;
+    EXPECT_THAT(e.expected(), HasSubstr("closing it")) << text;
+  }
 }
 
 TEST(YamlReaderBadInputTest, UnclosedFlowSequenceInStringNamesItsLine) {
