@@ -67,7 +67,7 @@ bool IsTimeColumnName(const std::string& name, std::string* unit) {
   return false;
 }
 
-std::string UnitFromNameSuffix(const std::string& name) {
+NameAndUnit SplitUnitSuffix(const std::string& name) {
   // Longest first: `_m_s2` before `_s2`-less `_m_s`, `_mm_s` before `_m_s`... each is matched as
   // a whole suffix after an underscore, so `_rad_s` is not taken for `_s`.
   static const std::pair<const char*, const char*> kSuffixes[] = {
@@ -82,9 +82,11 @@ std::string UnitFromNameSuffix(const std::string& name) {
       {"_mps", "m/s"}};
   const std::string lower = Lower(name);
   for (const auto& [suffix, unit] : kSuffixes) {
-    if (EndsWith(lower, suffix)) return unit;
+    if (EndsWith(lower, suffix)) {
+      return {name.substr(0, name.size() - std::string(suffix).size()), unit};
+    }
   }
-  return "";
+  return {name, ""};
 }
 
 }  // namespace mbid::records::internal

@@ -24,8 +24,9 @@ std::string StripUnitBrackets(const std::string& text);
 bool IsTimeColumnName(const std::string& name, std::string* unit);
 
 // The unit a channel's name states by the project's suffix convention (`boom_angle_rad`,
-// `theta_deg`, `acc_m_s2`, `rate_deg_s`), "" when it states none. Only suffixes that name one
-// unit unambiguously (no `_g`: gram or gravity; no `_nm`: newton metre or nanometre).
-std::string UnitFromNameSuffix(const std::string& name);
+// `theta_deg`, `acc_m_s2`, `rate_deg_s`) and the name without it: {"boom_angle", "rad"}; the
+// unit "" when it states none. Only suffixes that name one unit unambiguously (no `_g`: gram or
+// gravity; no `_nm`: newton metre or nanometre).
+NameAndUnit SplitUnitSuffix(const std::string& name);
 
 }  // namespace mbid::records::internal

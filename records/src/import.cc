@@ -58,6 +58,29 @@ std::string ColumnList(const RawTable& table) {
                      fmt::join(names, ", "));
 }
 
+// A name whose suffix states its unit (`boom_incl_rad`, with no unit beside it) names the channel
+// without it, as `boom_incl [rad]` does: the values are converted to SI, and the model's output
+// is `boom_incl` (a trial's file was refused: "channel 'boom_incl_rad' is neither an output nor a
+// coordinate"). A name the model has itself, or one that two columns would share, stays whole.
+void NameChannelsWithoutTheirUnitSuffix(const RawTable& table, const ImportOptions& options,
+                                        std::vector<Selected>* selected) {
+  if (table.si_by_contract) return;
+  std::vector<std::string> names;
+  for (const Selected& s : *selected) {
+    const internal::NameAndUnit split = internal::SplitUnitSuffix(s.column->name);
+    const bool rename = s.unit.empty() && !split.unit.empty() &&
+                        options.target_units.count(s.channel) == 0 &&
+                        ProblemWithChannelName(split.name).empty();
+    names.push_back(rename ? split.name : s.channel);
+  }
+  for (size_t c = 0; c < selected->size(); ++c) {
+    if (std::count(names.begin(), names.end(), names[c]) > 1) continue;
+    bool taken = false;
+    for (const Selected& other : *selected) taken = taken || other.channel == names[c];
+    if (!taken) (*selected)[c].channel = names[c];
+  }
+}
+
 std::vector<Selected> SelectColumns(const RawTable& table, const std::string& path,
                                     const ImportOptions& options, ImportReport* report) {
   std::vector<Selected> selected;
@@ -99,6 +122,7 @@ std::vector<Selected> SelectColumns(const RawTable& table, const std::string& pa
       }
       selected.push_back({column.name, &column, column.unit});
     }
+    NameChannelsWithoutTheirUnitSuffix(table, options, &selected);
     return selected;
   }
   for (const auto& [channel, spec] : options.channel_columns) {
@@ -241,9 +265,11 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
     const std::string field = DescribeColumn(*s.column);
     std::string unit = s.unit;
     if (unit.empty() && !table.si_by_contract) {
-      unit = internal::UnitFromNameSuffix(s.column->name);
+      unit = internal::SplitUnitSuffix(s.column->name).unit;
       if (!unit.empty()) {
-        r.conversions.push_back(fmt::format("{}: unit {} from the name's suffix", s.channel, unit));
+        r.conversions.push_back(
+            fmt::format("{}: unit {} from the name's suffix{}", s.column->name, unit,
+                        s.channel != s.column->name ? ", channel " + s.channel : std::string()));
       }
     }
     if (unit.empty()) {

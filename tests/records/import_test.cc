@@ -212,7 +212,8 @@ TEST(ImportTest, BlankSeparatedTablesAndHeadersInACommentAreRead) {
     const bool blanks = name[0] == 'a';
     EXPECT_EQ(report.dialect, blanks ? "blank-separated" : "','-separated, header in a comment");
     EXPECT_THAT(report.conversions,
-                ::testing::Contains("theta_deg: unit deg from the name's suffix"));
+                ::testing::Contains("theta_deg: unit deg from the name's suffix, channel theta"));
+    EXPECT_EQ(m.channels.back(), "theta");
     const double scale = blanks ? 1e-3 : 1.0;  // y [mm] -> m; acc_m_s2 is SI
     EXPECT_NEAR(m.values(37, 0), decay(0.37) * scale, 5e-7 * scale) << name;
     EXPECT_NEAR(m.values(37, 1), 2 * decay(0.37) * kDeg, 5e-7 * kDeg) << name;
@@ -222,6 +223,26 @@ TEST(ImportTest, BlankSeparatedTablesAndHeadersInACommentAreRead) {
   const InputError bare = CatchInputError([&] { ImportMeasurement(dir.File("bare.txt")); });
   EXPECT_EQ(bare.field(), "line 1");
   EXPECT_THAT(bare.problem(), HasSubstr("without a line of names"));
+}
+
+// A name that states its unit by the suffix names its channel without it, as `boom [rad]` does
+// (a trial's `boom_incl_rad` was refused by the scenario: no output of that name), unless the
+// model has an output of the whole name, or two columns would share the shorter one.
+TEST(ImportTest, AUnitSuffixIsNoPartOfTheChannelsName) {
+  TempDir dir;
+  WriteText(dir.File("log.csv"),
+            "time_s,boom_incl_rad,tip_mm,theta_deg,theta_rad,stick_m\n0,0.1,2,3,4,5\n"
+            "0.01,0.1,2,3,4,5\n0.02,0.1,2,3,4,5\n");
+  ImportOptions options;
+  options.target_units = {{"stick_m", "m"}};
+  ImportReport report;
+  const Measurement m = ImportMeasurement(dir.File("log.csv"), options, &report);
+  EXPECT_EQ(m.channels,
+            (std::vector<std::string>{"boom_incl", "tip", "theta_deg", "theta_rad", "stick_m"}));
+  EXPECT_NEAR(m.values(1, 1), 0.002, 1e-15);  // mm -> m
+  EXPECT_THAT(report.conversions,
+              ::testing::Contains("boom_incl_rad: unit rad from the name's suffix, channel "
+                                  "boom_incl"));
 }
 
 // Epoch stamps (a logger's PC clock): in ms, scaled to s before the first was subtracted, exact
