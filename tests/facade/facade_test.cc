@@ -528,6 +528,31 @@ TEST(FacadeTest, ARecordThatStartsAfterTheReleaseIsNoFailureOfTheModel) {
       << ::testing::PrintToString(run.reasons);
 }
 
+// The same pendulum logged from 1 s before its release, its sensor mounted reversed and the
+// reversal not stated: K = -1 over a record that rests before the release found in it is a model
+// (or a sensor's sign) the record refutes: failed. It was "inconclusive", asking whether the
+// logger had started after the release (a trial's jib inclinometer, K = -0.9997).
+TEST(FacadeTest, ARecordCutAtAReleaseFoundInItIsNoLateStart) {
+  const std::string pendulum = "name: pendulum\n" + Pendulum(2.0);
+  const mbid::Measurement full = mbid::Simulate(mbid::LoadScenarioFromText(pendulum, "p.yaml"));
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("mbid_reversed_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(folder);
+  {
+    std::ofstream out(folder / "reversed.csv");
+    out << "time,angle\n";
+    for (Eigen::Index j = 0; j < 100 + full.samples(); ++j) {  // 1 s held at the deflection
+      const double angle = j < 100 ? full.values(0, 0) : full.values(j - 100, 0);
+      out << fmt::format("{:.2f},{:.17g}\n", 0.01 * static_cast<double>(j), -angle);
+    }
+  }
+  const mbid::ValidationResult run = mbid::RunValidationCycle(mbid::LoadScenarioFromText(
+      pendulum + "record: {file: " + (folder / "reversed.csv").string() + "}\n", "rev.yaml"));
+  std::filesystem::remove_all(folder);
+  EXPECT_EQ(run.verdict, mbid::Verdict::kFailed) << ::testing::PrintToString(run.reasons);
+  EXPECT_EQ(::testing::PrintToString(run.reasons).find("starts in motion"), std::string::npos);
+}
+
 // A test deflecting the swing 0.05 rad and the pin not at all, both deflections fitted: the pin's
 // came out near 0 with a std of a few urad, "undetermined" for a relative std of its own value
 // (a trial's 2e-6 +- 5e-6 rad, "rank 8 of 8"). It is relative to the test's largest deflection of
