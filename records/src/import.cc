@@ -283,7 +283,8 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
       unit = target.empty() ? "rad" : target;
     }
     if (target.empty()) target = internal::SiUnitFor(unit, path, field);
-    const internal::UnitConversion conversion = internal::FindConversion(unit, target, path, field);
+    const internal::UnitConversion conversion =
+        internal::FindConversion(unit, target, path, field, s.column->name);
     internal::Convert(conversion, &values[c]);
     if (!conversion.identity()) {
       r.conversions.push_back(internal::DescribeConversion(s.channel, unit, target, conversion));

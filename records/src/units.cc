@@ -237,7 +237,8 @@ std::string SiUnitByUdunits(const std::string& unit, const std::string& source,
 }
 
 UnitConversion FindConversion(const std::string& from, const std::string& to,
-                              const std::string& source, const std::string& field) {
+                              const std::string& source, const std::string& field,
+                              const std::string& column) {
   if (from == to) return {};
   RefuseAmbiguous(from, source, field);
   const std::lock_guard<std::mutex> lock(UnitsMutex());
@@ -251,12 +252,26 @@ UnitConversion FindConversion(const std::string& from, const std::string& to,
   if (Dimension(a.get()) != Dimension(b.get()) || ut_are_convertible(a.get(), b.get()) == 0) {
     // udunits' g is the gram (and mg the milligram): say how an accelerometer's g is written.
     const bool gram = Dimension(a.get()) == "kg" && Dimension(b.get()) == "m.s-2";
+    // A sensor's raw signal (volts, a 4-20 mA loop): its calibration is a scaled unit of what it
+    // measures (a trial's 50 mV/deg inclinometer, mounted reversed, read as "-0.02 deg").
+    const bool electric = Dimension(a.get()) == "m2.kg.s-3.A-1" || Dimension(a.get()) == "A";
+    const std::string example = to == "rad"     ? "0.02 deg"
+                                : to == "m"     ? "0.5 mm"
+                                : to == "m/s^2" ? "0.01 gn"
+                                : to == "rad/s" ? "0.1 deg/s"
+                                                : "0.01 " + to;
     throw InputError(
         source, field,
         fmt::format("unit '{}' ({}) cannot be converted to {}", from, Dimension(a.get()), to),
         gram ? std::string("a unit of acceleration; standard gravity is written gn ('g' is the "
                            "gram), milli-g '0.001 gn'")
-             : fmt::format("a unit convertible to {} ({})", to, Dimension(b.get())));
+        : electric
+            ? fmt::format("a unit convertible to {}: the sensor's calibration, what one {} of its "
+                          "signal measures, as a scaled unit (`units: {{\"{}\": \"{}\"}}` in the "
+                          "record entry or --unit \"{}={}\"; a minus sign for a sensor mounted "
+                          "reversed)",
+                          to, from, column, example, column, example)
+            : fmt::format("a unit convertible to {} ({})", to, Dimension(b.get())));
   }
   cv_converter* converter = ut_get_converter(a.get(), b.get());
   if (converter == nullptr) {

@@ -33,9 +33,11 @@ std::string SiUnitByUdunits(const std::string& unit, const std::string& source,
 
 // The conversion from `from` to `to`. An unknown unit, or units of different dimensions
 // (counting the radian as one: deg to 1 is refused), is an InputError naming `source` and
-// `field`, the unit text and the unit expected.
+// `field`, the unit text and the unit expected; for a sensor's raw signal (V, mV, mA) the advice
+// shows its calibration as a scaled unit for `column`.
 UnitConversion FindConversion(const std::string& from, const std::string& to,
-                              const std::string& source, const std::string& field);
+                              const std::string& source, const std::string& field,
+                              const std::string& column = "COLUMN");
 
 // Applies `conversion` in place (NaN gap markers stay NaN).
 void Convert(const UnitConversion& conversion, std::vector<double>* values);

@@ -245,6 +245,23 @@ TEST(ImportTest, AUnitSuffixIsNoPartOfTheChannelsName) {
                                   "boom_incl"));
 }
 
+// An inclinometer of 50 mV per degree, logged in mV and mounted reversed: refused for a model's
+// angle with the way to give its calibration (a trial's message said only "cannot be converted
+// to rad"), and read through it, its sign turned, as that way says.
+TEST(ImportTest, ASensorsRawSignalIsReadThroughItsCalibration) {
+  TempDir dir;
+  WriteText(dir.File("jib.csv"), "time [s],Jib [mV]\n0,50\n0.01,-25\n0.02,100\n");
+  ImportOptions options;
+  options.target_units = {{"Jib", "rad"}};
+  const InputError raw = CatchInputError([&] { ImportMeasurement(dir.File("jib.csv"), options); });
+  EXPECT_THAT(raw.expected(), HasSubstr("`units: {\"Jib\": \"0.02 deg\"}`"));
+  EXPECT_THAT(raw.expected(), HasSubstr("a minus sign for a sensor mounted reversed"));
+  options.units = {{"Jib", "-0.02 deg"}};
+  const Measurement m = ImportMeasurement(dir.File("jib.csv"), options);
+  EXPECT_NEAR(m.values(0, 0), -1.0 * kDeg, 1e-15);  // 50 mV: 1 deg, reversed
+  EXPECT_NEAR(m.values(1, 0), 0.5 * kDeg, 1e-15);
+}
+
 // Epoch stamps (a logger's PC clock): in ms, scaled to s before the first was subtracted, exact
 // 1 ms steps read as 1.00017 ms and the file was refused as a dropped sample; in s printed to
 // 0.01 s, each stamp parses 2.4e-7 s off its printed value, with the same result. Both are read
