@@ -528,29 +528,59 @@ TEST(FacadeTest, ARecordThatStartsAfterTheReleaseIsNoFailureOfTheModel) {
       << ::testing::PrintToString(run.reasons);
 }
 
-// The same pendulum logged from 1 s before its release, its sensor mounted reversed and the
-// reversal not stated: K = -1 over a record that rests before the release found in it is a model
-// (or a sensor's sign) the record refutes: failed. It was "inconclusive", asking whether the
-// logger had started after the release (a trial's jib inclinometer, K = -0.9997).
-TEST(FacadeTest, ARecordCutAtAReleaseFoundInItIsNoLateStart) {
-  const std::string pendulum = "name: pendulum\n" + Pendulum(2.0);
+// `pendulum`'s record logged from 1 s before its release, held at its deflection, with the
+// channels `reversed` (one flag per channel) turned over; the cycle's result on it.
+mbid::ValidationResult RunReversed(const std::string& pendulum, const std::vector<bool>& reversed) {
   const mbid::Measurement full = mbid::Simulate(mbid::LoadScenarioFromText(pendulum, "p.yaml"));
   const std::filesystem::path folder =
       std::filesystem::temp_directory_path() / ("mbid_reversed_" + std::to_string(::getpid()));
   std::filesystem::create_directories(folder);
   {
     std::ofstream out(folder / "reversed.csv");
-    out << "time,angle\n";
-    for (Eigen::Index j = 0; j < 100 + full.samples(); ++j) {  // 1 s held at the deflection
-      const double angle = j < 100 ? full.values(0, 0) : full.values(j - 100, 0);
-      out << fmt::format("{:.2f},{:.17g}\n", 0.01 * static_cast<double>(j), -angle);
+    out << "time," << fmt::format("{}", fmt::join(full.channels, ",")) << "\n";
+    for (Eigen::Index j = 0; j < 100 + full.samples(); ++j) {
+      const Eigen::Index k = j < 100 ? 0 : j - 100;
+      out << fmt::format("{:.2f}", 0.01 * static_cast<double>(j));
+      for (Eigen::Index c = 0; c < full.values.cols(); ++c) {
+        out << fmt::format(
+            ",{:.17g}", reversed[static_cast<size_t>(c)] ? -full.values(k, c) : full.values(k, c));
+      }
+      out << "\n";
     }
   }
   const mbid::ValidationResult run = mbid::RunValidationCycle(mbid::LoadScenarioFromText(
       pendulum + "record: {file: " + (folder / "reversed.csv").string() + "}\n", "rev.yaml"));
   std::filesystem::remove_all(folder);
-  EXPECT_EQ(run.verdict, mbid::Verdict::kFailed) << ::testing::PrintToString(run.reasons);
-  EXPECT_EQ(::testing::PrintToString(run.reasons).find("starts in motion"), std::string::npos);
+  return run;
+}
+
+// The same pendulum logged from 1 s before its release, its sensor mounted reversed and the
+// reversal not stated: over a record that rests before the release found in it, a sensor's sign
+// (or a model) the record refutes fails. It was "inconclusive", asking whether the logger had
+// started after the release (a trial's jib inclinometer, K = -0.9997). With a second, correct
+// sensor that the fit follows, K = -1 on the reversed one, and the reason names the sign.
+TEST(FacadeTest, ARecordCutAtAReleaseFoundInItIsNoLateStart) {
+  std::string pendulum = "name: pendulum\n" + Pendulum(2.0);
+  const mbid::ValidationResult alone = RunReversed(pendulum, {true});
+  EXPECT_EQ(alone.verdict, mbid::Verdict::kFailed) << ::testing::PrintToString(alone.reasons);
+  EXPECT_EQ(::testing::PrintToString(alone.reasons).find("starts in motion"), std::string::npos);
+
+  const std::string one = "    angle: {type: coordinate, coordinate: swing}\n";
+  const std::string channels = "channels: [angle]";
+  const std::string noise = "noise_std_rad: 1.0e-5";
+  ASSERT_NE(pendulum.find(one), std::string::npos);
+  pendulum.replace(pendulum.find(one), one.size(),
+                   one + "    second: {type: coordinate, coordinate: swing}\n");
+  pendulum.replace(pendulum.find(channels), channels.size(), "channels: [angle, second]");
+  // The second sensor 100 times noisier: the fit follows the first, as a trial's fit followed
+  // its other three channels.
+  pendulum.replace(pendulum.find(noise), noise.size(),
+                   "noise_std_rad: {angle: 1.0e-5, second: 1.0e-3}");
+  const mbid::ValidationResult run = RunReversed(pendulum, {false, true});
+  const std::string reasons = ::testing::PrintToString(run.reasons);
+  EXPECT_EQ(run.verdict, mbid::Verdict::kFailed) << reasons;
+  EXPECT_NE(reasons.find("K(second) = -"), std::string::npos) << reasons;
+  EXPECT_NE(reasons.find("a sensor mounted reversed"), std::string::npos) << reasons;
 }
 
 // A test deflecting the swing 0.05 rad and the pin not at all, both deflections fitted: the pin's

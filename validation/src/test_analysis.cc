@@ -191,6 +191,15 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
       const std::string& channel = fit.channels[static_cast<size_t>(c)];
       std::string reason = fmt::format("K({}) = {:.4f} is below the threshold {}", channel, k(c),
                                        settings.min_correlation);
+      // The record as the re-simulation's mirror image (a trial's jib inclinometer, K = -0.9997,
+      // said nothing more): a sign, not a model.
+      if (k(c) < -0.9) {
+        reason += fmt::format(
+            " (the record is the re-simulation's mirror image: a sensor mounted reversed, whose "
+            "unit then takes a minus sign, `units: {{{}: \"-1 deg\"}}` for one in deg, or an "
+            "output whose direction is opposite to the sensor's)",
+            channel);
+      }
       // A re-simulation that leaves the record's noise and no more cannot correlate better:
       // the channel has too little signal to judge the model by, which does not refute it (a
       // machine's exact model failed on a channel of a part that does not move). Inconclusive.
