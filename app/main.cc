@@ -32,6 +32,7 @@ struct ImportFlags {
   std::optional<double> sample_rate_hz;
   std::string release;
   std::optional<double> release_time_s;
+  std::optional<double> end_time_s;
 };
 
 void AddImportFlags(CLI::App* command, ImportFlags* flags) {
@@ -62,6 +63,9 @@ void AddImportFlags(CLI::App* command, ImportFlags* flags) {
       ->add_option("--release-time-s", flags->release_time_s,
                    "The free decay starts at this time of the record, s")
       ->excludes(release);
+  command->add_option("--end-time-s", flags->end_time_s,
+                      "The test ends at this time of the record, s (what follows is another "
+                      "test's)");
 }
 
 mbid::validation::ImportOverrides MakeOverrides(const ImportFlags& flags) {
@@ -87,6 +91,11 @@ mbid::validation::ImportOverrides MakeOverrides(const ImportFlags& flags) {
                            std::to_string(*flags.release_time_s), "a finite time in s");
   }
   overrides.release_time_s = flags.release_time_s;
+  if (flags.end_time_s && !std::isfinite(*flags.end_time_s)) {
+    throw mbid::InputError("command line", "--end-time-s", std::to_string(*flags.end_time_s),
+                           "a finite time in s");
+  }
+  overrides.end_time_s = flags.end_time_s;
   return overrides;
 }
 

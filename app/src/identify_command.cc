@@ -10,6 +10,7 @@
 #include "mbid/identification/identify.h"
 #include "mbid/records/records.h"
 #include "mbid/validation/identification_settings.h"
+#include "mbid/validation/release_cut.h"
 #include "mbid/validation/scenario.h"
 
 namespace mbid::app {
@@ -22,8 +23,11 @@ int RunIdentifyCommand(const std::string& data_path,
                        const std::string& output_path, const CommonOptions& common) {
   given.Validate("command line");  // before reading a possibly large file
   records::ImportReport import;
-  const Measurement measurement = records::ImportMeasurement(
+  Measurement measurement = records::ImportMeasurement(
       data_path, MergeImportOptions({}, common.import, nullptr), &import);
+  if (common.import.end_time_s) {
+    validation::EndRecordAt(&measurement, *common.import.end_time_s, data_path, "--end-time-s");
+  }
   const std::string scenario = validation::ReadRecordScenario(data_path);
   // A record mbid simulated carries its test: after a forcing (an impulse, a burst) the free
   // decay starts where the forcing ends, as `mbid run` analyses it.

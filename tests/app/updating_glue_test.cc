@@ -7,6 +7,7 @@
 #include <tuple>
 #include <vector>
 
+#include "../common/test_util.h"
 #include "../updating/crane_fixture.h"
 #include "mbid/identification/release.h"
 #include "mbid/model/linear_model.h"
@@ -218,12 +219,49 @@ TEST(UpdatingGlueTest, AReleaseGivenBeforeTheRecordStartsItThatLongAfter) {
   Measurement record = updating::testing::SimulateExact(crane, 1.0, 50.0);
   record.source = "import";  // a logger's file, not mbid's own
   const Eigen::Index samples = record.values.rows();
-  const validation::AppliedRelease applied =
-      validation::CutRecordAtRelease(&record, "logger.csv", {false, -0.5}, crane.excitation);
+  const validation::AppliedRelease applied = validation::CutRecordAtRelease(
+      &record, "logger.csv", {false, -0.5, std::nullopt}, crane.excitation);
   EXPECT_EQ(applied.how, "given");
   EXPECT_EQ(applied.release_time_s, -0.5);
   EXPECT_EQ(record.values.rows(), samples);      // nothing cut
   EXPECT_NEAR(record.start_time_s, 0.5, 1e-12);  // 0 - (-0.5)
+}
+
+// A test's end given (`end_time_s`, --end-time-s): a second drop a few seconds after the first
+// came to rest is not found (its rest is too short), and the fit ran over both drops,
+// inconclusive in 272 s; ended before it, a trial's record passes in 8 s. The samples after the
+// end go, in the file's time; an end that leaves no test, or one before the given release, is
+// refused naming the key.
+TEST(UpdatingGlueTest, ATestEndsWhereTheUserSays) {
+  const updating::testing::Crane crane =
+      updating::testing::LoadCrane(updating::testing::kReferenceScenario);
+  Measurement record = updating::testing::SimulateExact(crane, 4.0, 50.0);  // 201 samples
+  record.source = "import";
+  Measurement ended = record;
+  const validation::AppliedRelease applied =
+      validation::CutRecordAtRelease(&ended, "logger.csv", {false, 0.0, 3.0}, crane.excitation);
+  EXPECT_EQ(ended.values.rows(), 151);  // 0 .. 3 s
+  EXPECT_TRUE(ended.values == record.values.topRows(151));
+  EXPECT_EQ(applied.end_time_s, 3.0);
+  EXPECT_EQ(applied.ToJson().at("end_time_s"), 3.0);
+  for (const validation::ReleaseChoice& bad :
+       {validation::ReleaseChoice{false, 1.0, 0.5}, validation::ReleaseChoice{false, {}, 0.1}}) {
+    Measurement copy = record;
+    const InputError e = testing::CatchInputError(
+        [&] { validation::CutRecordAtRelease(&copy, "logger.csv", bad, crane.excitation); });
+    EXPECT_EQ(e.source(), "logger.csv");
+    EXPECT_EQ(e.field(), "end_time_s");
+  }
+  // The record entry's key, and the command line's over it.
+  const YamlReader entry =
+      YamlReader::FromString("file: x.csv\nrelease_time_s: 2\nend_time_s: 1.5\n", "s.yaml");
+  const InputError before = testing::CatchInputError([&] { validation::ReadReleaseChoice(entry); });
+  EXPECT_EQ(before.field(), "end_time_s");
+  validation::ImportOverrides overrides;
+  overrides.end_time_s = 9.0;
+  EXPECT_EQ(validation::OverrideRelease({false, 2.0, 5.0}, overrides).end_time_s, 9.0);
+  overrides.release_none = true;
+  EXPECT_EQ(validation::OverrideRelease({false, 2.0, 5.0}, overrides).end_time_s, 9.0);
 }
 
 // A logger left running through a second test: held, the crane's 14 s decay (at rest from about

@@ -34,8 +34,8 @@ std::string OutputList(const model::MechanicalModel& model) {
 RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
                      const std::string& scenario_dir, const model::MechanicalModel& model) {
   if (!entry.IsMap()) entry.Fail("not a mapping", "{file: PATH} or {synthetic_modes: {...}}");
-  std::vector<std::string> keys = {"name",       "file",    "synthetic_modes",
-                                   "excitation", "release", "release_time_s"};
+  std::vector<std::string> keys = {"name",    "file",           "synthetic_modes", "excitation",
+                                   "release", "release_time_s", "end_time_s"};
   keys.insert(keys.end(), ImportKeys().begin(), ImportKeys().end());
   entry.ExpectMap(keys);
   RecordSource source;
@@ -73,7 +73,7 @@ RecordSource ReadOne(const YamlReader& entry, const std::string& default_name,
                    "an excitation only with file: PATH (synthetic modes have none)");
     }
     std::vector<std::string> file_keys = ImportKeys();
-    file_keys.insert(file_keys.end(), {"release", "release_time_s"});
+    file_keys.insert(file_keys.end(), {"release", "release_time_s", "end_time_s"});
     for (const std::string& key : file_keys) {
       if (entry.Has(key))
         entry.FailAt(key, "given for synthetic_modes", "import keys only with file: PATH");

@@ -20,13 +20,39 @@ ReleaseChoice ReadReleaseChoice(const YamlReader& entry) {
   }
   if (entry.Has("release")) choice.none = entry.Choice("release", {"none", "detect"}, "") == "none";
   if (entry.Has("release_time_s")) choice.time_s = entry.Double("release_time_s");
+  if (entry.Has("end_time_s")) {
+    choice.end_time_s = entry.Double("end_time_s");
+    if (choice.time_s && !(*choice.end_time_s > *choice.time_s)) {
+      entry.FailAt("end_time_s", fmt::format("{} s, not after release_time_s", *choice.end_time_s),
+                   "the test's end after its release, in the record's own time");
+    }
+  }
   return choice;
 }
 
 ReleaseChoice OverrideRelease(const ReleaseChoice& entry, const ImportOverrides& overrides) {
-  if (overrides.release_none) return {true, std::nullopt};
-  if (overrides.release_time_s) return {false, overrides.release_time_s};
-  return entry;
+  ReleaseChoice choice = entry;
+  if (overrides.release_none) choice = {true, std::nullopt, choice.end_time_s};
+  if (overrides.release_time_s) choice = {false, overrides.release_time_s, choice.end_time_s};
+  if (overrides.end_time_s) choice.end_time_s = overrides.end_time_s;
+  return choice;
+}
+
+void EndRecordAt(Measurement* record, double end_time_s, const std::string& origin,
+                 const std::string& field) {
+  const double tau = record->sample_interval_s;
+  // The samples at or before the end (a printed end within 1e-6 samples of one keeps it).
+  const double kept = std::floor((end_time_s - record->start_time_s) / tau + 1e-6) + 1;
+  if (!(kept >= 10)) {
+    throw InputError(origin, field,
+                     fmt::format("{:.6g} s leaves {} of the record's samples (it starts at {:.6g} "
+                                 "s)",
+                                 end_time_s, std::max(0.0, kept), record->start_time_s),
+                     "the test's end after at least 10 samples, in the record's own time");
+  }
+  if (kept < static_cast<double>(record->samples())) {
+    record->values = record->values.topRows(static_cast<Eigen::Index>(kept)).eval();
+  }
 }
 
 nlohmann::json AppliedRelease::ToJson() const {
@@ -35,6 +61,7 @@ nlohmann::json AppliedRelease::ToJson() const {
   if (forcing_end_s > 0) json["test_start_s"] = release_time_s;
   if (clipped_until_s) json["clipped_until_s"] = *clipped_until_s;
   if (next_excitation_s) json["next_excitation_s"] = *next_excitation_s;
+  if (end_time_s) json["end_time_s"] = *end_time_s;
   if (detected_time_s) json["detected_release_time_s"] = *detected_time_s;
   if (std_s) json["release_std_s"] = *std_s;
   return json;
@@ -118,7 +145,17 @@ AppliedRelease CutAtReleaseOnly(Measurement* record, const std::string& origin,
 AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin,
                                   const ReleaseChoice& choice,
                                   const simulation::Excitation& excitation) {
+  if (choice.end_time_s) {
+    if (choice.time_s && !(*choice.end_time_s > *choice.time_s)) {
+      throw InputError(origin, "end_time_s",
+                       fmt::format("{:.6g} s, not after the release at {:.6g} s",
+                                   *choice.end_time_s, *choice.time_s),
+                       "the test's end after its release, in the record's own time");
+    }
+    EndRecordAt(record, *choice.end_time_s, origin, "end_time_s");
+  }
   AppliedRelease applied = CutAtReleaseOnly(record, origin, choice, excitation);
+  applied.end_time_s = choice.end_time_s;
   if (applied.how != "none") {
     // A second test in the same record (a reload and a second drop, a knock) after this decay
     // came to rest is no part of it: the fit ends before it.

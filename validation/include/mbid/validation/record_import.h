@@ -29,6 +29,7 @@ struct ImportOverrides {
   // unset: the release is found in the record (identification/release.h).
   bool release_none = false;
   std::optional<double> release_time_s;
+  std::optional<double> end_time_s;  // --end-time-s T: the test ends there (the file's time)
 };
 
 // Parses "NAME=VALUE" items of `flag`; an item without '=' or with an empty side is an

@@ -20,7 +20,16 @@ namespace mbid::validation {
 struct ReleaseChoice {
   bool none = false;
   std::optional<double> time_s;  // in the record's own time
+  // `end_time_s: T` / --end-time-s T: the test ends there, in the record's own time; what
+  // follows is no part of it (a second drop a few seconds after the first came to rest).
+  std::optional<double> end_time_s;
 };
+
+// Drops the samples of `record` after `end_time_s` (its own time). An InputError naming
+// `origin` and `field` for an end at or before the first sample or one that leaves fewer than
+// 10 samples; an end after the last sample keeps the record whole.
+void EndRecordAt(Measurement* record, double end_time_s, const std::string& origin,
+                 const std::string& field);
 
 // The record entry's `release` and `release_time_s` keys (exclusive).
 ReleaseChoice ReadReleaseChoice(const YamlReader& entry);
@@ -46,6 +55,8 @@ struct AppliedRelease {
   // FindNextExcitation), in the record's own time: the record is cut before it; the line says so.
   std::optional<double> next_excitation_s;
   std::string next_excitation;
+  // Where the user ended the test (ReleaseChoice::end_time_s), in the record's own time.
+  std::optional<double> end_time_s;
   // A detected release the fit placed (Place): the instant as detected, and the placed one's
   // standard deviation; release_time_s is then the placed instant.
   std::optional<double> detected_time_s;
