@@ -32,7 +32,8 @@ std::vector<std::string> RecordFaults(const AnalysisRecord& record) {
                      (fault->kind == ChannelFault::Kind::kClipped
                           ? ", and no mode fitted to the flattened peaks is to be trusted"
                           : "; the modes do not describe it (blank such samples and fill them: "
-                            "fill_gaps: linear)"));
+                            "fill_gaps: linear; a second test starting there: end this one before "
+                            "it, end_time_s or --end-time-s)"));
   }
   return faults;
 }
@@ -95,7 +96,7 @@ void AssessReliability(const AnalysisRecord& record, const IdentificationOptions
         "the residual from {:.4g} to {:.4g} s has {:.3g} times the power it has elsewhere: "
         "something there is not in the modes (a missed, heavily damped mode, a transient, a "
         "start before the free decay, a second excitation before this decay came to rest: "
-        "end the analysis before it, --window-end-s)",
+        "end the analysis before it: --window-end-s, or end_time_s in a record entry)",
         from_s, from_s + windows.excess->samples * tau, windows.excess->power_ratio);
     (windows.excess->power_ratio >= 3 ? reasons : result->warnings).push_back(what);
   }
