@@ -169,21 +169,34 @@ void BM_AnchorSensitivityRun(benchmark::State& state) {
 // parameters) for a record of its two inclinometers (argument 0) and, the anchor, of the
 // inclinometers and the two accelerometers (1). The angles need positions alone: before session
 // 27 every output was computed, and the accelerometers' forward dynamics made both cost the same.
-void BM_ExcavatorSensitivityRun(benchmark::State& state) {
+// scenarios/excavator-arm.yaml's test, and its joint parameters' names.
+struct Excavator {
+  std::unique_ptr<mbid::model::MechanicalModel> model;
+  mbid::simulation::Excitation excitation;
+  mbid::simulation::SimulationOptions simulation;
+  mbid::simulation::SensorOptions sensors;
+  std::vector<std::string> names;
+};
+
+Excavator LoadExcavator() {
   const mbid::YamlReader root =
       mbid::YamlReader::FromFile(std::string(MBID_SOURCE_DIR) + "/scenarios/excavator-arm.yaml");
-  const auto model = mbid::model::MakeModel(root.Child("model"));
-  const auto excitation = mbid::simulation::ReadExcitation(root.Child("excitation"), *model);
-  const auto simulation = mbid::simulation::ReadSimulationOptions(root.Child("simulation"));
-  mbid::simulation::SensorOptions sensors =
-      mbid::simulation::ReadSensorOptions(root.Child("sensors"), *model);
-  if (state.range(0) == 0) sensors.channels = {"boom_incl", "stick_incl"};
-  std::vector<std::string> names;
-  for (const mbid::model::Parameter& p : model->parameters()) names.push_back(p.name);
+  Excavator e;
+  e.model = mbid::model::MakeModel(root.Child("model"));
+  e.excitation = mbid::simulation::ReadExcitation(root.Child("excitation"), *e.model);
+  e.simulation = mbid::simulation::ReadSimulationOptions(root.Child("simulation"));
+  e.sensors = mbid::simulation::ReadSensorOptions(root.Child("sensors"), *e.model);
+  for (const mbid::model::Parameter& p : e.model->parameters()) e.names.push_back(p.name);
+  return e;
+}
+
+void BM_ExcavatorSensitivityRun(benchmark::State& state) {
+  Excavator e = LoadExcavator();
+  if (state.range(0) == 0) e.sensors.channels = {"boom_incl", "stick_incl"};
   mbid::simulation::SensitivityResult result;
   for (auto _ : state) {
-    result = mbid::simulation::SimulateWithSensitivities(*model, excitation, simulation, sensors,
-                                                         names, {}, {});
+    result = mbid::simulation::SimulateWithSensitivities(*e.model, e.excitation, e.simulation,
+                                                         e.sensors, e.names, {}, {});
   }
   state.counters["steps"] = static_cast<double>(result.statistics.steps);
 }
@@ -195,27 +208,20 @@ void BM_ExcavatorSensitivityRun(benchmark::State& state) {
 // Before, the cost grew with the samples (each a Simbody realization, and for sensitivities
 // their difference quotients).
 void BM_ExcavatorHighRate(benchmark::State& state) {
-  const mbid::YamlReader root =
-      mbid::YamlReader::FromFile(std::string(MBID_SOURCE_DIR) + "/scenarios/excavator-arm.yaml");
-  const auto model = mbid::model::MakeModel(root.Child("model"));
-  const auto excitation = mbid::simulation::ReadExcitation(root.Child("excitation"), *model);
-  const auto simulation = mbid::simulation::ReadSimulationOptions(root.Child("simulation"));
-  mbid::simulation::SensorOptions sensors =
-      mbid::simulation::ReadSensorOptions(root.Child("sensors"), *model);
-  sensors.sample_rate_hz = static_cast<double>(state.range(0));
-  std::vector<std::string> names;
-  for (const mbid::model::Parameter& p : model->parameters()) names.push_back(p.name);
+  Excavator e = LoadExcavator();
+  e.sensors.sample_rate_hz = static_cast<double>(state.range(0));
   for (auto _ : state) {
     if (state.range(1) == 0) {
       benchmark::DoNotOptimize(
-          mbid::simulation::Simulate(*model, excitation, simulation, sensors).exact.values.data());
+          mbid::simulation::Simulate(*e.model, e.excitation, e.simulation, e.sensors)
+              .exact.values.data());
     } else {
       benchmark::DoNotOptimize(mbid::simulation::SimulateWithSensitivities(
-                                   *model, excitation, simulation, sensors, names, {}, {})
+                                   *e.model, e.excitation, e.simulation, e.sensors, e.names, {}, {})
                                    .exact.values.data());
     }
   }
-  state.counters["samples"] = simulation.duration_s * sensors.sample_rate_hz + 1;
+  state.counters["samples"] = e.simulation.duration_s * e.sensors.sample_rate_hz + 1;
 }
 
 // Route 1 (eq. 7, 100 starts, then eq. 8 on the record for each set) for the crane's exact
