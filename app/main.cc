@@ -86,15 +86,13 @@ mbid::validation::ImportOverrides MakeOverrides(const ImportFlags& flags) {
   }
   overrides.sample_rate_hz = flags.sample_rate_hz;
   overrides.release_none = flags.release == "none";
-  if (flags.release_time_s && !std::isfinite(*flags.release_time_s)) {
-    throw mbid::InputError("command line", "--release-time-s",
-                           std::to_string(*flags.release_time_s), "a finite time in s");
+  for (const auto& [flag, time] : {std::pair{"--release-time-s", flags.release_time_s},
+                                   std::pair{"--end-time-s", flags.end_time_s}}) {
+    if (time && !std::isfinite(*time)) {
+      throw mbid::InputError("command line", flag, std::to_string(*time), "a finite time in s");
+    }
   }
   overrides.release_time_s = flags.release_time_s;
-  if (flags.end_time_s && !std::isfinite(*flags.end_time_s)) {
-    throw mbid::InputError("command line", "--end-time-s", std::to_string(*flags.end_time_s),
-                           "a finite time in s");
-  }
   overrides.end_time_s = flags.end_time_s;
   return overrides;
 }
