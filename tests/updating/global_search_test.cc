@@ -363,6 +363,28 @@ TEST(CredibilityTest, ColouredResidualInflatesTheStandardDeviations) {
   EXPECT_NE(result.parameters[0].why_undetermined.find("coloured sensor noise"), std::string::npos);
 }
 
+// Two springs in series that one sensor sees as one: each undetermined, and the reason says the
+// records know their combination (a trial's read only "relative std 0.71 above 0.3").
+TEST(CredibilityTest, AParameterKnownOnlyInACombinationNamesItsPartner) {
+  UpdateResult result;
+  for (const char* name : {"c_qa", "c_qb", "d_qa"}) {
+    ParameterEstimate p;
+    p.name = name;
+    p.value = 1e4;
+    p.std = 7e3;
+    p.relative_std = 0.7;
+    result.parameters.push_back(p);
+  }
+  result.correlation = Eigen::Matrix3d{{1, -0.9999, 0.5}, {-0.9999, 1, -0.5}, {0.5, -0.5, 1}};
+  ASSERT_TRUE(MarkIfSpreadUndetermined(result.parameters[0], 1.0, 0.3, &result));
+  EXPECT_EQ(result.parameters[0].why_undetermined,
+            "relative std 0.7 above 0.3; correlated -1 with c_qb: the records determine a "
+            "combination of the two (as of two joints in series that the sensors see as one), not "
+            "each");
+  ASSERT_TRUE(MarkIfSpreadUndetermined(result.parameters[2], 1.0, 0.3, &result));
+  EXPECT_EQ(result.parameters[2].why_undetermined, "relative std 0.7 above 0.3");
+}
+
 TEST(CredibilityTest, WhiteExcessOverTheNoiseOnlyInflates) {
   // White noise 1.2 times the stated level (chi^2/dof 1.44): the level was stated too low, the
   // model still explains the record; the standard deviations are scaled by 1.2.

@@ -26,6 +26,26 @@ constexpr double kNoticeableExcess = 1.2;
 // 1.15-1.34, the true ones at 0.97-0.99.
 constexpr double kStructuredExcess = 1.05;
 
+// "; correlated -1 with c_qb: ..." for a parameter the records know only in a combination with
+// another (two springs in series that one sensor sees as one: their series stiffness is
+// determined, each spring not; a trial read only "relative std 0.71 above 0.3"), else "".
+std::string PartnerInACombination(const UpdateResult& result, const ParameterEstimate& p) {
+  const auto n = static_cast<Eigen::Index>(result.parameters.size());
+  if (result.correlation.rows() != n || result.correlation.cols() != n) return "";
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (result.parameters[static_cast<size_t>(i)].name != p.name) continue;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double rho = result.correlation(i, j);
+      if (j == i || !(std::abs(rho) > 0.99)) continue;
+      return fmt::format(
+          "; correlated {:.3g} with {}: the records determine a combination of the two (as of "
+          "two joints in series that the sensors see as one), not each",
+          rho, result.parameters[static_cast<size_t>(j)].name);
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& tests,
@@ -273,8 +293,8 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
                     "residual, and so does coloured sensor noise (an oversampled record through "
                     "an anti-alias filter); the records cannot tell which",
                     result.chi_square_per_dof, worst_time, worst_channel, result.std_inflation);
-    } else if (!MarkIfSpreadUndetermined(p, result.std_inflation,
-                                         options.undetermined_relative_std) &&
+    } else if (!MarkIfSpreadUndetermined(p, result.std_inflation, options.undetermined_relative_std,
+                                         &result) &&
                !p.determined && p.why_undetermined.empty()) {
       p.why_undetermined = "marked by the caller";
     }
@@ -283,14 +303,15 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
 }
 
 bool MarkIfSpreadUndetermined(ParameterEstimate& p, double std_inflation,
-                              double undetermined_relative_std) {
+                              double undetermined_relative_std, const UpdateResult* within) {
   const double relative = p.relative_std * std_inflation;
   if (!std::isfinite(relative)) {
     p.why_undetermined = "no standard deviation: the records leave it in a flat direction";
   } else if (relative > undetermined_relative_std) {
     p.why_undetermined =
-        fmt::format("relative std {:.3g}{} above {}", relative,
-                    std_inflation > 1 ? " (inflated)" : "", undetermined_relative_std);
+        fmt::format("relative std {:.3g}{} above {}{}", relative,
+                    std_inflation > 1.01 ? " (inflated)" : "", undetermined_relative_std,
+                    within != nullptr ? PartnerInACombination(*within, p) : std::string());
   } else if (p.lower < p.upper && (p.interval_lower <= p.lower || p.interval_upper >= p.upper)) {
     // The records allow values up to the bound (and maybe beyond): the bound, not the data,
     // decides where the estimate ends.

@@ -102,7 +102,8 @@ std::vector<std::string> WidenToTheIntervalEnds(const model::MechanicalModel& mo
         result.covariance.col(k) *= worst.ratio;
         SetInterval(p, result.std_inflation);
         // Once undetermined, a look farther out cannot make it determined again.
-        if (!MarkIfSpreadUndetermined(p, result.std_inflation, options.undetermined_relative_std)) {
+        if (!MarkIfSpreadUndetermined(p, result.std_inflation, options.undetermined_relative_std,
+                                      &result)) {
           next.push_back(k);
         }
       }

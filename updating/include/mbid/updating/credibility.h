@@ -19,9 +19,12 @@ void AssessCredibility(UpdateResult& result, const std::vector<TestRecord>& test
 // Marks `p` undetermined, with the reason, where its spread says the records do not determine
 // it: no finite std, a relative std (times `std_inflation`) above `undetermined_relative_std`,
 // or an interval (ParameterEstimate::interval_lower, already set) reaching a bound. Returns
-// whether it did; `p` is left as it is otherwise.
+// whether it did; `p` is left as it is otherwise. With the fit `within` (p among its
+// parameters), a relative std above the limit names the parameter `p` is correlated +-1 with:
+// the records then determine a combination of the two (springs in series), not each.
 bool MarkIfSpreadUndetermined(ParameterEstimate& p, double std_inflation,
-                              double undetermined_relative_std);
+                              double undetermined_relative_std,
+                              const UpdateResult* within = nullptr);
 
 // Shared parameters the records can tell only through the model's nonlinear coupling: in the
 // tuned model's linearization every mode the parameter moves is invisible in the records'
