@@ -2,6 +2,7 @@
 // two spellings, and bad descriptions stopped with one line and nothing written.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -64,6 +65,50 @@ TEST_F(MachineCliTest, CraneShorthandAndDescriptionGiveTheSameModes) {
     const double fa = ja["modes"][k]["frequency_hz"].get<double>();
     EXPECT_NEAR(jb["modes"][k]["frequency_hz"].get<double>(), fa, 1e-12 * fa) << k;
   }
+}
+
+// `mbid modes` says where a machine rests under its attached payload (an audit set initial
+// deflections about the loaded rest without knowing it): an arm horizontal at q = 0 on a
+// 5000 N m/rad spring preloaded against the arm's own weight (50 kg, 1 m out), a 100 kg payload
+// 2 m out. At the arm's angle theta the spring balances both weights' moments beyond the
+// preload: c |theta| = M g L cos(theta) + m g l (cos(theta) - 1), solved here by bisection.
+TEST_F(MachineCliTest, ModesSayWhereAPayloadRestsTheMachine) {
+  const std::string machine = R"(name: arm
+model:
+  type: multibody
+  gravity_mps2: 9.81
+  bodies:
+    arm: {parent: ground, joint: {type: revolute, coordinates: [q], axis: [0, -1, 0]},
+          mass_kg: 50.0, com_m: [1.0, 0, 0], inertia_kgm2: [1.0, 20.0, 20.0]}
+  springs:
+    q: {stiffness_Nm_per_rad: 5000.0, damping_Nms_per_rad: 20.0}
+  points:
+    tip: {body: arm, at_m: [2.0, 0, 0]}
+  outputs:
+    angle: {type: coordinate, coordinate: q}
+  payload_point: tip
+)";
+  const fs::path loaded = Write("loaded.yaml", machine + "  payload_mass_kg: 100.0\n");
+  const fs::path json = dir_ / "modes.json";
+  const CommandResult modes = Run("modes " + loaded.string() + " --json " + json.string());
+  ASSERT_EQ(modes.exit_code, 0) << modes.err;
+  double low = 0, high = 0.5;  // c theta - m g L cos(theta) changes sign in [0, 0.5]
+  for (int k = 0; k < 100; ++k) {
+    const double mid = 0.5 * (low + high);
+    const double balance =
+        5000 * mid - 100 * 9.81 * 2.0 * std::cos(mid) - 50 * 9.81 * 1.0 * (std::cos(mid) - 1);
+    (balance > 0 ? high : low) = mid;
+  }
+  const double rest = nlohmann::json::parse(ReadText(json))["rest"]["q"].get<double>();
+  EXPECT_NEAR(std::abs(rest), low, 1e-9 * low);  // 0.36 rad
+  EXPECT_NE(modes.out.find("under its attached payload (q = "), std::string::npos) << modes.out;
+  // Without a payload the machine rests at q = 0: nothing more is said.
+  const fs::path bare = Write("bare.yaml", machine);
+  const fs::path bare_json = dir_ / "bare.json";
+  const CommandResult unloaded = Run("modes " + bare.string() + " --json " + bare_json.string());
+  ASSERT_EQ(unloaded.exit_code, 0) << unloaded.err;
+  EXPECT_FALSE(nlohmann::json::parse(ReadText(bare_json)).contains("rest"));
+  EXPECT_NE(unloaded.out.find("linearized at rest\n"), std::string::npos) << unloaded.out;
 }
 
 // A free coordinate (the swing without its drive's spring: a vertical axis, so gravity does not
