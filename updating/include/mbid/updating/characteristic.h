@@ -160,8 +160,9 @@ struct CharacteristicResult {
   int converged_starts = 0;
   double best_residual = 0;  // smallest scaled residual any start reached
   std::string message;
-  // The poles came from an identification that judged itself reliable. Sets solved from doubtful
-  // poles (a noise peak taken for the mode) are starts, never every set the records allow.
+  // The poles came from modes that explain the record (a reliable identification, or one whose
+  // modes correlate with every channel at its min_correlation). Sets solved from doubtful poles
+  // (a noise peak taken for the mode) are starts, never every set the records allow.
   bool poles_reliable = true;
 
   std::string status_name() const;  // "solved" | "no_admissible_set" | "no_solution"
