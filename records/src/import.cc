@@ -62,9 +62,8 @@ std::string ColumnList(const RawTable& table) {
 // without it, as `boom_incl [rad]` does: the values are converted to SI, and the model's output
 // is `boom_incl` (a trial's file was refused: "channel 'boom_incl_rad' is neither an output nor a
 // coordinate"). A name the model has itself, or one that two columns would share, stays whole.
-void NameChannelsWithoutTheirUnitSuffix(const RawTable& table, const ImportOptions& options,
+void NameChannelsWithoutTheirUnitSuffix(const ImportOptions& options,
                                         std::vector<Selected>* selected) {
-  if (table.si_by_contract) return;
   std::vector<std::string> names;
   for (const Selected& s : *selected) {
     const internal::NameAndUnit split = internal::SplitUnitSuffix(s.column->name);
@@ -122,7 +121,7 @@ std::vector<Selected> SelectColumns(const RawTable& table, const std::string& pa
       }
       selected.push_back({column.name, &column, column.unit});
     }
-    NameChannelsWithoutTheirUnitSuffix(table, options, &selected);
+    NameChannelsWithoutTheirUnitSuffix(options, &selected);
     return selected;
   }
   for (const auto& [channel, spec] : options.channel_columns) {
@@ -264,7 +263,10 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
     std::string target = target_it == options.target_units.end() ? "" : target_it->second;
     const std::string field = DescribeColumn(*s.column);
     std::string unit = s.unit;
-    if (unit.empty() && !table.si_by_contract) {
+    // A name's suffix states a unit even in a file that looks like mbid's CSV (',' and a first
+    // column `time`, as pandas writes one): `jib_incl_deg` was read as radians, 57 times too
+    // large, without a word. mbid's own CSV states its units in a comment and never gets here.
+    if (unit.empty()) {
       unit = internal::SplitUnitSuffix(s.column->name).unit;
       if (!unit.empty()) {
         r.conversions.push_back(

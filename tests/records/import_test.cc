@@ -243,6 +243,14 @@ TEST(ImportTest, AUnitSuffixIsNoPartOfTheChannelsName) {
   EXPECT_THAT(report.conversions,
               ::testing::Contains("boom_incl_rad: unit rad from the name's suffix, channel "
                                   "boom_incl"));
+  // A ',' file whose first column is `time` (as pandas writes one) looks like mbid's CSV, whose
+  // units without a comment are SI: a name's suffix still states its unit (`jib_deg` was read
+  // as radians, 57 times too large, without a word).
+  WriteText(dir.File("pandas.csv"), "time,jib_deg,tip_mm\n0,1,2\n0.01,1,2\n0.02,1,2\n");
+  const Measurement pandas = ImportMeasurement(dir.File("pandas.csv"));
+  EXPECT_EQ(pandas.channels, (std::vector<std::string>{"jib", "tip"}));
+  EXPECT_NEAR(pandas.values(0, 0), kDeg, 1e-15);
+  EXPECT_NEAR(pandas.values(0, 1), 0.002, 1e-15);
 }
 
 // An inclinometer of 50 mV per degree, logged in mV and mounted reversed: refused for a model's
