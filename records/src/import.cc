@@ -165,10 +165,21 @@ std::string ApplyUserUnits(const RawTable& table, const std::string& path,
   for (Selected& s : *selected) {
     // By name, by channel, or by number among the data columns (as --channel takes it).
     const std::string number = std::to_string(s.column - table.columns.data() + 1);
+    std::string given_by;
     for (const std::string& key : {number, s.column->name, s.channel}) {
       const auto unit = options.units.find(key);
-      if (unit == options.units.end()) continue;
+      if (unit == options.units.end() || key == given_by) continue;
+      // Two units for one column (its name's and its channel's: a reversed sensor's "-1 deg"
+      // beside its calibration "0.02 deg" read the latter's millivolts as degrees) is no choice
+      // of ours to make.
+      if (!given_by.empty() && unit->second != s.unit) {
+        throw InputError(path, "units." + key,
+                         fmt::format("'{}' for {}, which units.{} gives '{}'", unit->second,
+                                     DescribeColumn(*s.column), given_by, s.unit),
+                         "one unit per column, under its name, number or channel");
+      }
       s.unit = unit->second;
+      given_by = key;
       used.insert(key);
     }
   }

@@ -252,6 +252,16 @@ TEST(UpdatingGlueTest, ATestEndsWhereTheUserSays) {
     EXPECT_EQ(e.source(), "logger.csv");
     EXPECT_EQ(e.field(), "end_time_s");
   }
+  // An end before the release the record shows (here the crane held 1 s, then released).
+  Measurement held = record;
+  held.values = Eigen::MatrixXd(50 + record.samples(), record.channel_count());
+  held.values.topRows(50) = record.values.row(0).replicate(50, 1);
+  held.values.bottomRows(record.samples()) = record.values;
+  const InputError early = testing::CatchInputError([&] {
+    validation::CutRecordAtRelease(&held, "logger.csv", {false, {}, 0.8}, crane.excitation);
+  });
+  EXPECT_EQ(early.field(), "end_time_s");
+  EXPECT_NE(early.problem().find("(found in the record)"), std::string::npos) << early.problem();
   // The record entry's key, and the command line's over it.
   const YamlReader entry =
       YamlReader::FromString("file: x.csv\nrelease_time_s: 2\nend_time_s: 1.5\n", "s.yaml");

@@ -268,6 +268,15 @@ TEST(ImportTest, ASensorsRawSignalIsReadThroughItsCalibration) {
   const Measurement m = ImportMeasurement(dir.File("jib.csv"), options);
   EXPECT_NEAR(m.values(0, 0), -1.0 * kDeg, 1e-15);  // 50 mV: 1 deg, reversed
   EXPECT_NEAR(m.values(1, 0), 0.5 * kDeg, 1e-15);
+  // The sign given under the channel's name beside the calibration under the column's: two
+  // units for one column are refused (the channel's "-1 deg" won, 50 times off, silently).
+  ImportOptions both;
+  both.channel_columns = {{"jib_incl", "Jib"}};
+  both.units = {{"Jib", "0.02 deg"}, {"jib_incl", "-1 deg"}};
+  both.target_units = {{"jib_incl", "rad"}};
+  const InputError twice = CatchInputError([&] { ImportMeasurement(dir.File("jib.csv"), both); });
+  EXPECT_EQ(twice.field(), "units.jib_incl");
+  EXPECT_THAT(twice.expected(), HasSubstr("one unit per column"));
 }
 
 // Epoch stamps (a logger's PC clock): in ms, scaled to s before the first was subtracted, exact

@@ -146,11 +146,20 @@ AppliedRelease CutRecordAtRelease(Measurement* record, const std::string& origin
                                   const ReleaseChoice& choice,
                                   const simulation::Excitation& excitation) {
   if (choice.end_time_s) {
-    if (choice.time_s && !(*choice.end_time_s > *choice.time_s)) {
-      throw InputError(origin, "end_time_s",
-                       fmt::format("{:.6g} s, not after the release at {:.6g} s",
-                                   *choice.end_time_s, *choice.time_s),
-                       "the test's end after its release, in the record's own time");
+    // The release given, or the one the whole record shows (an end before it leaves a record at
+    // rest, which was analysed as one: "too little signal", exit 0).
+    std::optional<double> release_s = choice.time_s;
+    if (!release_s && !choice.none && !record->made_by_mbid() &&
+        !(excitation.CalcForcingEndTime() > 0)) {
+      const identification::ReleaseDetection found = identification::DetectRelease(*record);
+      if (found.detected) release_s = found.release_time_s;
+    }
+    if (release_s && !(*choice.end_time_s > *release_s)) {
+      throw InputError(
+          origin, "end_time_s",
+          fmt::format("{:.6g} s, not after the release at {:.6g} s{}", *choice.end_time_s,
+                      *release_s, choice.time_s ? "" : " (found in the record)"),
+          "the test's end after its release, in the record's own time");
     }
     EndRecordAt(record, *choice.end_time_s, origin, "end_time_s");
   }

@@ -194,11 +194,11 @@ void AnalyseTest(RunTest& test, const model::MechanicalModel& model,
       // The record as the re-simulation's mirror image (a trial's jib inclinometer, K = -0.9997,
       // said nothing more): a sign, not a model.
       if (k(c) < -0.9) {
-        reason += fmt::format(
+        reason +=
             " (the record is the re-simulation's mirror image: a sensor mounted reversed, whose "
-            "unit then takes a minus sign, `units: {{{}: \"-1 deg\"}}` for one in deg, or an "
-            "output whose direction is opposite to the sensor's)",
-            channel);
+            "unit then takes a minus sign where the record entry or --unit gives it, \"-1 deg\" "
+            "for one logged in deg, \"-0.02 deg\" for a calibration of 0.02 deg per unit of its "
+            "signal; or an output whose direction is opposite to the sensor's)";
       }
       // A re-simulation that leaves the record's noise and no more cannot correlate better:
       // the channel has too little signal to judge the model by, which does not refute it (a
