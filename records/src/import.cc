@@ -287,10 +287,16 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
     }
     if (unit.empty()) {
       if (!table.si_by_contract) {
+        // The example in the unit the model reads the channel in, where there is a model.
+        const std::string example = target == "m/s^2"   ? "gn"
+                                    : target == "m"     ? "mm"
+                                    : target == "m/s"   ? "mm/s"
+                                    : target == "rad/s" ? "deg/s"
+                                                        : "deg";
         throw InputError(path, field, fmt::format("no unit for column '{}'", s.column->name),
-                         fmt::format("a unit: a header '{0} [deg]', a units row, `units: {{{0}: "
-                                     "deg}}` in the scenario's record entry or `--unit {0}=deg`",
-                                     s.column->name));
+                         fmt::format("a unit: a header '{0} [{1}]', a units row, `units: {{{0}: "
+                                     "{1}}}` in the scenario's record entry or `--unit {0}={1}`",
+                                     s.column->name, example));
       }
       // SI by contract: the unit the model expects, else radians (mbid's CSV of angles).
       unit = target.empty() ? "rad" : target;

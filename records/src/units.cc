@@ -101,7 +101,13 @@ ut_system* System() {
 
 UnitPtr Parse(const std::string& text) {
   if (text.empty()) return nullptr;
-  return UnitPtr(ut_parse(System(), ApplyAliases(text).c_str(), UT_UTF8));
+  // The typographic minus (U+2212, what a word processor makes of "-0.02 deg") is a minus.
+  std::string ascii = text;
+  for (size_t at = ascii.find("\xE2\x88\x92"); at != std::string::npos;
+       at = ascii.find("\xE2\x88\x92", at)) {
+    ascii.replace(at, 3, "-");
+  }
+  return UnitPtr(ut_parse(System(), ApplyAliases(ascii).c_str(), UT_UTF8));
 }
 
 // The unit's base-unit expression without its factor and offset: "0.001 m.s-2" -> "m.s-2",

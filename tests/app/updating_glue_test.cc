@@ -12,6 +12,7 @@
 #include "mbid/identification/release.h"
 #include "mbid/model/linear_model.h"
 #include "mbid/updating/settings.h"
+#include "mbid/validation/record_source.h"
 #include "mbid/validation/release_cut.h"
 #include "mbid/validation/release_profile.h"
 #include "mbid/validation/two_route_update.h"
@@ -272,6 +273,26 @@ TEST(UpdatingGlueTest, ATestEndsWhereTheUserSays) {
   EXPECT_EQ(validation::OverrideRelease({false, 2.0, 5.0}, overrides).end_time_s, 9.0);
   overrides.release_none = true;
   EXPECT_EQ(validation::OverrideRelease({false, 2.0, 5.0}, overrides).end_time_s, 9.0);
+}
+
+// Two columns that would both be `psi` without their unit suffix stay whole (records.md), and
+// the scenario's refusal says why and how to read the one meant (a re-audit's `tip_z_mm` beside
+// `tip_z_m` read only "neither an output nor a coordinate"); a name that is no unit suffix gets
+// no such hint.
+TEST(UpdatingGlueTest, TwoColumnsSharingAShortNameAreNamedWhenRefused) {
+  const updating::testing::Crane crane =
+      updating::testing::LoadCrane(updating::testing::kReferenceScenario);
+  Measurement record = updating::testing::SimulateExact(crane, 0.2, 50.0);
+  const std::string output = crane.model->output_names().front();
+  record.channels.front() = output + "_deg";
+  const InputError shared = testing::CatchInputError(
+      [&] { validation::RequireModelOutputs(record, "log.csv", *crane.model); });
+  EXPECT_NE(shared.problem().find("--channel " + output + "=" + output + "_deg"), std::string::npos)
+      << shared.problem();
+  record.channels.front() = output + "_left";
+  const InputError other = testing::CatchInputError(
+      [&] { validation::RequireModelOutputs(record, "log.csv", *crane.model); });
+  EXPECT_EQ(other.problem().find("unit suffix"), std::string::npos) << other.problem();
 }
 
 // A logger left running through a second test: held, the crane's 14 s decay (at rest from about

@@ -277,6 +277,23 @@ TEST(ImportTest, ASensorsRawSignalIsReadThroughItsCalibration) {
   const InputError twice = CatchInputError([&] { ImportMeasurement(dir.File("jib.csv"), both); });
   EXPECT_EQ(twice.field(), "units.jib_incl");
   EXPECT_THAT(twice.expected(), HasSubstr("one unit per column"));
+  // A word processor's minus (U+2212) is a minus.
+  ImportOptions typographic = options;
+  typographic.units = {{"Jib",
+                        "\xE2\x88\x92"
+                        "0.02 deg"}};
+  EXPECT_NEAR(ImportMeasurement(dir.File("jib.csv"), typographic).values(0, 0), -1.0 * kDeg, 1e-15);
+}
+
+// A column without a unit is refused with an example in the unit its channel is read in (an
+// accelerometer's was told '[deg]').
+TEST(ImportTest, AMissingUnitsExampleIsOfTheChannelsKind) {
+  TempDir dir;
+  WriteText(dir.File("na.csv"), "time [s];acc\n0;1\n0,01;2\n0,02;3\n");
+  ImportOptions options;
+  options.target_units = {{"acc", "m/s^2"}};
+  const InputError e = CatchInputError([&] { ImportMeasurement(dir.File("na.csv"), options); });
+  EXPECT_THAT(e.expected(), HasSubstr("a header 'acc [gn]'"));
 }
 
 // Epoch stamps (a logger's PC clock): in ms, scaled to s before the first was subtracted, exact

@@ -158,9 +158,27 @@ void RequireModelOutputs(const Measurement& record, const std::string& origin,
     // measured joint angles or slides: updating compares them like outputs.
     if (!IsOutput(model, channel) &&
         std::find(coordinates.begin(), coordinates.end(), channel) == coordinates.end()) {
+      // `tip_z_mm` beside `tip_z_m`: each would be `tip_z` without its unit suffix, and the
+      // import keeps both whole rather than choose (records.md).
+      static const std::set<std::string> kUnitSuffixes = {
+          "rad",  "mrad",   "deg",    "m",    "mm",    "um",  "rad_s", "deg_s", "m_s",
+          "mm_s", "rad_s2", "deg_s2", "m_s2", "mm_s2", "rpm", "mps",   "mps2"};
+      std::string shared;
+      for (const std::string& output : model.output_names()) {
+        if (channel.rfind(output + "_", 0) == 0 &&
+            kUnitSuffixes.count(channel.substr(output.size() + 1)) > 0) {
+          shared = output;
+        }
+      }
       throw InputError(
           origin, "channels",
-          fmt::format("channel '{}' is neither an output nor a coordinate of the model", channel),
+          fmt::format("channel '{}' is neither an output nor a coordinate of the model{}", channel,
+                      shared.empty()
+                          ? ""
+                          : fmt::format(" (nor is it named '{}' without its unit suffix: another "
+                                        "column would share that name; read the one you mean "
+                                        "under it, --channel {}={})",
+                                        shared, shared, channel)),
           fmt::format("{}, or coordinates ({})", OutputList(model), fmt::join(coordinates, ", ")));
     }
   }
