@@ -249,6 +249,10 @@ std::vector<std::vector<double>> TakeValues(const RawTable& table, const std::st
 
 }  // namespace
 
+std::string NameWithoutUnitSuffix(const std::string& name) {
+  return internal::SplitUnitSuffix(name).name;
+}
+
 Measurement ImportMeasurement(const std::string& path, const ImportOptions& options,
                               ImportReport* report) {
   ImportReport local;
@@ -288,11 +292,7 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
     if (unit.empty()) {
       if (!table.si_by_contract) {
         // The example in the unit the model reads the channel in, where there is a model.
-        const std::string example = target == "m/s^2"   ? "gn"
-                                    : target == "m"     ? "mm"
-                                    : target == "m/s"   ? "mm/s"
-                                    : target == "rad/s" ? "deg/s"
-                                                        : "deg";
+        const std::string example = internal::EverydayUnit(target);
         throw InputError(path, field, fmt::format("no unit for column '{}'", s.column->name),
                          fmt::format("a unit: a header '{0} [{1}]', a units row, `units: {{{0}: "
                                      "{1}}}` in the scenario's record entry or `--unit {0}={1}`",

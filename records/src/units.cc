@@ -242,6 +242,15 @@ std::string SiUnitByUdunits(const std::string& unit, const std::string& source,
   return si == SiUnits().end() ? dimension : si->second;
 }
 
+std::string EverydayUnit(const std::string& si_unit) {
+  if (si_unit.empty() || si_unit == "rad") return "deg";
+  if (si_unit == "m") return "mm";
+  if (si_unit == "m/s^2") return "gn";
+  if (si_unit == "rad/s") return "deg/s";
+  if (si_unit == "m/s") return "mm/s";
+  return si_unit;
+}
+
 UnitConversion FindConversion(const std::string& from, const std::string& to,
                               const std::string& source, const std::string& field,
                               const std::string& column) {
@@ -261,11 +270,7 @@ UnitConversion FindConversion(const std::string& from, const std::string& to,
     // A sensor's raw signal (volts, a 4-20 mA loop): its calibration is a scaled unit of what it
     // measures (a trial's 50 mV/deg inclinometer, mounted reversed, read as "-0.02 deg").
     const bool electric = Dimension(a.get()) == "m2.kg.s-3.A-1" || Dimension(a.get()) == "A";
-    const std::string example = to == "rad"     ? "0.02 deg"
-                                : to == "m"     ? "0.5 mm"
-                                : to == "m/s^2" ? "0.01 gn"
-                                : to == "rad/s" ? "0.1 deg/s"
-                                                : "0.01 " + to;
+    const std::string example = "0.02 " + EverydayUnit(to);
     throw InputError(
         source, field,
         fmt::format("unit '{}' ({}) cannot be converted to {}", from, Dimension(a.get()), to),

@@ -39,6 +39,11 @@ UnitConversion FindConversion(const std::string& from, const std::string& to,
                               const std::string& source, const std::string& field,
                               const std::string& column = "COLUMN");
 
+// The unit a sensor of `si_unit`'s kind is commonly logged in, for examples in messages: "deg"
+// for rad, "mm" for m, "gn" for m/s^2, "deg/s" for rad/s, "mm/s" for m/s, else `si_unit` ("deg"
+// for none).
+std::string EverydayUnit(const std::string& si_unit);
+
 // Applies `conversion` in place (NaN gap markers stay NaN).
 void Convert(const UnitConversion& conversion, std::vector<double>* values);
 

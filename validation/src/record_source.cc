@@ -160,16 +160,9 @@ void RequireModelOutputs(const Measurement& record, const std::string& origin,
         std::find(coordinates.begin(), coordinates.end(), channel) == coordinates.end()) {
       // `tip_z_mm` beside `tip_z_m`: each would be `tip_z` without its unit suffix, and the
       // import keeps both whole rather than choose (records.md).
-      static const std::set<std::string> kUnitSuffixes = {
-          "rad",  "mrad",   "deg",    "m",    "mm",    "um",  "rad_s", "deg_s", "m_s",
-          "mm_s", "rad_s2", "deg_s2", "m_s2", "mm_s2", "rpm", "mps",   "mps2"};
-      std::string shared;
-      for (const std::string& output : model.output_names()) {
-        if (channel.rfind(output + "_", 0) == 0 &&
-            kUnitSuffixes.count(channel.substr(output.size() + 1)) > 0) {
-          shared = output;
-        }
-      }
+      const std::string shortened = records::NameWithoutUnitSuffix(channel);
+      const std::string shared =
+          shortened != channel && IsOutput(model, shortened) ? shortened : "";
       throw InputError(
           origin, "channels",
           fmt::format("channel '{}' is neither an output nor a coordinate of the model{}", channel,

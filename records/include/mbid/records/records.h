@@ -64,6 +64,10 @@ Measurement ImportMeasurement(const std::string& path, const ImportOptions& opti
 // ImportReport::conversions.
 std::vector<std::string> ConvertToSi(Measurement* measurement, const std::string& source);
 
+// `name` without the unit suffix ImportMeasurement reads a unit from (`tip_z_mm` -> `tip_z`;
+// records.md), or `name` itself where it has none.
+std::string NameWithoutUnitSuffix(const std::string& name);
+
 // The file name extensions ImportMeasurement reads (".csv", ".h5", ...), and whether `path`
 // has one of them (case ignored).
 std::vector<std::string> SupportedExtensions();
