@@ -36,7 +36,7 @@ std::string PartnerInACombination(const UpdateResult& result, const ParameterEst
     if (result.parameters[static_cast<size_t>(i)].name != p.name) continue;
     for (Eigen::Index j = 0; j < n; ++j) {
       const double rho = result.correlation(i, j);
-      if (j == i || !(std::abs(rho) > 0.99)) continue;
+      if (j == i || !(std::abs(rho) > kCombinationCorrelation)) continue;
       return fmt::format(
           "; correlated {:.3g} with {}: the records determine a combination of the two (as of "
           "two joints in series that the sensors see as one), not each",

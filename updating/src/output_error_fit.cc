@@ -327,7 +327,7 @@ void AddEstimates(const FitProblem& fit, const std::vector<TestRecord>& tests,
   }
   for (int i = 0; i < count; ++i) {
     for (int j = i + 1; j < count; ++j) {
-      if (std::abs(result->correlation(i, j)) > 0.99) {
+      if (std::abs(result->correlation(i, j)) > kCombinationCorrelation) {
         result->warnings.push_back(fit.unknowns[static_cast<size_t>(i)].name + " and " +
                                    fit.unknowns[static_cast<size_t>(j)].name + " are correlated " +
                                    FormatValue(result->correlation(i, j)));

@@ -21,6 +21,10 @@ inline double CalcPearson(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 // Ljung-Box Q of `residual` over `lags` lags (at most a quarter of its length), its p-value
 // (chi-square), and the integrated autocorrelation time 1 + 2 sum rho_k (at least 1): how many
 // samples one independent residual spans.
+// Two estimates correlated beyond this are known only in a combination (the warning "c_qa and
+// c_qb are correlated -1", and the partner a parameter undetermined for its spread names).
+inline constexpr double kCombinationCorrelation = 0.99;
+
 inline void Whiteness(const Eigen::VectorXd& residual, int lags, double* q, double* p,
                       double* time) {
   const Eigen::VectorXd r = residual.array() - residual.mean();
