@@ -249,8 +249,6 @@ Campaign LoadCampaign(const std::string& path) {
                        "each key either in set or in the sweep");
     }
   }
-  if (campaign.study) campaign.study->ReadSection(root, campaign);
-
   const int count = static_cast<int>(inputs.size());
   campaign.cases.reserve(inputs.size());
   for (int i = 0; i < count; ++i) {
@@ -274,6 +272,8 @@ Campaign LoadCampaign(const std::string& path) {
     if (first_inputs.size() == campaign.swept_keys.size()) break;
   }
   ProbeKeys(campaign, first_inputs);
+  // After the probe: the base scenario with `set:` loads, and a study may read it.
+  if (campaign.study) campaign.study->ReadSection(root, campaign);
   return campaign;
 }
 

@@ -45,6 +45,7 @@ void AddExactModes(const std::vector<model::Mode>& modes, CaseOutcome& outcome) 
     outcome.row[prefix + "decay_rate_per_s"] = Number(modes[k].decay_rate_per_s());
     outcome.row[prefix + "damping_ratio"] = Number(modes[k].damping_ratio());
     outcome.exact_damping_ratios.push_back(modes[k].damping_ratio());
+    outcome.exact_frequencies_hz.push_back(modes[k].frequency_hz());
     if (!(modes[k].damping_ratio() >= smallest)) smallest = modes[k].damping_ratio();
   }
   outcome.row["exact.min_damping_ratio"] = Number(smallest);
@@ -211,6 +212,11 @@ nlohmann::ordered_json ReadCaseRow(const std::string& path, H5Reader::Probe prob
 
 double RowNumber(const nlohmann::ordered_json& row, const std::string& column) {
   const auto it = row.find(column);
+  if (it != row.end() && it->is_string()) {  // an infinity (internal::Number)
+    const std::string& text = it->get_ref<const std::string&>();
+    if (text == "inf") return std::numeric_limits<double>::infinity();
+    if (text == "-inf") return -std::numeric_limits<double>::infinity();
+  }
   if (it == row.end() || !it->is_number()) return kNaN;
   return it->get<double>();
 }

@@ -29,6 +29,15 @@ std::string XRange(const DamperSizingSpec& spec, const JointSizing& joint) {
                           : fmt::format("[{}:{}]", d_low, d_high);
 }
 
+// The absolute bands, channel by channel in its unit's key.
+std::string SettlingBands(const DamperSizingSpec& spec) {
+  std::vector<std::string> bands;
+  for (const auto& [channel, band] : spec.settling_bands) {
+    bands.push_back(fmt::format("{} {} {}", channel, band, spec.settling_band_units.at(channel)));
+  }
+  return fmt::format("{}", fmt::join(bands, ", "));
+}
+
 // A vertical line at the smallest damping that meets `target`, if one does.
 void AddSmallestMarker(const JointSizing& joint, const std::string& target, double y_low,
                        double y_high, std::vector<PlotSeries>* series) {
@@ -127,7 +136,12 @@ std::string DamperSizingReport(const DamperSizingSpec& spec, const DamperSizingR
   md << "## Damper sizing\n\n";
   md << "Each joint's damping `d_k` alone is swept over its range (the other joints keep the "
         "base scenario's values); the smallest admissible `d_k` is refined by bisection between "
-        "the last sweep point that fails a target and the first that meets it.\n\nTargets: ";
+        "the last sweep point that fails a target and the first that meets it, and so is the "
+        "largest "
+        "of the window of dampings that meet it from there; where no sweep point meets a target, "
+        "the model is searched between the sweep's best points. A settling time counts only "
+        "when the outputs stay in their band for a period of the slowest mode before the record "
+        "ends.\n\nTargets: ";
   std::vector<std::string> targets;
   if (spec.min_damping_ratio > 0) {
     targets.push_back(fmt::format("smallest modal damping ratio >= {}", spec.min_damping_ratio));
@@ -135,17 +149,20 @@ std::string DamperSizingReport(const DamperSizingSpec& spec, const DamperSizingR
   if (spec.has_settling_target()) {
     targets.push_back(fmt::format(
         "settling time <= {} s (band: {})", spec.max_settling_time_s,
-        spec.settling_band_rad > 0
-            ? fmt::format("{} rad", spec.settling_band_rad)
-            : fmt::format("{} of each output's peak deviation", spec.settling_band_fraction)));
+        spec.settling_bands.empty()
+            ? fmt::format("{} of each output's peak deviation", spec.settling_band_fraction)
+            : SettlingBands(spec)));
   }
   md << fmt::format("{}.\n\n", fmt::join(targets, "; "));
-  md << "| joint | target | smallest d, N*m*s/rad | how |\n|---|---|---|---|\n";
+  md << "| joint | target | smallest d, N*m*s/rad | largest d, N*m*s/rad | how |\n"
+        "|---|---|---|---|---|\n";
   for (const JointSizing& joint : result.joints) {
     for (size_t t = 0; t < joint.targets.size(); ++t) {
       const double d = joint.smallest_Nms_per_rad[t];
-      md << fmt::format("| {} | {} | {} | {} |\n", joint.joint, joint.targets[t],
-                        std::isfinite(d) ? fmt::format("{:.6g}", d) : "not met", joint.notes[t]);
+      const double up_to = joint.largest_Nms_per_rad[t];
+      md << fmt::format("| {} | {} | {} | {} | {} |\n", joint.joint, joint.targets[t],
+                        std::isfinite(d) ? fmt::format("{:.6g}", d) : "not met",
+                        std::isfinite(up_to) ? fmt::format("{:.6g}", up_to) : "", joint.notes[t]);
     }
   }
   md << "\n";

@@ -15,8 +15,10 @@
 
 namespace mbid::campaign::internal {
 
-// A row value: JSON has no NaN or infinity, they become null (an empty cell in summary.csv).
+// A row value: JSON has no NaN or infinity; NaN (missing) becomes null, an empty cell in
+// summary.csv, and an infinity (a settling time never reached) the text "inf" or "-inf".
 inline nlohmann::ordered_json Number(double value) {
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
   if (!std::isfinite(value)) return nullptr;
   return value;
 }

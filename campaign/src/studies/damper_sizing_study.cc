@@ -37,9 +37,20 @@ class DamperSizingStudy : public CampaignStudy {
 
   void AddCaseMetrics(const simulation::SimulationResult& test,
                       CaseOutcome* outcome) const override {
-    outcome->settling_time_s = CalcSettlingTime(
-        test.exact, test.forcing_end_s, spec_.settling_band_fraction, spec_.settling_band_rad);
+    outcome->settling_time_s =
+        CalcSettlingTime(test.exact, test.forcing_end_s, spec_.settling_band_fraction,
+                         spec_.settling_bands, SlowestPeriod(outcome->exact_frequencies_hz));
     outcome->row["settling_time_s"] = internal::Number(outcome->settling_time_s);
+  }
+
+  // The bands are in the channels' units: read against the cases' model.
+  void ReadSection(const YamlReader& root, const Campaign& campaign) override {
+    CampaignCase probe;
+    probe.id = "probe";
+    ReadSettlingBands(root.Child("damper_sizing"),
+                      validation::LoadScenarioFromText(campaign.CaseScenarioText(probe),
+                                                       campaign.CaseSource(probe)),
+                      &spec_);
   }
 
   // The curves are its own figures.

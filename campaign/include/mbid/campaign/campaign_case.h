@@ -33,6 +33,7 @@ struct CaseOutcome {
 
   // Study metrics (NaN when not computed).
   std::vector<double> exact_damping_ratios;  // per exact mode, ascending frequency
+  std::vector<double> exact_frequencies_hz;  // damped, the same modes (0 for a real pole)
   double settling_time_s = std::numeric_limits<double>::quiet_NaN();
 
   bool ok() const { return status == "ok"; }
@@ -78,7 +79,7 @@ void WriteCaseFile(const CaseOutcome& outcome, const std::string& path);
 nlohmann::ordered_json ReadCaseRow(const std::string& path,
                                    H5Reader::Probe probe = H5Reader::Probe::kEverything);
 
-// A summary row value: a number, or NaN for null or absent.
+// A summary row value: a number, +-inf for "inf"/"-inf", or NaN for null or absent.
 double RowNumber(const nlohmann::ordered_json& row, const std::string& column);
 
 }  // namespace mbid::campaign

@@ -11,6 +11,7 @@
 #include "mbid/common/hdf5_io.h"
 #include "mbid/common/measurement.h"
 #include "mbid/common/yaml_reader.h"
+#include "mbid/validation/scenario.h"
 
 namespace mbid::campaign {
 
@@ -30,10 +31,12 @@ struct DamperSizingSpec {
   bool log_spacing = true;
   double min_damping_ratio = 0;    // target; 0 = none
   double max_settling_time_s = 0;  // target; 0 = none
-  // Settling band: a fraction of each channel's peak deviation after the excitation, or (if
-  // positive) an absolute band in the channels' unit (rad).
+  // Settling band: a fraction of each channel's peak deviation after the excitation, or
+  // absolute bands in each channel's unit (`settling_band_rad`, `_m`, `_mps`, `_mps2`,
+  // `_radps`; a number per unit or a map per channel), then one for every channel.
   double settling_band_fraction = 0.02;
-  double settling_band_rad = 0;
+  std::map<std::string, double> settling_bands;  // channel -> band in its unit; empty: fraction
+  std::map<std::string, std::string> settling_band_units;  // channel -> its unit
   double relative_tolerance = 1e-6;  // bisection stops at this relative bracket width
 
   bool has_settling_target() const { return max_settling_time_s > 0; }
@@ -44,18 +47,32 @@ struct DamperSizingSpec {
 };
 
 // Reads the `damper_sizing:` section; joints must exist in the base scenario's model.joints (the
-// truck crane) or be revolute coordinates with a spring in model.springs (a description).
+// truck crane) or be revolute coordinates with a spring in model.springs (a description). The
+// absolute settling bands need the channels' units: ReadSettlingBands.
 DamperSizingSpec ReadDamperSizing(const YamlReader& section, const YAML::Node& base);
+
+// The absolute settling bands of `damper_sizing.targets` for the channels of the cases' scenario
+// (`probe`: the base with the campaign's `set:`): a band for every channel in its unit or none;
+// and a record long enough to show the settling target (the target plus the slowest mode's
+// period at the base damping).
+void ReadSettlingBands(const YamlReader& section, const validation::Scenario& probe,
+                       DamperSizingSpec* spec);
 
 // The cases of the sweep: for each joint, `points` values of its damping (log or linear).
 std::vector<std::vector<Assignment>> DamperSizingCases(const DamperSizingSpec& spec,
                                                        const std::string& field);
 
 // The settling time (s) of a free decay about zero: the first sample time after which every
-// channel stays within its band (|y| <= fraction * max|y| after `after_s`, or <= band_rad), or
-// +inf if the last sample is still outside. Times before `after_s` (a forcing) are ignored.
+// channel stays within its band (`bands` by channel, else |y| <= fraction * max|y| after
+// `after_s`), +inf if the last sample is still outside, and +inf too if the outputs stay inside
+// for less than `hold_s` before the record ends: a ringing output passes inside its band near
+// each zero crossing, so only a stay of a whole period of the slowest mode shows that it has
+// settled. Times before `after_s` (a forcing) are ignored.
 double CalcSettlingTime(const Measurement& exact, double after_s, double band_fraction,
-                        double band_rad);
+                        const std::map<std::string, double>& bands, double hold_s);
+
+// The longest damped period (s) of the modes with these frequencies (0 for real poles only).
+double SlowestPeriod(const std::vector<double>& frequencies_hz);
 
 // The sizing of one joint: its curves and the smallest damping meeting each target.
 struct JointSizing {
@@ -65,9 +82,12 @@ struct JointSizing {
   Eigen::VectorXd min_damping_ratio;    // per point
   Eigen::VectorXd settling_time_s;      // per point (NaN without a settling target)
   // Per target ("min_damping_ratio", "max_settling_time_s", "all"): the smallest damping that
-  // meets it, NaN if no sweep point does; and how it was found.
+  // meets it, NaN if none was found; the largest of the window of dampings that meet it from
+  // there (a damper that locks its joint lowers the damping ratios again), the range's end when
+  // it is met up to there; and how they were found.
   std::vector<std::string> targets;
   std::vector<double> smallest_Nms_per_rad;
+  std::vector<double> largest_Nms_per_rad;
   std::vector<std::string> notes;
 };
 

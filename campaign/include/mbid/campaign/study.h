@@ -51,7 +51,8 @@ class CampaignStudy {
   // campaign->swept_keys and may adjust campaign->steps. Default: the sweep makes them.
   virtual std::optional<std::vector<std::vector<Assignment>>> ReadCases(const YamlReader& root,
                                                                         Campaign* campaign);
-  // Once the cases and swept keys are known: reads (the rest of) the study's section.
+  // Once the cases and swept keys are known and the base scenario with `set:` is known to load:
+  // reads (the rest of) the study's section.
   virtual void ReadSection(const YamlReader& root, const Campaign& campaign);
 
   // Adds the study's metrics of one simulated case to its outcome and summary row.
