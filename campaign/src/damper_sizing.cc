@@ -250,9 +250,9 @@ Window FindWindow(const DamperSizingSpec& spec, const std::string& target,
     std::vector<size_t> peaks;
     for (size_t i = 1; i + 1 < n; ++i) {
       const double m = Margin(spec, target, points[i]);
-      if (m >= Margin(spec, target, points[i - 1]) && m >= Margin(spec, target, points[i + 1])) {
-        peaks.push_back(i);
-      }
+      const double before = Margin(spec, target, points[i - 1]);
+      const double after_peak = Margin(spec, target, points[i + 1]);
+      if (m >= before && m >= after_peak && (m > before || m > after_peak)) peaks.push_back(i);
     }
     std::sort(peaks.begin(), peaks.end(), [&](size_t i, size_t j) {
       return Margin(spec, target, points[i]) > Margin(spec, target, points[j]);
@@ -286,8 +286,12 @@ Window FindWindow(const DamperSizingSpec& spec, const std::string& target,
       std::string note = fmt::format("not met by any damping from {:.6g} to {:.6g} N*m*s/rad",
                                      damping.empty() ? kNaN : damping.front(),
                                      damping.empty() ? kNaN : damping.back());
-      if (!std::isnan(best.first) &&
-          !(Margin(spec, target, points[best_point]) > Margin(spec, target, best.second))) {
+      if (target == "max_settling_time_s" && n > 0 &&
+          !(Margin(spec, target, points[best_point]) > -1) &&
+          !(Margin(spec, target, best.second) > -1)) {
+        note += ": the outputs settled within the record at no damping tried";
+      } else if (!std::isnan(best.first) &&
+                 !(Margin(spec, target, points[best_point]) > Margin(spec, target, best.second))) {
         note += fmt::format(
             ": the best found is {} at {:.6g} N*m*s/rad (a search of the model "
             "around the sweep's best points)",

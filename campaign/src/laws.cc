@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -10,6 +11,7 @@
 
 #include "mbid/campaign/campaign_case.h"
 #include "mbid/common/eigen_decompositions.h"
+#include "mbid/common/yaml_reader.h"
 #include "units.h"
 #include "vectors.h"
 
@@ -125,6 +127,35 @@ std::string PolynomialLaw::TermName(int term) const {
   return factors.empty() ? "1" : fmt::format("{}", fmt::join(factors, "*"));
 }
 
+namespace {
+
+// Why the cases cannot determine a law's terms: a variable that does not vary, one with fewer
+// distinct values than the degree needs (a quadratic needs three), or variables that vary
+// together.
+std::string WhyUndetermined(const Eigen::MatrixXd& x, int degree,
+                            const std::vector<std::string>& variables) {
+  std::vector<std::string> reasons;
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    std::vector<double> values(x.col(i).data(), x.col(i).data() + x.rows());
+    std::sort(values.begin(), values.end());
+    const auto distinct = std::unique(values.begin(), values.end()) - values.begin();
+    const std::string name = internal::ShortName(variables[static_cast<size_t>(i)]);
+    if (distinct <= 1) {
+      reasons.push_back(name + " does not vary");
+    } else if (distinct <= degree) {
+      reasons.push_back(fmt::format("{} takes {} distinct values, a degree {} needs {}", name,
+                                    distinct, degree, degree + 1));
+    }
+  }
+  if (reasons.empty()) {
+    return "the cases do not determine the terms: the variables vary together (each alone has "
+           "values enough for the degree)";
+  }
+  return fmt::format("the cases do not determine the terms: {}", fmt::join(reasons, "; "));
+}
+
+}  // namespace
+
 PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int degree,
                                const std::vector<std::string>& variables,
                                const std::string& quantity) {
@@ -153,9 +184,7 @@ PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& 
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(design, Eigen::ComputeThinU | Eigen::ComputeThinV);
   const Eigen::VectorXd& s = svd.singularValues();
   if (!(s[p - 1] > kRankTolerance * s[0])) {
-    return Unfitted(law,
-                    "the cases do not determine the terms (variables that do not vary, or "
-                    "too few distinct values for the degree)");
+    return Unfitted(law, WhyUndetermined(x, degree, variables));
   }
   law.scaled_coefficients = svd.solve(y);
   const Eigen::VectorXd residual = y - design * law.scaled_coefficients;
@@ -174,12 +203,65 @@ PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& 
   return law;
 }
 
+std::vector<std::string> NumericColumns(const std::vector<std::string>& parameters,
+                                        const std::vector<std::string>& channels, int coordinates) {
+  std::vector<std::string> columns{"exact.min_damping_ratio", "simulation.samples",
+                                   "simulation.cvodes_steps", "simulation.rhs_evaluations",
+                                   "identified.modes"};
+  for (int k = 1; k <= 2 * coordinates; ++k) {
+    for (const char* quantity : {"frequency_hz", "decay_rate_per_s", "damping_ratio"}) {
+      columns.push_back(fmt::format("exact.mode{}.{}", k, quantity));
+    }
+  }
+  for (const std::string& parameter : parameters) {
+    columns.push_back("truth." + parameter);
+    columns.push_back("updated." + parameter);
+    columns.push_back("updated." + parameter + ".std");
+  }
+  for (const char* name : {"cost_initial", "cost_final", "iterations", "minima", "rank"}) {
+    columns.push_back(std::string("updated.") + name);
+  }
+  for (const std::string& channel : channels) {
+    columns.push_back("identified.correlation." + channel);
+    columns.push_back("updated.correlation." + channel);
+  }
+  return columns;
+}
+
+bool IsIdentifiedModeColumn(const std::string& column, const std::vector<std::string>& channels) {
+  const std::string prefix = "identified.mode";
+  if (column.rfind(prefix, 0) != 0) return false;
+  size_t end = prefix.size();
+  while (end < column.size() && std::isdigit(static_cast<unsigned char>(column[end]))) ++end;
+  if (end == prefix.size() || column[prefix.size()] == '0' || end >= column.size() ||
+      column[end] != '.') {
+    return false;
+  }
+  const std::string quantity = column.substr(end + 1);
+  for (const char* name : {"frequency_hz", "decay_rate_per_s", "damping_ratio", "std_frequency_hz",
+                           "std_decay_rate_per_s"}) {
+    if (quantity == name) return true;
+  }
+  return quantity.rfind("amplitude.", 0) == 0 &&
+         std::find(channels.begin(), channels.end(), quantity.substr(10)) != channels.end();
+}
+
 LawsSpec ReadLaws(const YamlReader& section, const std::vector<std::string>& swept_keys,
-                  bool identify, bool update) {
+                  bool identify, bool update, const std::vector<std::string>& columns,
+                  const std::vector<std::string>& channels) {
   section.ExpectMap({"variables", "quantities", "degree"});
   LawsSpec spec;
   spec.variables = section.StringList("variables");
   if (spec.variables.empty()) section.FailAt("variables", "empty list", "swept keys");
+  const auto once = [&](const std::vector<std::string>& names, const char* key) {
+    for (size_t i = 0; i < names.size(); ++i) {
+      if (std::find(names.begin(), names.begin() + static_cast<long>(i), names[i]) !=
+          names.begin() + static_cast<long>(i)) {
+        section.FailAt(key, "'" + names[i] + "' twice", "each once");
+      }
+    }
+  };
+  once(spec.variables, "variables");
   for (const std::string& variable : spec.variables) {
     if (std::find(swept_keys.begin(), swept_keys.end(), variable) == swept_keys.end()) {
       section.FailAt("variables", "'" + variable + "' is not swept",
@@ -192,6 +274,7 @@ LawsSpec ReadLaws(const YamlReader& section, const std::vector<std::string>& swe
   if (spec.quantities.empty()) {
     section.FailAt("quantities", "empty list", "summary columns such as updated.c_theta");
   }
+  once(spec.quantities, "quantities");
   for (const std::string& quantity : spec.quantities) {
     const auto starts = [&](const char* prefix) { return quantity.rfind(prefix, 0) == 0; };
     if (!starts("truth.") && !starts("exact.") && !starts("identified.") && !starts("updated.") &&
@@ -207,6 +290,13 @@ LawsSpec ReadLaws(const YamlReader& section, const std::vector<std::string>& swe
     if (starts("updated.") && !update) {
       section.FailAt("quantities", "'" + quantity + "' needs the update step",
                      "steps: [update] (or all)");
+    }
+    if (std::find(columns.begin(), columns.end(), quantity) == columns.end() &&
+        !IsIdentifiedModeColumn(quantity, channels)) {
+      section.FailAt("quantities", "'" + quantity + "' is no numeric column of the cases",
+                     fmt::format("a numeric summary column such as '{}' (docs/campaigns.md, "
+                                 "\"Steps of a case\")",
+                                 ClosestMatch(quantity, columns)));
     }
   }
   spec.degree = section.Int("degree", 1);

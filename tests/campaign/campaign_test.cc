@@ -261,6 +261,21 @@ TEST_F(CampaignTest, LawRecoversAnExactQuadraticInTwoVariables) {
   const PolynomialLaw flat = FitPolynomialLaw(x.topRows(3).replicate(2, 1).eval(),
                                               y.head(3).replicate(2, 1).eval(), 2, {"e", "m"}, "q");
   EXPECT_NE(flat.status, "ok");
+  // Two payloads cannot give m^2 (a documented example swept two, at degree 2), and a second
+  // variable that moves with the first cannot be told from it: each reason says which.
+  Eigen::MatrixXd two_payloads(8, 2);
+  Eigen::VectorXd values(8);
+  for (int i = 0; i < 8; ++i) {
+    two_payloads.row(i) << 10.0 * (i / 2), (i % 2 == 0 ? 650.0 : 1300.0);
+    values[i] = 1.0 + i;
+  }
+  EXPECT_NE(FitPolynomialLaw(two_payloads, values, 2, {"e", "m"}, "q")
+                .status.find("m takes 2 distinct values, a degree 2 needs 3"),
+            std::string::npos);
+  Eigen::MatrixXd together(8, 2);
+  for (int i = 0; i < 8; ++i) together.row(i) << i, 2.0 * i;
+  EXPECT_NE(FitPolynomialLaw(together, values, 1, {"e", "m"}, "q").status.find("vary together"),
+            std::string::npos);
 }
 
 // Sizing the damper of joint `angle` of `base` for a damping ratio of 0.1: 11 log-spaced points
@@ -535,6 +550,43 @@ laws:
     return text.str();
   }();
   EXPECT_NE(report.find("### truth.c_angle (N*m/rad)"), std::string::npos) << report;
+}
+
+// A misspelt quantity ran every case and reported "0 cases with values"; a variable twice was
+// accepted. Both are refused at load, the misspelling with the column meant.
+TEST_F(CampaignTest, LawsRefuseAColumnTheCasesDoNotHave) {
+  Write("oscillator.yaml", kOscillator);
+  const auto laws = [&](const std::string& section) {
+    return Write("laws.yaml", R"(name: laws
+base: oscillator.yaml
+steps: [modes]
+sweep:
+  - list:
+      model.inertia_kgm2: [1, 2, 3]
+study: laws
+laws:
+)" + section);
+  };
+  try {
+    LoadCampaign(laws("  variables: [model.inertia_kgm2]\n  quantities: [truth.c_angel]\n"));
+    ADD_FAILURE() << "a misspelt quantity was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.field(), "laws.quantities");
+    EXPECT_NE(error.problem().find("'truth.c_angel' is no numeric column"), std::string::npos);
+    EXPECT_NE(error.expected().find("'truth.c_angle'"), std::string::npos) << error.what();
+  }
+  try {
+    LoadCampaign(
+        laws("  variables: [model.inertia_kgm2, model.inertia_kgm2]\n"
+             "  quantities: [truth.c_angle]\n"));
+    ADD_FAILURE() << "a variable twice was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.field(), "laws.variables");
+  }
+  // What the cases have is accepted: a mode's quantity, an identified mode's by its form.
+  EXPECT_NO_THROW(
+      LoadCampaign(laws("  variables: [model.inertia_kgm2]\n"
+                        "  quantities: [exact.mode1.frequency_hz, truth.d_angle]\n")));
 }
 
 TEST_F(CampaignTest, LawUnitsComeFromTheModel) {

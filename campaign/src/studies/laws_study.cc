@@ -17,10 +17,21 @@ class LawsStudy : public CampaignStudy {
  public:
   std::string name() const override { return "laws"; }
 
-  // Variables must be swept keys: read once the sweep is.
+  // Variables must be swept keys: read once the sweep is; quantities columns of the model's.
   void ReadSection(const YamlReader& root, const Campaign& campaign) override {
-    spec_ = ReadLaws(root.Child("laws"), campaign.swept_keys, campaign.steps.identify,
-                     campaign.steps.update);
+    CampaignCase probe;
+    probe.id = "probe";
+    const validation::Scenario scenario = validation::LoadScenarioFromText(
+        campaign.CaseScenarioText(probe), campaign.CaseSource(probe));
+    const std::unique_ptr<model::MechanicalModel> model = scenario.MakeModel();
+    std::vector<std::string> parameters;
+    for (const model::Parameter& parameter : model->parameters()) {
+      parameters.push_back(parameter.name);
+    }
+    spec_ = ReadLaws(
+        root.Child("laws"), campaign.swept_keys, campaign.steps.identify, campaign.steps.update,
+        NumericColumns(parameters, scenario.sensors.channels, model->coordinate_count()),
+        scenario.sensors.channels);
   }
 
   StudyReport Run(const StudyRun& run) const override {

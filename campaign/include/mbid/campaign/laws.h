@@ -21,10 +21,21 @@ struct LawsSpec {
   int degree = 1;
 };
 
-// Reads the `laws:` section. Variables must be swept keys; quantities must name a column the
-// steps produce (updated.* needs update, identified.* needs identify).
+// The numeric summary columns a case of this scenario can have (docs/campaigns.md, "Steps of a
+// case"): truth.<parameter>, exact.mode<k>.<quantity> (k up to twice the coordinates),
+// exact.min_damping_ratio, simulation.*, updated.<parameter>[.std] and updated.* numbers,
+// identified.modes and identified.correlation.<channel>; identified.mode<k>.* is matched by form
+// (IsIdentifiedModeColumn), its count unknown before the run.
+std::vector<std::string> NumericColumns(const std::vector<std::string>& parameters,
+                                        const std::vector<std::string>& channels, int coordinates);
+bool IsIdentifiedModeColumn(const std::string& column, const std::vector<std::string>& channels);
+
+// Reads the `laws:` section. Variables must be swept keys, each once; quantities must name a
+// numeric column the steps produce (`columns`, NumericColumns; updated.* needs update,
+// identified.* needs identify), each once.
 LawsSpec ReadLaws(const YamlReader& section, const std::vector<std::string>& swept_keys,
-                  bool identify, bool update);
+                  bool identify, bool update, const std::vector<std::string>& columns,
+                  const std::vector<std::string>& channels);
 
 // y = sum_j a_j prod_i x_i^e_ji over the monomials of total degree <= degree, fitted by least
 // squares. The fit runs on the variables scaled to [-1, 1] over the data (for conditioning)
