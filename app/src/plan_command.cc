@@ -75,6 +75,12 @@ void PrintPlan(const updating::TestPlan& plan, const std::string& estimate_sourc
   }
   std::cout << "(columns per parameter: expected relative standard deviation with the recorded "
                "tests; inf = undetermined)\n";
+  for (const updating::CandidateScore& candidate : plan.candidates) {
+    if (candidate.moves_nothing) {
+      std::cout << "candidate " << candidate.name
+                << ": its test moves no output by its sensors' noise; it adds nothing\n";
+    }
+  }
 }
 
 void PrintAlternatives(const updating::AlternativesPlan& plan,

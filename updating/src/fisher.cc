@@ -111,6 +111,11 @@ FisherInformation CalcFisherInformation(const model::MechanicalModel& model, con
   information.parameters = parameters;
   information.matrix = jacobian.transpose() * jacobian;
   information.residuals = static_cast<long>(samples) * m;
+  for (int c = 0; c < m && samples > 0; ++c) {
+    const auto y = run.exact.values.col(c);
+    information.largest_swing_to_noise =
+        std::max(information.largest_swing_to_noise, (y.maxCoeff() - y.minCoeff()) / sigma[c]);
+  }
   information.statistics = run.statistics;
   return information;
 }

@@ -158,6 +158,10 @@ TestPlan PlanNextTest(const model::MechanicalModel& model, const std::vector<Tes
       score.fisher.col(k).setZero();
       score.unseen.push_back(found.name);
     }
+    if (!(information.largest_swing_to_noise >= 1)) {
+      score.moves_nothing = true;
+      score.fisher.setZero();
+    }
     const Eigen::MatrixXd total = plan.recorded_fisher + score.fisher;
     score.score = CalcLogDetWithRidge(total, options.ridge, &score.ridge);
     if (!recorded.empty()) {

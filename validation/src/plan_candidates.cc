@@ -112,7 +112,14 @@ CandidateFile ReadCandidateFile(const std::string& path, const Scenario& scenari
                                                    path, entry.field() + ".sensors"),
                                         *own);
       for (const auto& [channel, value] : candidate.test.sensors.noise_std) {
-        if (value > 0) own_noise.push_back(channel);
+        // A noiseless sensor would tell everything exactly; 0 is no level to plan with.
+        if (!(value > 0)) {
+          throw InputError(path, entry.field() + ".sensors",
+                           fmt::format("a noise level of {} for '{}'", value, channel),
+                           "a positive noise standard deviation (or none: the recorded tests' "
+                           "or the scenario's)");
+        }
+        own_noise.push_back(channel);
       }
     } else {
       candidate.test.sensors = scenario.sensors;
@@ -182,6 +189,7 @@ nlohmann::json CandidateScoresToJson(
     }
     item["determined"] = determined;
     item["unseen"] = candidate.unseen;  // its channels do not see their modes
+    item["moves_nothing"] = candidate.moves_nothing;
     item["rank"] = candidate.rank;
     item["ridge"] = NumberOrNull(candidate.ridge);
     for (size_t i = 0; i < file.candidates.size(); ++i) {

@@ -50,6 +50,9 @@ struct FisherInformation {
   std::vector<std::string> parameters;  // the order of the rows and columns
   Eigen::MatrixXd matrix;               // F in log coordinates (dimensionless)
   long residuals = 0;                   // samples x channels
+  // The test's largest swing: max over channels of (max y - min y) / noise std of the
+  // noise-free outputs. Below 1 the test moves nothing its sensors can see.
+  double largest_swing_to_noise = 0;
   simulation::IntegratorStatistics statistics;
 };
 

@@ -63,6 +63,9 @@ struct CandidateScore {
   // (credibility.h's FindUnseenParameters): its information on them is a second-order effect
   // no fit can use, left out of `fisher`, the score and the standard deviations.
   std::vector<std::string> unseen;
+  // The candidate's test moves no output by its sensors' noise (a deflection of zero from the
+  // rest): its information, round-off of a still machine, is left out; it adds nothing.
+  bool moves_nothing = false;
   int rank = 0;  // of the recorded tests and this candidate together
   simulation::IntegratorStatistics statistics;
 };
