@@ -2,6 +2,7 @@
 // uncertainty, and damper sizing on the one-joint oscillator whose damping ratio is analytic.
 #include "mbid/campaign/campaign.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -319,23 +320,29 @@ TEST_F(CampaignTest, DamperSizingFindsTheAnalyticSmallestDamper) {
   }
 }
 
+// A turntable (a disc of 100 kg*m^2 about z) on a spring of `stiffness` N*m/rad carrying a slide
+// (1 kg*m^2: J = 101) on 1e4 N/m, 100 N*s/m; the model section up to its outputs.
+std::string TurntableWithSlide(double stiffness) {
+  return fmt::format(R"(model:
+  type: multibody
+  bodies:
+    table: {{parent: ground, joint: {{type: revolute, coordinates: [angle], axis: [0, 0, 1]}},
+            mass_kg: 1.0, inertia_kgm2: [50, 50, 100]}}
+    slide: {{parent: table, joint: {{type: prismatic, coordinates: [x], axis: [1, 0, 0]}},
+            mass_kg: 1.0, inertia_kgm2: [1, 1, 1]}}
+  springs:
+    angle: {{stiffness_Nm_per_rad: {}, damping_Nms_per_rad: 1.0}}
+    x: {{stiffness_N_per_m: 1.0e4, damping_Ns_per_m: 100.0}}
+)",
+                     stiffness);
+}
+
 // The oscillator as a machine description: a turntable (a disc of 100 kg*m^2 about z, carrying a
 // slide of 1 kg*m^2: J = 101), gravity along z (no gravity stiffness). Its joint is a spring of
 // model.springs, sized as the crane's joints are (the study read model.joints only and ended in
 // an internal YAML error, exit 1). A prismatic coordinate's damper (N*s/m) is refused by name.
 TEST_F(CampaignTest, DamperSizingSizesAMachineDescriptionsSpring) {
-  Write("turntable.yaml", R"(name: turntable
-model:
-  type: multibody
-  bodies:
-    table: {parent: ground, joint: {type: revolute, coordinates: [angle], axis: [0, 0, 1]},
-            mass_kg: 1.0, inertia_kgm2: [50, 50, 100]}
-    slide: {parent: table, joint: {type: prismatic, coordinates: [x], axis: [1, 0, 0]},
-            mass_kg: 1.0, inertia_kgm2: [1, 1, 1]}
-  springs:
-    angle: {stiffness_Nm_per_rad: 4.0, damping_Nms_per_rad: 1.0}
-    x: {stiffness_N_per_m: 1.0e4, damping_Ns_per_m: 100.0}
-  outputs:
+  Write("turntable.yaml", "name: turntable\n" + TurntableWithSlide(4.0) + R"(  outputs:
     angle: {type: coordinate, coordinate: angle}
 excitation: {type: initial_deflection, deflection_rad: {angle: 0.01}}
 simulation: {duration_s: 2}
@@ -440,18 +447,7 @@ damper_sizing:
 // Settling bands are in the channels' units and given for every channel (a band in rad was
 // applied to a displacement in m, silently); a record must be long enough to show the target.
 TEST_F(CampaignTest, DamperSizingRefusesBandsAndRecordsThatCannotShowTheTarget) {
-  Write("slide.yaml", R"(name: slide
-model:
-  type: multibody
-  bodies:
-    table: {parent: ground, joint: {type: revolute, coordinates: [angle], axis: [0, 0, 1]},
-            mass_kg: 1.0, inertia_kgm2: [50, 50, 100]}
-    slide: {parent: table, joint: {type: prismatic, coordinates: [x], axis: [1, 0, 0]},
-            mass_kg: 1.0, inertia_kgm2: [1, 1, 1]}
-  springs:
-    angle: {stiffness_Nm_per_rad: 4000.0, damping_Nms_per_rad: 1.0}
-    x: {stiffness_N_per_m: 1.0e4, damping_Ns_per_m: 100.0}
-  outputs:
+  Write("slide.yaml", "name: slide\n" + TurntableWithSlide(4000.0) + R"(  outputs:
     angle: {type: coordinate, coordinate: angle}
     x: {type: coordinate, coordinate: x}
 excitation: {type: initial_deflection, deflection_rad: {angle: 0.01}}
