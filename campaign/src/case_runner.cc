@@ -46,6 +46,7 @@ void AddExactModes(const std::vector<model::Mode>& modes, CaseOutcome& outcome) 
     outcome.row[prefix + "damping_ratio"] = Number(modes[k].damping_ratio());
     outcome.exact_damping_ratios.push_back(modes[k].damping_ratio());
     outcome.exact_frequencies_hz.push_back(modes[k].frequency_hz());
+    outcome.exact_decay_rates_per_s.push_back(modes[k].decay_rate_per_s());
     if (!(modes[k].damping_ratio() >= smallest)) smallest = modes[k].damping_ratio();
   }
   outcome.row["exact.min_damping_ratio"] = Number(smallest);

@@ -13,6 +13,7 @@ namespace mbid::campaign::internal {
 namespace {
 
 constexpr int kMaxBisections = 200;  // log2 of any range over any tolerance above 1e-15
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // How far a point is inside the target, relative to it: >= 0 where it meets it, NaN where its
 // evaluation failed. "all" is the smaller of the two.
@@ -80,7 +81,7 @@ class WindowSearch {
     SizingPoint pc = At(to_d(c)), pd = At(to_d(d));
     const auto margin = [&](const SizingPoint& p) {
       const double m = Margin(spec_, target_, p);
-      return std::isnan(m) ? -std::numeric_limits<double>::infinity() : m;
+      return std::isnan(m) ? -kInfinity : m;
     };
     const double width = b - a;
     while (b - a > 1e-4 * width && margin(pc) < 0 && margin(pd) < 0) {
@@ -155,14 +156,16 @@ Window FindWindow(const DamperSizingSpec& spec, const std::string& target,
   while (first < n && !Meets(spec, target, points[first])) ++first;
   size_t after = n;  // the first sweep point after the window that fails
   if (first == n) {
-    // Interior local maxima of the sampled margin, best first: the model between their
-    // neighbours may meet the target where no sample does.
+    // Local maxima of the sampled margin (the range's ends too), best first: the model between
+    // their neighbours may meet the target where no sample does.
     std::vector<size_t> peaks;
-    for (size_t i = 1; i + 1 < n; ++i) {
+    for (size_t i = 0; i < n; ++i) {
       const double m = Margin(spec, target, points[i]);
-      const double before = Margin(spec, target, points[i - 1]);
-      const double after_peak = Margin(spec, target, points[i + 1]);
-      if (m >= before && m >= after_peak && (m > before || m > after_peak)) peaks.push_back(i);
+      const double before = i > 0 ? Margin(spec, target, points[i - 1]) : -kInfinity;
+      const double after_peak = i + 1 < n ? Margin(spec, target, points[i + 1]) : -kInfinity;
+      if (n > 1 && m >= before && m >= after_peak && (m > before || m > after_peak)) {
+        peaks.push_back(i);
+      }
     }
     std::sort(peaks.begin(), peaks.end(), [&](size_t i, size_t j) {
       return Margin(spec, target, points[i]) > Margin(spec, target, points[j]);
@@ -170,14 +173,15 @@ Window FindWindow(const DamperSizingSpec& spec, const std::string& target,
     std::pair<double, SizingPoint> best{kNaN, SizingPoint()};
     for (size_t k = 0; k < std::min<size_t>(peaks.size(), 3); ++k) {
       const size_t i = peaks[k];
-      const auto found = search.Best(damping[i - 1], damping[i + 1]);
+      const size_t low = i > 0 ? i - 1 : i, high = i + 1 < n ? i + 1 : i;
+      const auto found = search.Best(damping[low], damping[high]);
       if (std::isnan(best.first) ||
           Margin(spec, target, found.second) > Margin(spec, target, best.second)) {
         best = found;
       }
       if (Meets(spec, target, found.second)) {
-        window.smallest = search.Bisect(found.first, damping[i - 1]);
-        window.largest = search.Bisect(found.first, damping[i + 1]);
+        window.smallest = search.Bisect(found.first, damping[low]);
+        window.largest = search.Bisect(found.first, damping[high]);
         notes.push_back(fmt::format(
             "met only between {:.6g} and {:.6g} N*m*s/rad, where no sweep point is: found by a "
             "search of the model around the sweep's best point ({:.6g} N*m*s/rad: {}) and "

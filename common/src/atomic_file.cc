@@ -248,7 +248,15 @@ void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
 bool ParseAtomicTemporaryName(const std::string& name, std::string* target, int* pid) {
   const size_t at = name.rfind(".tmp-");
   if (at == std::string::npos || at == 0) return false;
-  const std::string rest = name.substr(at + 5);  // "<pid>-<n>"
+  std::string rest = name.substr(at + 5);  // "<pid>-<n>"
+  // The scratch files a figure's writer keeps beside its temporary (report/gnuplot.cc).
+  for (const char* scratch : {".dat", ".gp", ".log"}) {
+    const size_t length = std::char_traits<char>::length(scratch);
+    if (rest.size() > length && rest.compare(rest.size() - length, length, scratch) == 0) {
+      rest.resize(rest.size() - length);
+      break;
+    }
+  }
   const size_t dash = rest.find('-');
   if (dash == 0 || dash == std::string::npos || dash > 9 ||
       rest.find_first_not_of("0123456789-") != std::string::npos ||

@@ -130,6 +130,90 @@ OpenFlow FindOpenFlow(const std::string& text, int line, int column) {
   }
   return open.empty() ? OpenFlow{} : open.back();
 }
+
+// Where a quoted scalar opens that no quote closes before the end of the text (0-based), or
+// {0, ...} if none: yaml-cpp reads such a scalar to the end of the file without an error, and
+// the keys after it go missing ("name: \"crane" then "missing required key 'model'"). A quote
+// opens a scalar only where a value or key starts (the line's first character, or after ": ",
+// "- ", '[', '{', ','); an apostrophe inside a word does not. Comments and block scalars
+// (| or >) are skipped.
+OpenFlow FindUnclosedQuote(const std::string& text) {
+  OpenFlow open;
+  int l = 0, c = 0;
+  char quote = 0;
+  bool comment = false;
+  int block_indent = -1;  // a block scalar's lines are indented more than its key's
+  int line_indent = 0;
+  bool line_start = true;
+  char previous = '\n';  // the last non-blank character on the line before this one
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char ch = text[i];
+    if (ch == '\n') {
+      if (quote == 0) {
+        // "key: |" or "key: >-": the following, deeper lines are text.
+        if (previous == '|' || previous == '>' ||
+            ((previous == '-' || previous == '+') && i >= 2 &&
+             (text[i - 2] == '|' || text[i - 2] == '>'))) {
+          block_indent = line_indent;
+        }
+      }
+      ++l;
+      c = 0;
+      comment = false;
+      line_start = true;
+      line_indent = 0;
+      previous = '\n';
+      continue;
+    }
+    if (line_start && quote == 0) {
+      if (ch == ' ' || ch == '\t') {
+        ++line_indent;
+        ++c;
+        continue;
+      }
+      line_start = false;
+      if (block_indent >= 0 && line_indent > block_indent)
+        comment = true;  // block text
+      else
+        block_indent = -1;
+    }
+    if (comment) {
+    } else if (quote != 0) {
+      if (ch == '\\' && quote == '"') {
+        ++i;
+        ++c;
+      } else if (ch == quote && quote == '\'' && i + 1 < text.size() && text[i + 1] == '\'') {
+        ++i;  // '' is a quote inside single quotes
+        ++c;
+      } else if (ch == quote) {
+        quote = 0;
+        previous = ch;
+      }
+    } else if (ch == '#' && (c == 0 || text[i - 1] == ' ' || text[i - 1] == '\t')) {
+      comment = true;
+    } else if ((ch == '"' || ch == '\'') &&
+               (previous == '\n' || previous == '[' || previous == '{' || previous == ',' ||
+                ((previous == ':' || previous == '-' || previous == '?') &&
+                 (text[i - 1] == ' ' || text[i - 1] == '\t')))) {
+      quote = ch;
+      open = {ch, l, c};
+    } else if (ch != ' ' && ch != '\t') {
+      previous = ch;
+    }
+    ++c;
+  }
+  return quote != 0 ? open : OpenFlow{};
+}
+
+void ThrowIfAQuoteIsNotClosed(const std::string& text, const std::string& source,
+                              const std::string& consequence) {
+  const OpenFlow quote = FindUnclosedQuote(text);
+  if (quote.bracket == 0) return;
+  throw InputError(source, fmt::format("line {}", quote.line + 1),
+                   fmt::format("the {} at column {} is not closed ({})", quote.bracket,
+                               quote.column + 1, consequence),
+                   fmt::format("a {} closing it", quote.bracket));
+}
 }  // namespace
 
 std::string ClosestMatch(const std::string& word, const std::vector<std::string>& candidates) {
@@ -153,8 +237,13 @@ YamlReader YamlReader::FromFile(const std::string& path) {
 YamlReader YamlReader::FromString(const std::string& text, const std::string& source) {
   ValidateUtf8Text(text, source);
   try {
-    return YamlReader(YAML::Load(text), source, "");
+    YAML::Node root = YAML::Load(text);
+    ThrowIfAQuoteIsNotClosed(text, source, "the rest of the file was read as its text");
+    return YamlReader(root, source, "");
   } catch (const YAML::ParserException& e) {
+    ThrowIfAQuoteIsNotClosed(text, source,
+                             fmt::format("YAML syntax error at line {}, column {}: {}",
+                                         e.mark.line + 1, e.mark.column + 1, e.msg));
     const OpenFlow flow = e.msg.find("flow") != std::string::npos
                               ? FindOpenFlow(text, e.mark.line, e.mark.column)
                               : OpenFlow{};

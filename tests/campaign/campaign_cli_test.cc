@@ -230,6 +230,11 @@ TEST_F(CampaignCliTest, ResumeRedoesTemporariesAndDamagedCaseFilesAndLeavesTheUs
   Write("out/cases/notes.txt", "mine");
   Write("out/cases/plan.tmp-draft", "mine too");
   Write("out/readme.md", "and mine");
+  // A figure's temporary and its scratch files, of a process killed while drawing it (a
+  // re-audit found the scratch files left after the resume).
+  for (const char* scratch : {"", ".dat", ".gp", ".log"}) {
+    Write(std::string("out/modes.png.tmp-12345-7") + scratch, "a figure being drawn");
+  }
   const CommandResult result =
       Run("campaign " + campaign.string() + " -o " + out.string() + " --resume");
   ASSERT_EQ(result.exit_code, 0) << result.err;
@@ -244,6 +249,9 @@ TEST_F(CampaignCliTest, ResumeRedoesTemporariesAndDamagedCaseFilesAndLeavesTheUs
   }
   std::sort(left.begin(), left.end());
   EXPECT_EQ(left, (std::vector<std::string>{"notes.txt", "plan.tmp-draft"}));
+  for (const auto& entry : fs::directory_iterator(out)) {
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+  }
 }
 
 // model.parameters is a free map: a misspelt swept parameter became one more that nothing

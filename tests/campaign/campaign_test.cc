@@ -33,7 +33,7 @@ using campaign::FitPolynomialLaw;
 using campaign::LoadCampaign;
 using campaign::PolynomialLaw;
 using campaign::RunCampaign;
-using campaign::SlowestPeriod;
+using campaign::SettlingHold;
 
 namespace {
 
@@ -196,7 +196,8 @@ TEST_F(CampaignTest, AnOutputRingingThroughZeroAtTheRecordsEndHasNotSettled) {
     const double t = 0.01 * j;
     record.values(j, 0) = std::exp(-0.015 * t) * std::sin(omega * t);
   }
-  const double period = SlowestPeriod({0.0, 1.0});  // a real pole and the 1 Hz mode
+  // A real pole and the 1 Hz mode decaying at 0.015 /s: its whole period.
+  const double period = SettlingHold({0.0, 1.0}, {5.0, 0.015});
   EXPECT_DOUBLE_EQ(period, 1.0);
   // Without the stay the last sample alone counts as settled: 5 s.
   EXPECT_NEAR(CalcSettlingTime(record, 0.0, 0.02, {}, 0.0), 5.0, 1e-9);
@@ -320,6 +321,32 @@ TEST_F(CampaignTest, DamperSizingFindsTheAnalyticSmallestDamper) {
   }
 }
 
+// Nearly critically damped (an audit's turntable, J = 50, c = 2000, d = 630: zeta 0.99612), the
+// damped period is 11.3 s, longer than the 10 s record, and a whole period's stay made every
+// damper near the critical one "not settled": it settles in 0.92 s and crosses zero once, with
+// an overshoot of e^-35 of its envelope. Its stay is 3 / decay rate = 0.476 s.
+TEST_F(CampaignTest, ANearlyCriticallyDampedOutputSettlesWithinTheRecord) {
+  const double omega_n = std::sqrt(2000.0 / 50.0), zeta = 630.0 / (2 * std::sqrt(2000.0 * 50));
+  const double sigma = zeta * omega_n, omega_d = omega_n * std::sqrt(1 - zeta * zeta);
+  Measurement record;
+  record.channels = {"angle"};
+  record.units = {"rad"};
+  record.sample_interval_s = 0.01;
+  record.values.resize(1001, 1);
+  for (int j = 0; j <= 1000; ++j) {
+    const double t = 0.01 * j;
+    record.values(j, 0) =
+        std::exp(-sigma * t) * (std::cos(omega_d * t) + sigma / omega_d * std::sin(omega_d * t));
+  }
+  const double hold = SettlingHold({omega_d / (2 * M_PI)}, {sigma});
+  EXPECT_NEAR(hold, 3 / sigma, 1e-12);
+  EXPECT_GT(2 * M_PI / omega_d, 10.0);
+  const double settled = CalcSettlingTime(record, 0.0, 0.02, {}, hold);
+  // The closed form's entry into 2 % of the peak: the same sample with or without the stay.
+  EXPECT_EQ(settled, CalcSettlingTime(record, 0.0, 0.02, {}, 0.0));
+  EXPECT_NEAR(settled, 0.92, 0.015);
+}
+
 // A turntable (a disc of 100 kg*m^2 about z) on a spring of `stiffness` N*m/rad carrying a slide
 // (1 kg*m^2: J = 101) on 1e4 N/m, 100 N*s/m; the model section up to its outputs.
 std::string TurntableWithSlide(double stiffness) {
@@ -395,7 +422,7 @@ model:
     a1: {type: coordinate, coordinate: q1}
 excitation: {type: initial_deflection, deflection_rad: {q1: 0.01}}
 )");
-  const Campaign campaign = LoadCampaign(Write("sizing.yaml", R"(name: window
+  const std::string sizing = R"(name: window
 base: absorber.yaml
 study: damper_sizing
 damper_sizing:
@@ -404,7 +431,8 @@ damper_sizing:
   points: 13
   relative_tolerance: 1.0e-9
   targets: {min_damping_ratio: 0.1}
-)"));
+)";
+  const Campaign campaign = LoadCampaign(Write("sizing.yaml", sizing));
   CampaignRunOptions options;
   options.quiet = true;
   const std::string out = (dir_ / "out").string();
@@ -442,6 +470,17 @@ damper_sizing:
   EXPECT_NEAR(largest, 3.921, 1e-3);
   EXPECT_NE(file.ReadStrings("/damper_sizing/q2", "notes")[0].find("met only between"),
             std::string::npos);
+  // Two points only, the best of them an end of the range (a re-audit's case: "not met by any
+  // damping from 0.1 to 10000"): the model between them is searched too.
+  std::string two_points = sizing;
+  two_points.replace(two_points.find("points: 13"), 10, "points: 2");
+  const std::string out2 = (dir_ / "out2").string();
+  EXPECT_EQ(RunCampaign(LoadCampaign(Write("two.yaml", two_points)), out2, options).failed, 0);
+  const H5Reader file2(out2 + "/campaign.h5");
+  EXPECT_NEAR(file2.ReadVector("/damper_sizing/q2", "smallest_Nms_per_rad")[0], smallest,
+              1e-7 * smallest);
+  EXPECT_NEAR(file2.ReadVector("/damper_sizing/q2", "largest_Nms_per_rad")[0], largest,
+              1e-7 * largest);
 }
 
 // Settling bands are in the channels' units and given for every channel (a band in rad was

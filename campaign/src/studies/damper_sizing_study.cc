@@ -37,9 +37,9 @@ class DamperSizingStudy : public CampaignStudy {
 
   void AddCaseMetrics(const simulation::SimulationResult& test,
                       CaseOutcome* outcome) const override {
-    outcome->settling_time_s =
-        CalcSettlingTime(test.exact, test.forcing_end_s, spec_.settling_band_fraction,
-                         spec_.settling_bands, SlowestPeriod(outcome->exact_frequencies_hz));
+    outcome->settling_time_s = CalcSettlingTime(
+        test.exact, test.forcing_end_s, spec_.settling_band_fraction, spec_.settling_bands,
+        SettlingHold(outcome->exact_frequencies_hz, outcome->exact_decay_rates_per_s));
     outcome->row["settling_time_s"] = internal::Number(outcome->settling_time_s);
   }
 

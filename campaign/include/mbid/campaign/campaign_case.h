@@ -32,8 +32,9 @@ struct CaseOutcome {
   std::vector<std::function<void(H5Writer&)>> groups;
 
   // Study metrics (NaN when not computed).
-  std::vector<double> exact_damping_ratios;  // per exact mode, ascending frequency
-  std::vector<double> exact_frequencies_hz;  // damped, the same modes (0 for a real pole)
+  std::vector<double> exact_damping_ratios;     // per exact mode, ascending frequency
+  std::vector<double> exact_frequencies_hz;     // damped, the same modes (0 for a real pole)
+  std::vector<double> exact_decay_rates_per_s;  // the same modes
   double settling_time_s = std::numeric_limits<double>::quiet_NaN();
 
   bool ok() const { return status == "ok"; }

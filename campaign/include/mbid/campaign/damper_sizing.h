@@ -53,8 +53,8 @@ DamperSizingSpec ReadDamperSizing(const YamlReader& section, const YAML::Node& b
 
 // The absolute settling bands of `damper_sizing.targets` for the channels of the cases' scenario
 // (`probe`: the base with the campaign's `set:`): a band for every channel in its unit or none;
-// and a record long enough to show the settling target (the target plus the slowest mode's
-// period at the base damping).
+// and a record long enough to show the settling target (the forcing, the target and
+// SettlingHold at the base damping).
 void ReadSettlingBands(const YamlReader& section, const validation::Scenario& probe,
                        DamperSizingSpec* spec);
 
@@ -65,14 +65,19 @@ std::vector<std::vector<Assignment>> DamperSizingCases(const DamperSizingSpec& s
 // The settling time (s) of a free decay about zero: the first sample time after which every
 // channel stays within its band (`bands` by channel, else |y| <= fraction * max|y| after
 // `after_s`), +inf if the last sample is still outside, and +inf too if the outputs stay inside
-// for less than `hold_s` before the record ends: a ringing output passes inside its band near
-// each zero crossing, so only a stay of a whole period of the slowest mode shows that it has
-// settled. Times before `after_s` (a forcing) are ignored.
+// for less than `hold_s` (SettlingHold) before the record ends: a ringing output passes inside
+// its band near each zero crossing, so only a longer stay shows that it has settled. Times
+// before `after_s` (a forcing) are ignored.
 double CalcSettlingTime(const Measurement& exact, double after_s, double band_fraction,
                         const std::map<std::string, double>& bands, double hold_s);
 
-// The longest damped period (s) of the modes with these frequencies (0 for real poles only).
-double SlowestPeriod(const std::vector<double>& frequencies_hz);
+// How long outputs must stay inside their band to count as settled: over the oscillatory modes
+// (frequency > 0), the longest of min(damped period, 3 / decay rate). A lightly damped mode
+// must be seen for a whole period; a nearly critically damped one, whose period grows without
+// bound, decays by e^-3 in 3 / decay rate and rings no more (its overshoot past zero is below
+// e^-1.5 of its envelope wherever the period is longer).
+double SettlingHold(const std::vector<double>& frequencies_hz,
+                    const std::vector<double>& decay_rates_per_s);
 
 // The sizing of one joint: its curves and the smallest damping meeting each target.
 struct JointSizing {

@@ -84,7 +84,8 @@ struct NamedFile {
 void CheckOutputsAreNew(const std::vector<NamedFile>& inputs,
                         const std::vector<NamedFile>& outputs);
 
-// Whether the file name `name` is an AtomicFile temporary, "<target>.tmp-<pid>-<n>"; if so,
+// Whether the file name `name` is an AtomicFile temporary, "<target>.tmp-<pid>-<n>" (or a
+// figure's scratch file beside one: the same with ".dat", ".gp" or ".log"); if so,
 // `target` and `pid` (either may be null) receive its target's file name and its writer's pid.
 bool ParseAtomicTemporaryName(const std::string& name, std::string* target, int* pid);
 
