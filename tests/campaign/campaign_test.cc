@@ -57,6 +57,16 @@ class CampaignTest : public ::testing::Test {
     return path.string();
   }
 
+  // Runs `campaign` quietly on one worker into dir_/folder, expecting no case to fail; returns
+  // the folder.
+  std::string RunQuietly(const Campaign& campaign, const std::string& folder) const {
+    CampaignRunOptions options;
+    options.quiet = true;
+    const std::string out = (dir_ / folder).string();
+    EXPECT_EQ(RunCampaign(campaign, out, options).failed, 0);
+    return out;
+  }
+
   fs::path dir_;
 };
 
@@ -377,10 +387,7 @@ sensors: {sample_rate_hz: 50, channels: [angle], noise_std_rad: 1.0e-5, seed: 1}
 )");
   const std::string sizing = SizingCampaign("turntable.yaml");
   const Campaign campaign = LoadCampaign(Write("sizing.yaml", sizing));
-  CampaignRunOptions options;
-  options.quiet = true;
-  const std::string out = (dir_ / "out").string();
-  EXPECT_EQ(RunCampaign(campaign, out, options).failed, 0);
+  const std::string out = RunQuietly(campaign, "out");
   const H5Reader file(out + "/campaign.h5");
   const Eigen::VectorXd smallest = file.ReadVector("/damper_sizing/angle", "smallest_Nms_per_rad");
   ASSERT_EQ(smallest.size(), 1);
@@ -433,10 +440,7 @@ damper_sizing:
   targets: {min_damping_ratio: 0.1}
 )";
   const Campaign campaign = LoadCampaign(Write("sizing.yaml", sizing));
-  CampaignRunOptions options;
-  options.quiet = true;
-  const std::string out = (dir_ / "out").string();
-  EXPECT_EQ(RunCampaign(campaign, out, options).failed, 0);
+  const std::string out = RunQuietly(campaign, "out");
   const H5Reader file(out + "/campaign.h5");
   EXPECT_LT(file.ReadVector("/damper_sizing/q2", "min_damping_ratio").maxCoeff(), 0.08);
   const double smallest = file.ReadVector("/damper_sizing/q2", "smallest_Nms_per_rad")[0];
@@ -474,8 +478,7 @@ damper_sizing:
   // damping from 0.1 to 10000"): the model between them is searched too.
   std::string two_points = sizing;
   two_points.replace(two_points.find("points: 13"), 10, "points: 2");
-  const std::string out2 = (dir_ / "out2").string();
-  EXPECT_EQ(RunCampaign(LoadCampaign(Write("two.yaml", two_points)), out2, options).failed, 0);
+  const std::string out2 = RunQuietly(LoadCampaign(Write("two.yaml", two_points)), "out2");
   const H5Reader file2(out2 + "/campaign.h5");
   EXPECT_NEAR(file2.ReadVector("/damper_sizing/q2", "smallest_Nms_per_rad")[0], smallest,
               1e-7 * smallest);
@@ -528,10 +531,7 @@ sensors: {sample_rate_hz: 50, channels: [angle, x]}
   const Campaign both = LoadCampaign(
       campaign("{max_settling_time_s: 3, settling_band_rad: 1.0e-4, settling_band_m: 1.0e-5}\n"
                "  points: 2"));
-  CampaignRunOptions options;
-  options.quiet = true;
-  const std::string out = (dir_ / "out").string();
-  EXPECT_EQ(RunCampaign(both, out, options).failed, 0);
+  const std::string out = RunQuietly(both, "out");
   const H5Reader file(out + "/campaign.h5");
   EXPECT_EQ(file.ReadDoubleAttribute("/damper_sizing", "settling_band.angle"), 1.0e-4);
   EXPECT_EQ(file.ReadDoubleAttribute("/damper_sizing", "settling_band.x"), 1.0e-5);
