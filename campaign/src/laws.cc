@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
 #include <cctype>
 #include <cmath>
 #include <functional>
@@ -17,6 +18,9 @@
 
 namespace mbid::campaign {
 namespace {
+
+// A weighted law misses its cases beyond their stds when chi^2 exceeds its 99.9 % quantile.
+constexpr double kLackOfFitP = 1e-3;
 
 using internal::kNaN;
 constexpr int kMaxDegree = 4;
@@ -158,7 +162,7 @@ std::string WhyUndetermined(const Eigen::MatrixXd& x, int degree,
 
 PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int degree,
                                const std::vector<std::string>& variables,
-                               const std::string& quantity) {
+                               const std::string& quantity, const Eigen::VectorXd& y_std) {
   PolynomialLaw law;
   law.quantity = quantity;
   law.variables = variables;
@@ -181,12 +185,17 @@ PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& 
       design(r, j) = Monomial(law.exponents[static_cast<size_t>(j)], u);
     }
   }
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(design, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  // With each case's std, rows weighted by 1 / std (weighted least squares).
+  law.weighted = y_std.size() == n;
+  const Eigen::VectorXd weight =
+      law.weighted ? y_std.cwiseInverse().eval() : Eigen::VectorXd::Ones(n).eval();
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(weight.asDiagonal() * design,
+                                              Eigen::ComputeThinU | Eigen::ComputeThinV);
   const Eigen::VectorXd& s = svd.singularValues();
   if (!(s[p - 1] > kRankTolerance * s[0])) {
     return Unfitted(law, WhyUndetermined(x, degree, variables));
   }
-  law.scaled_coefficients = svd.solve(y);
+  law.scaled_coefficients = svd.solve(weight.cwiseProduct(y));
   const Eigen::VectorXd residual = y - design * law.scaled_coefficients;
   const double rss = residual.squaredNorm();
   const double tss = (y.array() - y.mean()).matrix().squaredNorm();
@@ -195,7 +204,21 @@ PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& 
       svd.matrixV() * s.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
   const double variance = n > p ? rss / static_cast<double>(n - p) : kNaN;
   law.residual_std = std::sqrt(variance);
-  law.scaled_covariance = variance * inverse_normal;
+  if (law.weighted) {
+    // The cases' stds give the covariance; a scatter beyond them (chi^2 per degree of freedom
+    // above 1: the polynomial does not describe the cases) inflates it by that ratio.
+    law.chi_square_per_dof =
+        n > p ? weight.cwiseProduct(residual).squaredNorm() / static_cast<double>(n - p) : kNaN;
+    law.scaled_covariance = (n > p ? std::max(1.0, law.chi_square_per_dof) : kNaN) * inverse_normal;
+    if (n > p) {
+      const boost::math::chi_squared chi2(static_cast<double>(n - p));
+      law.lack_of_fit =
+          boost::math::cdf(boost::math::complement(
+              chi2, law.chi_square_per_dof * static_cast<double>(n - p))) < kLackOfFitP;
+    }
+  } else {
+    law.scaled_covariance = variance * inverse_normal;
+  }
   const Eigen::MatrixXd transform = ScaledToRaw(law.exponents, law.center, law.half_range);
   law.coefficients = transform * law.scaled_coefficients;
   law.covariance = transform * law.scaled_covariance * transform.transpose();
@@ -306,12 +329,29 @@ LawsSpec ReadLaws(const YamlReader& section, const std::vector<std::string>& swe
   return spec;
 }
 
+std::string StdColumnOf(const std::string& quantity) {
+  // A parameter's (the other updated.* columns have no .std: their laws are unweighted).
+  if (quantity.rfind("updated.", 0) == 0) {
+    return quantity.find('.', 8) == std::string::npos ? quantity + ".std" : "";
+  }
+  for (const char* value : {"frequency_hz", "decay_rate_per_s"}) {
+    const std::string suffix = std::string(".") + value;
+    if (quantity.rfind("identified.mode", 0) == 0 && quantity.size() > suffix.size() &&
+        quantity.compare(quantity.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      return quantity.substr(0, quantity.size() - suffix.size()) + ".std_" + value;
+    }
+  }
+  return "";
+}
+
 std::vector<PolynomialLaw> FitLaws(const LawsSpec& spec,
                                    const std::vector<nlohmann::ordered_json>& rows) {
   std::vector<PolynomialLaw> laws;
   for (const std::string& quantity : spec.quantities) {
+    const std::string std_column = StdColumnOf(quantity);
     std::vector<Eigen::VectorXd> xs;
-    std::vector<double> ys;
+    std::vector<double> ys, stds;
+    int left_out = 0;
     for (const auto& row : rows) {
       if (row["status"] != "ok") continue;
       Eigen::VectorXd x(static_cast<Eigen::Index>(spec.variables.size()));
@@ -320,13 +360,26 @@ std::vector<PolynomialLaw> FitLaws(const LawsSpec& spec,
       }
       const double y = RowNumber(row, quantity);
       if (!x.allFinite() || !std::isfinite(y)) continue;
+      // A value the case's records do not determine is no point of the law (its value is where
+      // its fit stopped).
+      const auto determined = row.find(quantity + ".determined");
+      if (determined != row.end() && determined->is_boolean() && !determined->get<bool>()) {
+        ++left_out;
+        continue;
+      }
       xs.push_back(x);
       ys.push_back(y);
+      stds.push_back(std_column.empty() ? kNaN : RowNumber(row, std_column));
     }
     Eigen::MatrixXd x(static_cast<Eigen::Index>(xs.size()),
                       static_cast<Eigen::Index>(spec.variables.size()));
     for (size_t r = 0; r < xs.size(); ++r) x.row(static_cast<Eigen::Index>(r)) = xs[r];
-    laws.push_back(FitPolynomialLaw(x, ToVector(ys), spec.degree, spec.variables, quantity));
+    const Eigen::VectorXd y_std = ToVector(stds);
+    const bool weighted = !stds.empty() && y_std.allFinite() && (y_std.array() > 0).all();
+    PolynomialLaw law = FitPolynomialLaw(x, ToVector(ys), spec.degree, spec.variables, quantity,
+                                         weighted ? y_std : Eigen::VectorXd());
+    law.left_out_undetermined = left_out;
+    laws.push_back(std::move(law));
   }
   return laws;
 }
@@ -362,6 +415,9 @@ void WriteLaws(H5Writer& file, const std::vector<PolynomialLaw>& laws) {
     file.WriteScalar(group, "samples", law.samples, "1");
     file.WriteScalar(group, "residual_std", law.residual_std, unit);
     file.WriteScalar(group, "r_squared", law.r_squared, "1");
+    file.WriteScalar(group, "chi_square_per_dof", law.chi_square_per_dof, "1");
+    file.WriteScalar(group, "left_out_undetermined", law.left_out_undetermined, "1");
+    file.WriteStringAttribute(group, "lack_of_fit", law.lack_of_fit ? "yes" : "no");
   }
 }
 

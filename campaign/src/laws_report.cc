@@ -115,8 +115,26 @@ std::string LawsReport(const LawsSpec& spec, const std::vector<PolynomialLaw>& l
       md << fmt::format("| {} | {:.6g} | {:.3g} |\n", law.TermName(static_cast<int>(j)),
                         law.coefficients[j], law.std[j]);
     }
-    md << fmt::format("\n{} cases; residual std {:.4g} {}; R^2 = {:.6f}.\n\n", law.samples,
+    md << fmt::format("\n{} cases; residual std {:.4g} {}; R^2 = {:.6f}.", law.samples,
                       law.residual_std, unit, law.r_squared);
+    if (law.left_out_undetermined > 0) {
+      md << fmt::format(" {} case(s) left out: their records do not determine the value.",
+                        law.left_out_undetermined);
+    }
+    if (law.weighted) {
+      md << fmt::format(
+          " Weighted by the cases' standard deviations: chi^2 per degree of "
+          "freedom {:.3g}",
+          law.chi_square_per_dof);
+      md << (law.lack_of_fit
+                 ? fmt::format("; **the law misses the cases by {:.2g} times their standard "
+                               "deviations: a polynomial of degree {} in these variables does "
+                               "not describe them** (the coefficients' stds are inflated by it)",
+                               std::sqrt(law.chi_square_per_dof), spec.degree)
+                 : std::string())
+         << ".";
+    }
+    md << "\n\n";
     if (!gnuplot) continue;
 
     const std::string name = fmt::format("law_{}.png", q + 1);

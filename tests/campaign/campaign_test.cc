@@ -29,7 +29,9 @@ using campaign::CalcSettlingTime;
 using campaign::Campaign;
 using campaign::CampaignRunOptions;
 using campaign::CampaignRunSummary;
+using campaign::FitLaws;
 using campaign::FitPolynomialLaw;
+using campaign::LawsSpec;
 using campaign::LoadCampaign;
 using campaign::PolynomialLaw;
 using campaign::RunCampaign;
@@ -244,6 +246,71 @@ TEST_F(CampaignTest, LawOfAStraightLineHasTheTextbookUncertainty) {
   EXPECT_EQ(law.TermName(1), "boom_elevation_deg");
   // The fitted value's std at the mean of x is s / sqrt(N).
   EXPECT_NEAR(law.CalcStd(Eigen::VectorXd::Constant(1, mean_x)), s / std::sqrt(n), 1e-13);
+}
+
+// Fitted parameters come with their stds, which differ from case to case by orders of magnitude;
+// an undetermined one's value is where its fit stopped. The law of updated.* weights each case
+// by 1 / std^2 (the textbook weighted least squares) and leaves undetermined values out; a
+// chi^2 far beyond its degrees of freedom says the polynomial does not describe the cases.
+TEST_F(CampaignTest, LawsOfFittedValuesAreWeightedByTheirStds) {
+  std::vector<nlohmann::ordered_json> rows;
+  std::mt19937_64 generator(5);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<double> xs, ys, sigmas;
+  for (int i = 0; i < 12; ++i) {
+    const double x = i, sigma = 0.01 * (1 + 10 * (i % 3));  // 0.01, 0.11, 0.21
+    const double y = 3 + 0.5 * x + sigma * unit(generator);
+    rows.push_back({{"status", "ok"},
+                    {"x", x},
+                    {"updated.c_q", y},
+                    {"updated.c_q.std", sigma},
+                    {"updated.c_q.determined", true}});
+    xs.push_back(x), ys.push_back(y), sigmas.push_back(sigma);
+  }
+  // An undetermined value far off the line: left out, counted.
+  rows.push_back({{"status", "ok"},
+                  {"x", 5.0},
+                  {"updated.c_q", 90.0},
+                  {"updated.c_q.std", 80.0},
+                  {"updated.c_q.determined", false}});
+  LawsSpec spec;
+  spec.variables = {"x"};
+  spec.quantities = {"updated.c_q"};
+  spec.degree = 1;
+  const PolynomialLaw law = FitLaws(spec, rows).front();
+  ASSERT_EQ(law.status, "ok");
+  EXPECT_TRUE(law.weighted);
+  EXPECT_EQ(law.left_out_undetermined, 1);
+  EXPECT_EQ(law.samples, 12);
+  // Closed form: with w = 1 / sigma^2 and weighted means, slope = Sum w dx dy / Sum w dx^2 and
+  // var(slope) = 1 / Sum w dx^2 (times chi^2 / dof when that exceeds 1).
+  double sw = 0, swx = 0, swy = 0;
+  for (size_t i = 0; i < xs.size(); ++i) {
+    const double w = 1 / (sigmas[i] * sigmas[i]);
+    sw += w, swx += w * xs[i], swy += w * ys[i];
+  }
+  const double mx = swx / sw, my = swy / sw;
+  double sxx = 0, sxy = 0;
+  for (size_t i = 0; i < xs.size(); ++i) {
+    const double w = 1 / (sigmas[i] * sigmas[i]);
+    sxx += w * (xs[i] - mx) * (xs[i] - mx), sxy += w * (xs[i] - mx) * (ys[i] - my);
+  }
+  const double slope = sxy / sxx;
+  EXPECT_NEAR(law.coefficients[1], slope, 1e-12);
+  EXPECT_NEAR(law.coefficients[0], my - slope * mx, 1e-11);
+  double chi2 = 0;
+  for (size_t i = 0; i < xs.size(); ++i) {
+    const double r = (ys[i] - law.coefficients[0] - law.coefficients[1] * xs[i]) / sigmas[i];
+    chi2 += r * r;
+  }
+  EXPECT_NEAR(law.chi_square_per_dof, chi2 / 10, 1e-9);
+  EXPECT_NEAR(law.std[1], std::sqrt(std::max(1.0, chi2 / 10) / sxx), 1e-12);
+  EXPECT_FALSE(law.lack_of_fit);
+  // A parabola fitted by a line within stds of 0.01: chi^2 per dof in the thousands.
+  for (size_t i = 0; i < 12; ++i) rows[i]["updated.c_q"] = 3 + 0.5 * xs[i] + 0.05 * xs[i] * xs[i];
+  const PolynomialLaw straight = FitLaws(spec, rows).front();
+  EXPECT_TRUE(straight.lack_of_fit);
+  EXPECT_GT(straight.chi_square_per_dof, 100);
 }
 
 TEST_F(CampaignTest, LawRecoversAnExactQuadraticInTwoVariables) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -41,7 +42,10 @@ LawsSpec ReadLaws(const YamlReader& section, const std::vector<std::string>& swe
 // squares. The fit runs on the variables scaled to [-1, 1] over the data (for conditioning)
 // and is expanded back to coefficients of the raw variables. Uncertainty: with s^2 = RSS /
 // (N - P) the residual variance, Cov(a) = s^2 (A^T A)^-1 (ordinary least squares with
-// independent errors of equal variance); with N = P the fit is exact and the std is NaN.
+// independent errors of equal variance); with N = P the fit is exact and the std is NaN. With
+// each case's std sigma_i (a fitted or identified value's), weighted least squares:
+// Cov(a) = max(1, chi^2 / (N - P)) (A^T W A)^-1, W = diag(1 / sigma_i^2), the ratio a scatter
+// beyond the cases' stds (the polynomial does not describe them).
 struct PolynomialLaw {
   std::string quantity;
   std::string units;  // the quantity's unit (the model's, for c_ and d_ parameters)
@@ -53,7 +57,13 @@ struct PolynomialLaw {
   int samples = 0;
   double residual_std = 0;  // s, in the quantity's unit (NaN when N = P)
   double r_squared = 0;
-  std::string status = "ok";  // or why the law could not be fitted
+  bool weighted = false;  // by the cases' stds
+  // chi^2 / (N - P) of a weighted fit: about 1 when the law describes the cases within their
+  // stds, far above when it does not (NaN unweighted or N = P).
+  double chi_square_per_dof = std::numeric_limits<double>::quiet_NaN();
+  bool lack_of_fit = false;       // chi^2 beyond its 99.9 % quantile: the law misses the cases
+  int left_out_undetermined = 0;  // cases whose value their records do not determine
+  std::string status = "ok";      // or why the law could not be fitted
 
   // Scaled form, used for evaluation: u_i = (x_i - center_i) / half_range_i.
   Eigen::VectorXd center, half_range;
@@ -71,9 +81,16 @@ struct PolynomialLaw {
 // determine the terms give a law with status saying so and NaN coefficients.
 PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int degree,
                                const std::vector<std::string>& variables,
-                               const std::string& quantity);
+                               const std::string& quantity,
+                               const Eigen::VectorXd& y_std = Eigen::VectorXd());
 
-// The laws of every quantity from the summary rows (cases with status ok and the values).
+// The column of a quantity's std (updated.<parameter>.std, identified.mode<k>.std_<quantity>),
+// or "" where the cases give none.
+std::string StdColumnOf(const std::string& quantity);
+
+// The laws of every quantity from the summary rows (cases with status ok and the values; a
+// value its case marks undetermined is left out), weighted by the cases' stds where every case
+// has one (StdColumnOf).
 std::vector<PolynomialLaw> FitLaws(const LawsSpec& spec,
                                    const std::vector<nlohmann::ordered_json>& rows);
 
