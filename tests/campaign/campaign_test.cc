@@ -398,6 +398,36 @@ TEST_F(CampaignTest, DamperSizingFindsTheAnalyticSmallestDamper) {
   }
 }
 
+// Two lightly damped modes 0.1 Hz apart (a re-audit's two tuned turntables) beat every 10 s; at
+// 20 % of the peak the output sits inside its band for 1.06 s around the node at 4.6 s, longer
+// than its stay (a period, 1.04 s), and a 5.15 s record ended there: "settled at 4.09 s", a
+// damper 133 times too small "met" the target. Continued by its modes the output leaves the band
+// again (its envelope stays above the band until about 60 s).
+TEST_F(CampaignTest, ModesBeatingAfterANodeHaveNotSettled) {
+  const double f1 = 0.957668, f2 = 1.057963;
+  const double sigma1 = 0.0053 * 2 * M_PI * f1, sigma2 = 0.0063 * 2 * M_PI * f2;
+  Measurement record;
+  record.channels = {"angle"};
+  record.units = {"rad"};
+  record.sample_interval_s = 0.01;
+  record.values.resize(516, 1);
+  for (int j = 0; j < 516; ++j) {
+    const double t = 0.01 * j;
+    record.values(j, 0) = 0.5 * std::exp(-sigma1 * t) * std::cos(2 * M_PI * f1 * t) +
+                          0.48 * std::exp(-sigma2 * t) * std::cos(2 * M_PI * f2 * t);
+  }
+  const double hold = SettlingHold({f1, f2}, {sigma1, sigma2});
+  EXPECT_NEAR(CalcSettlingTime(record, 0.0, 0.2, {}, hold), 4.09, 1e-9);  // the node
+  EXPECT_TRUE(std::isinf(CalcSettlingTime(record, 0.0, 0.2, {}, hold, {f1, f2}, {sigma1, sigma2})));
+  // One of the modes alone settles where the samples say: the check leaves it.
+  for (int j = 0; j < 516; ++j) {
+    record.values(j, 0) = std::exp(-0.5 * 0.01 * j) * std::cos(2 * M_PI * f1 * 0.01 * j);
+  }
+  const double alone = CalcSettlingTime(record, 0.0, 0.2, {}, SettlingHold({f1}, {0.5}));
+  EXPECT_TRUE(std::isfinite(alone));
+  EXPECT_EQ(CalcSettlingTime(record, 0.0, 0.2, {}, SettlingHold({f1}, {0.5}), {f1}, {0.5}), alone);
+}
+
 // Nearly critically damped (an audit's turntable, J = 50, c = 2000, d = 630: zeta 0.99612), the
 // damped period is 11.3 s, longer than the 10 s record, and a whole period's stay made every
 // damper near the critical one "not settled": it settles in 0.92 s and crosses zero once, with

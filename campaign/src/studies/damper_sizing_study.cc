@@ -39,7 +39,8 @@ class DamperSizingStudy : public CampaignStudy {
                       CaseOutcome* outcome) const override {
     outcome->settling_time_s = CalcSettlingTime(
         test.exact, test.forcing_end_s, spec_.settling_band_fraction, spec_.settling_bands,
-        SettlingHold(outcome->exact_frequencies_hz, outcome->exact_decay_rates_per_s));
+        SettlingHold(outcome->exact_frequencies_hz, outcome->exact_decay_rates_per_s),
+        outcome->exact_frequencies_hz, outcome->exact_decay_rates_per_s);
     outcome->row["settling_time_s"] = internal::Number(outcome->settling_time_s);
   }
 

@@ -66,10 +66,14 @@ std::vector<std::vector<Assignment>> DamperSizingCases(const DamperSizingSpec& s
 // channel stays within its band (`bands` by channel, else |y| <= fraction * max|y| after
 // `after_s`), +inf if the last sample is still outside, and +inf too if the outputs stay inside
 // for less than `hold_s` (SettlingHold) before the record ends: a ringing output passes inside
-// its band near each zero crossing, so only a longer stay shows that it has settled. Times
-// before `after_s` (a forcing) are ignored.
+// its band near each zero crossing, so only a longer stay shows that it has settled. With the
+// model's exact modes, +inf also where the modes fitted to the free decay, continued past the
+// record's end, leave a band again (modes beating: a node can outlast any stay). Times before
+// `after_s` (a forcing) are ignored.
 double CalcSettlingTime(const Measurement& exact, double after_s, double band_fraction,
-                        const std::map<std::string, double>& bands, double hold_s);
+                        const std::map<std::string, double>& bands, double hold_s,
+                        const std::vector<double>& frequencies_hz = {},
+                        const std::vector<double>& decay_rates_per_s = {});
 
 // How long outputs must stay inside their band to count as settled: over the oscillatory modes
 // (frequency > 0), the longest of min(damped period, 3 / decay rate). A lightly damped mode
