@@ -269,8 +269,32 @@ UnitConversion FindConversion(const std::string& from, const std::string& to,
     const bool gram = Dimension(a.get()) == "kg" && Dimension(b.get()) == "m.s-2";
     // A sensor's raw signal (volts, a 4-20 mA loop): its calibration is a scaled unit of what it
     // measures (a trial's 50 mV/deg inclinometer, mounted reversed, read as "-0.02 deg").
-    const bool electric = Dimension(a.get()) == "m2.kg.s-3.A-1" || Dimension(a.get()) == "A";
+    // A bridge's ratio (mV/V, %) is dimensionless: as raw, calibrated the same way.
+    const bool electric = Dimension(a.get()) == "m2.kg.s-3.A-1" || Dimension(a.get()) == "A" ||
+                          Dimension(a.get()) == "1";
     const std::string example = "0.02 " + EverydayUnit(to);
+    // A sensitivity ("deg/mV": what one mV measures) written where the column's unit goes.
+    const size_t slash = from.rfind('/');
+    if (slash != std::string::npos && slash + 1 < from.size()) {
+      const std::string per = from.substr(slash + 1);
+      const UnitPtr denominator = Parse(per);
+      const UnitPtr numerator = Parse(from.substr(0, slash));
+      const std::string dimension = denominator ? Dimension(denominator.get()) : "";
+      if ((dimension == "m2.kg.s-3.A-1" || dimension == "A") && numerator &&
+          Dimension(numerator.get()) == Dimension(b.get())) {
+        throw InputError(
+            source, field,
+            fmt::format("unit '{}' is a sensitivity (what one {} measures), not the unit of the "
+                        "column's values",
+                        from, per),
+            fmt::format(
+                "for a column in {}, its calibration as a scaled unit of what it "
+                "measures: the sensitivity's number times '{}' (`units: {{\"{}\": \"{}\"}}` "
+                "for 0.02 {} per {}; a minus sign for a sensor mounted reversed)",
+                per, from.substr(0, slash), column, "0.02 " + from.substr(0, slash),
+                from.substr(0, slash), per));
+      }
+    }
     throw InputError(
         source, field,
         fmt::format("unit '{}' ({}) cannot be converted to {}", from, Dimension(a.get()), to),

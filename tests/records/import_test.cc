@@ -283,6 +283,19 @@ TEST(ImportTest, ASensorsRawSignalIsReadThroughItsCalibration) {
                         "\xE2\x88\x92"
                         "0.02 deg"}};
   EXPECT_NEAR(ImportMeasurement(dir.File("jib.csv"), typographic).values(0, 0), -1.0 * kDeg, 1e-15);
+  // A bridge's ratio (mV/V) is raw too; a sensitivity (deg/mV) where the unit goes is named as
+  // one (both were "cannot be converted to rad", nothing more).
+  ImportOptions read_as_rad;
+  read_as_rad.target_units = {{"Jib", "rad"}};
+  WriteText(dir.File("bridge.csv"), "time [s],Jib [mV/V]\n0,0.5\n0.01,-0.25\n0.02,1\n");
+  EXPECT_THAT(
+      CatchInputError([&] { ImportMeasurement(dir.File("bridge.csv"), read_as_rad); }).expected(),
+      HasSubstr("the sensor's calibration, what one mV/V of its signal measures"));
+  WriteText(dir.File("sensitivity.csv"), "time [s],Jib [deg/mV]\n0,50\n0.01,-25\n0.02,100\n");
+  const InputError sensitivity =
+      CatchInputError([&] { ImportMeasurement(dir.File("sensitivity.csv"), read_as_rad); });
+  EXPECT_THAT(sensitivity.problem(), HasSubstr("'deg/mV' is a sensitivity"));
+  EXPECT_THAT(sensitivity.expected(), HasSubstr("`units: {\"Jib\": \"0.02 deg\"}`"));
 }
 
 // A column without a unit is refused with an example in the unit its channel is read in (an
