@@ -98,8 +98,11 @@ std::string LawsReport(const LawsSpec& spec, const std::vector<PolynomialLaw>& l
   md << "## Laws: how the parameters change with the operating condition\n\n";
   md << fmt::format(
       "Each quantity is fitted over the successful cases as a polynomial of total degree {} in "
-      "`{}` by least squares; the standard deviations assume independent errors of equal "
-      "variance, estimated from the residuals (s^2 = RSS / (N - P)).\n\n",
+      "`{}` by least squares. Where the cases give their own standard deviations (fitted and "
+      "identified values) each case is weighted by them and the coefficients' standard "
+      "deviations follow from them (inflated by chi^2 per degree of freedom above 1); "
+      "otherwise the errors are taken as independent and of equal variance, estimated from the "
+      "residuals (s^2 = RSS / (N - P)).\n\n",
       spec.degree, fmt::join(spec.variables, "`, `"));
   const bool gnuplot = GnuplotAvailable();
   for (size_t q = 0; q < laws.size(); ++q) {
