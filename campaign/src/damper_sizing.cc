@@ -231,14 +231,7 @@ void ReadSettlingBands(const YamlReader& section, const validation::Scenario& pr
                      "either absolute bands (settling_band_<unit>) or a fraction of the peak");
     }
     std::map<std::string, std::string>& units = spec->settling_band_units;
-    for (int i = 0; i < model->output_count(); ++i) {
-      units[model->output_names()[static_cast<size_t>(i)]] =
-          model->output_units()[static_cast<size_t>(i)];
-    }
-    for (int i = 0; i < model->coordinate_count(); ++i) {
-      units.emplace(model->coordinate_names()[static_cast<size_t>(i)],
-                    model->coordinate_units()[static_cast<size_t>(i)]);
-    }
+    units = simulation::ChannelUnits(*model);
     for (const std::string& channel : channels) {
       if (spec->settling_bands.count(channel) == 0) {
         targets.Fail(fmt::format("no band for channel '{}' (in {})", channel, units[channel]),

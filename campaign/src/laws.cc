@@ -100,6 +100,31 @@ PolynomialLaw Unfitted(PolynomialLaw law, const std::string& why) {
 
 using internal::ToVector;
 
+// Why the cases cannot determine a law's terms: a variable that does not vary, one with fewer
+// distinct values than the degree needs (a quadratic needs three), or variables that vary
+// together.
+std::string WhyUndetermined(const Eigen::MatrixXd& x, int degree,
+                            const std::vector<std::string>& variables) {
+  std::vector<std::string> reasons;
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    std::vector<double> values(x.col(i).data(), x.col(i).data() + x.rows());
+    std::sort(values.begin(), values.end());
+    const auto distinct = std::unique(values.begin(), values.end()) - values.begin();
+    const std::string name = internal::ShortName(variables[static_cast<size_t>(i)]);
+    if (distinct <= 1) {
+      reasons.push_back(name + " does not vary");
+    } else if (distinct <= degree) {
+      reasons.push_back(fmt::format("{} takes {} distinct values, a degree {} needs {}", name,
+                                    distinct, degree, degree + 1));
+    }
+  }
+  if (reasons.empty()) {
+    return "the cases do not determine the terms: the variables vary together (each alone has "
+           "values enough for the degree)";
+  }
+  return fmt::format("the cases do not determine the terms: {}", fmt::join(reasons, "; "));
+}
+
 }  // namespace
 
 double PolynomialLaw::Evaluate(const Eigen::VectorXd& x) const {
@@ -130,35 +155,6 @@ std::string PolynomialLaw::TermName(int term) const {
   }
   return factors.empty() ? "1" : fmt::format("{}", fmt::join(factors, "*"));
 }
-
-namespace {
-
-// Why the cases cannot determine a law's terms: a variable that does not vary, one with fewer
-// distinct values than the degree needs (a quadratic needs three), or variables that vary
-// together.
-std::string WhyUndetermined(const Eigen::MatrixXd& x, int degree,
-                            const std::vector<std::string>& variables) {
-  std::vector<std::string> reasons;
-  for (Eigen::Index i = 0; i < x.cols(); ++i) {
-    std::vector<double> values(x.col(i).data(), x.col(i).data() + x.rows());
-    std::sort(values.begin(), values.end());
-    const auto distinct = std::unique(values.begin(), values.end()) - values.begin();
-    const std::string name = internal::ShortName(variables[static_cast<size_t>(i)]);
-    if (distinct <= 1) {
-      reasons.push_back(name + " does not vary");
-    } else if (distinct <= degree) {
-      reasons.push_back(fmt::format("{} takes {} distinct values, a degree {} needs {}", name,
-                                    distinct, degree, degree + 1));
-    }
-  }
-  if (reasons.empty()) {
-    return "the cases do not determine the terms: the variables vary together (each alone has "
-           "values enough for the degree)";
-  }
-  return fmt::format("the cases do not determine the terms: {}", fmt::join(reasons, "; "));
-}
-
-}  // namespace
 
 PolynomialLaw FitPolynomialLaw(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int degree,
                                const std::vector<std::string>& variables,

@@ -56,11 +56,7 @@ std::vector<std::string> UnitKeys(const std::string& base) {
   return keys;
 }
 
-std::map<std::string, double> ReadPerUnitChannelValues(const YamlReader& node,
-                                                       const std::string& base,
-                                                       const std::vector<std::string>& channels,
-                                                       const model::MechanicalModel& model,
-                                                       bool non_negative) {
+std::map<std::string, std::string> ChannelUnits(const model::MechanicalModel& model) {
   std::map<std::string, std::string> units;
   for (int i = 0; i < model.output_count(); ++i) {
     units[model.output_names()[static_cast<size_t>(i)]] =
@@ -72,6 +68,15 @@ std::map<std::string, double> ReadPerUnitChannelValues(const YamlReader& node,
     units.emplace(model.coordinate_names()[static_cast<size_t>(i)],
                   coordinate_units[static_cast<size_t>(i)]);
   }
+  return units;
+}
+
+std::map<std::string, double> ReadPerUnitChannelValues(const YamlReader& node,
+                                                       const std::string& base,
+                                                       const std::vector<std::string>& channels,
+                                                       const model::MechanicalModel& model,
+                                                       bool non_negative) {
+  const std::map<std::string, std::string> units = ChannelUnits(model);
   // Each unit's key read as ReadChannelValues reads one, over that unit's channels; first the
   // two mistakes its generic errors would describe poorly.
   std::map<std::string, double> values;

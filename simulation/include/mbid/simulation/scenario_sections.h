@@ -30,6 +30,9 @@ std::map<std::string, double> ReadPerUnitChannelValues(const YamlReader& node,
                                                        const model::MechanicalModel& model,
                                                        bool non_negative);
 std::vector<std::string> UnitKeys(const std::string& base);
+// The unit of every name a channel may have: the model's outputs and coordinates (an output wins
+// over a coordinate of the same name, as in the channel lookup).
+std::map<std::string, std::string> ChannelUnits(const model::MechanicalModel& model);
 SimulationOptions ReadSimulationOptions(const YamlReader& simulation);
 // An `integrator:` block; keys it leaves out keep their values in `defaults`.
 IntegratorOptions ReadIntegratorOptions(const YamlReader& integrator, IntegratorOptions defaults);
